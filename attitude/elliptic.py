@@ -1,0 +1,300 @@
+"""Jacobi elliptic functions and elliptic integrals, parametrized by mc = 1 − m.
+
+Everything here takes the *complementary parameter* ``mc = 1 − m`` ([OLBC10] §19.1,
+§22.2) instead of the parameter ``m``: near the separatrix of the free rigid body
+``m`` is within 1e-14 of 1, and a float ``m`` has already lost the digits that
+matter there.  The solver computes ``mc`` from the physics without cancellation
+(Leroy, "The elliptic modulus") and hands it to these kernels unchanged.
+
+Why our own kernels: ``scipy.special.ellipj`` takes ``m`` and, for ``m ≥ 1 − 1e-9``,
+switches to an approximation that is only valid in the first quarter period (values
+of 1e47 and NaN further out; scipy issue #8480), and its error grows with ``u``
+because it does not reduce the argument.  The Carlson symmetric integrals and the
+complete integral K are taken from scipy, which computes them well.
+
+References
+----------
+[OLBC10] F. Olver et al., *NIST Handbook of Mathematical Functions*, 2010
+    (the DLMF), chapters 19 (elliptic integrals) and 22 (Jacobi functions).
+[Bul65] R. Bulirsch, "Numerical calculation of elliptic integrals and elliptic
+    functions", Numerische Mathematik 7 (1965) 78–90, procedure ``sncndn``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy import special
+
+__all__ = [
+    "complete_first_kind",
+    "elliptic_f",
+    "elliptic_pi",
+    "elliptic_pi_complete",
+    "jacobi_amplitude",
+    "jacobi_sn_cn_dn",
+    "pi_minus_f",
+    "reduce_argument",
+    "reduced_sn_cn_dn",
+]
+
+# Bulirsch's convergence threshold on the arithmetic-geometric mean: the method's
+# accuracy is the square of it, so 2**-27 gives full double precision.
+_AGM_TOLERANCE = 2.0**-27
+# Below this |u| the Taylor series to u⁵ is exact to rounding (the next term is
+# O(u⁶) ≈ 1e-24), and it avoids the overflow of Bulirsch's cot recurrence at tiny u.
+_SERIES_THRESHOLD = 1.0e-4
+
+
+def _as_mc(mc: ArrayLike) -> NDArray[np.float64]:
+    mc = np.asarray(mc, dtype=np.float64)
+    if not np.all((mc >= 0.0) & (mc <= 1.0)):
+        bad = mc[~((mc >= 0.0) & (mc <= 1.0))].ravel()[0]
+        raise ValueError(
+            f"complementary parameter mc must lie in [0, 1] (m = 1 - mc in [0, 1]), got mc={bad!r}"
+        )
+    return mc
+
+
+def complete_first_kind(mc: ArrayLike) -> NDArray[np.float64]:
+    """K(m), the complete elliptic integral of the first kind, from mc = 1 − m.
+
+    [OLBC10] 19.2.8.  Uses ``scipy.special.ellipkm1``, which takes mc directly and
+    is accurate as mc → 0 (where K ≈ ln(4/√mc)).  K is infinite for mc = 0.
+    """
+    mc = _as_mc(mc)
+    return special.ellipkm1(mc)
+
+
+def reduce_argument(u: ArrayLike, K: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Split ``u = 2 j K + r`` with integer ``j`` (as float) and ``|r| ≤ K``.
+
+    The Jacobi functions have period 4K, and sn, cn change sign over 2K while dn does
+    not ([OLBC10] 22.4.3); the amplitude grows by π over 2K ([OLBC10] 22.16.2).  For
+    K = ∞ (mc = 0) nothing is periodic and ``j = 0``, ``r = u``.
+    """
+    u = np.asarray(u, dtype=np.float64)
+    K = np.asarray(K, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        j = np.where(np.isfinite(K), np.rint(u / (2.0 * K)), 0.0)
+        r = np.where(j == 0.0, u, u - j * (2.0 * K))
+    return j, r
+
+
+def _agm_sequences(mc: NDArray[np.float64]) -> tuple[list, list, NDArray[np.float64]]:
+    """Arithmetic-geometric mean sequences a_i, b_i starting at (1, √mc) [Bul65].
+
+    With an array ``mc`` the iteration runs until every element has converged;
+    extra steps on an element that has already converged are identities to rounding.
+    """
+    a = np.ones_like(mc)
+    emc = mc
+    a_seq, b_seq = [], []
+    for _ in range(32):
+        a_seq.append(a)
+        emc = np.sqrt(emc)
+        b_seq.append(emc)
+        c = 0.5 * (a + emc)
+        if np.all(np.abs(a - emc) <= _AGM_TOLERANCE * a):
+            return a_seq, b_seq, c
+        emc = emc * a
+        a = c
+    raise ArithmeticError("AGM did not converge")  # pragma: no cover  (quadratic convergence)
+
+
+def _sn_cn_dn_core(
+    z: NDArray[np.float64], mc: NDArray[np.float64]
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """sn, cn, dn for |z| ≤ K/2 (same shapes for z and mc): Bulirsch, series or hyperbolic."""
+    sn = np.empty(z.shape)
+    cn = np.empty(z.shape)
+    dn = np.empty(z.shape)
+    hyperbolic = mc == 0.0
+    small = (np.abs(z) < _SERIES_THRESHOLD) & ~hyperbolic
+    general = ~(hyperbolic | small)
+
+    if np.any(hyperbolic):
+        x = z[hyperbolic]
+        sn[hyperbolic] = np.tanh(x)
+        cn[hyperbolic] = dn[hyperbolic] = 1.0 / np.cosh(x)
+
+    if np.any(small):
+        x = z[small]
+        m = 1.0 - mc[small]
+        x2 = x * x
+        sn[small] = x * (1.0 - x2 * ((1.0 + m) / 6.0 - x2 * (1.0 + m * (14.0 + m)) / 120.0))
+        cn[small] = 1.0 - x2 * (0.5 - x2 * (1.0 + 4.0 * m) / 24.0)
+        dn[small] = 1.0 - m * x2 * (0.5 - x2 * (4.0 + m) / 24.0)
+
+    if np.any(general):
+        # The AGM depends on mc only: computed once when mc is a scalar (the solver's
+        # case), elementwise otherwise.
+        mc_g = mc[general]
+        if np.all(mc_g == mc_g.flat[0]):
+            mc_g = mc_g.flat[0:1].reshape(())
+        a_seq, b_seq, c = _agm_sequences(mc_g)
+        x = z[general] * c
+        s = np.sin(x)
+        a = np.cos(x) / s
+        c = c * a
+        d = np.ones_like(x)
+        for a_i, b_i in zip(reversed(a_seq), reversed(b_seq), strict=True):
+            a = a * c
+            c = c * d
+            d = (b_i + a) / (a_i + a)
+            a = c / a_i
+        a = 1.0 / np.sqrt(c * c + 1.0)
+        s = np.copysign(a, s)
+        sn[general] = s
+        cn[general] = c * s
+        dn[general] = d
+    return sn, cn, dn
+
+
+def reduced_sn_cn_dn(
+    r: ArrayLike, mc: ArrayLike, K: ArrayLike | None = None
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """sn, cn, dn of a reduced argument ``|r| ≤ K`` (so cn ≥ 0), for 0 ≤ mc ≤ 1.
+
+    Bulirsch's ``sncndn`` [Bul65] (descending Gauss transformation driven by the
+    AGM of 1 and √mc), vectorized: one sine and one cosine per element, then a
+    rational recurrence.  For mc = 0 the functions are tanh, sech, sech
+    ([OLBC10] 22.5.8); for tiny |r| the Maclaurin series ([OLBC10] 22.10.1–3).
+
+    Near ±K, where cn and dn are both small (dn(K) = √mc), the recurrence only has
+    absolute accuracy.  So for K/2 < |r| ≤ K we evaluate at z = r ∓ K and shift by a
+    quarter period ([OLBC10] Table 22.4.3: sn(z + K) = cd z, cn(z + K) = −√mc sd z,
+    dn(z + K) = √mc nd z), which keeps all three to full relative accuracy.
+    ``K`` may be passed when the caller already has it.
+    """
+    r = np.asarray(r, dtype=np.float64)
+    mc = _as_mc(mc)
+    if K is None:
+        K = complete_first_kind(mc)
+    r, mc, K = np.broadcast_arrays(r, mc, np.asarray(K, dtype=np.float64))
+    far = np.abs(r) > 0.5 * K
+    z = np.where(far, r - np.copysign(K, r), r)
+    s, c, d = _sn_cn_dn_core(z, mc)
+    if not np.any(far):
+        return s, c, d
+    sigma = np.copysign(1.0, r)
+    sqrt_mc = np.sqrt(mc)
+    return (
+        np.where(far, sigma * c / d, s),
+        np.where(far, -sigma * sqrt_mc * s / d, c),
+        np.where(far, sqrt_mc / d, d),
+    )
+
+
+def jacobi_sn_cn_dn(
+    u: ArrayLike, mc: ArrayLike
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """Jacobi elliptic functions sn(u|m), cn(u|m), dn(u|m) for any real u, from mc = 1 − m.
+
+    The argument is first reduced by the half period 2K ([OLBC10] 22.4.3:
+    sn(u + 2K) = −sn u, cn(u + 2K) = −cn u, dn(u + 2K) = dn u), so the error does not
+    grow with |u| beyond the rounding of u itself.
+    """
+    mc = _as_mc(mc)
+    K = complete_first_kind(mc)
+    j, r = reduce_argument(u, K)
+    sn, cn, dn = reduced_sn_cn_dn(r, mc, K)
+    sign = 1.0 - 2.0 * np.mod(j, 2.0)  # (−1)^j
+    return sign * sn, sign * cn, dn
+
+
+def jacobi_amplitude(u: ArrayLike, mc: ArrayLike) -> NDArray[np.float64]:
+    """The Jacobi amplitude am(u|m), continuous and increasing in u, from mc = 1 − m.
+
+    am(u + 2jK) = am(u) + jπ ([OLBC10] 22.16.2), and on |r| ≤ K, where cn ≥ 0,
+    am(r) = atan2(sn r, cn r) lies in [−π/2, π/2] with no branch jump.  For mc = 0 it
+    is the Gudermannian gd(u) ([OLBC10] 22.16.4 with 4.23.40).
+    """
+    mc = _as_mc(mc)
+    K = complete_first_kind(mc)
+    j, r = reduce_argument(u, K)
+    sn, cn, _ = reduced_sn_cn_dn(r, mc, K)
+    return j * np.pi + np.arctan2(sn, cn)
+
+
+def _split_angle(phi: ArrayLike) -> tuple[NDArray[np.float64], ...]:
+    """φ = jπ + φr with |φr| ≤ π/2; returns j, sin φr, cos φr (cos φr ≥ 0)."""
+    phi = np.asarray(phi, dtype=np.float64)
+    j = np.rint(phi / np.pi)
+    phir = phi - j * np.pi
+    return j, np.sin(phir), np.cos(phir)
+
+
+def elliptic_f(phi: ArrayLike, mc: ArrayLike) -> NDArray[np.float64]:
+    """Incomplete elliptic integral of the first kind F(φ|m) for any real φ, from mc.
+
+    Carlson form [OLBC10] 19.25.5 on |φ| ≤ π/2, F = s R_F(c², c² + mc s², 1) with
+    s = sin φ, c = cos φ (``c² + mc s²`` is 1 − m s² without cancellation), and the
+    quasi-periodicity F(φ + jπ) = F(φ) + 2jK ([OLBC10] 19.2.10).
+    """
+    mc = _as_mc(mc)
+    j, s, c = _split_angle(phi)
+    c2 = c * c
+    with np.errstate(invalid="ignore"):
+        f = s * special.elliprf(c2, c2 + mc * s * s, 1.0)
+        return np.where(j == 0.0, f, f + 2.0 * j * complete_first_kind(mc))
+
+
+def pi_minus_f(
+    j: ArrayLike, sn: ArrayLike, cn: ArrayLike, dn: ArrayLike, n: ArrayLike, mc: ArrayLike
+) -> NDArray[np.float64]:
+    """Π(φ, n|m) − F(φ|m) at the amplitude φ = jπ + φr, given sin φr, cos φr ≥ 0, Δ(φr).
+
+    From [OLBC10] 19.25.14 (Carlson form of Π, valid for |φr| ≤ π/2):
+        Π(φr, n) = s R_F(c², Δ², 1) + (n/3) s³ R_J(c², Δ², 1, 1 − n s²),
+    and the quasi-periodicity Π(φr + jπ, n) = Π(φr, n) + 2j Π(n), with the complete
+    Π(n) = K + (n/3) R_J(0, mc, 1, 1 − n) ([OLBC10] 19.25.2).  The F parts cancel, so
+    what remains needs only R_J.
+
+    This is the useful form on a Jacobi amplitude: if φ = am(u), then F(φ) = u exactly
+    and Π(am u, n) = u + pi_minus_f(...), with sn, cn, dn of the reduced argument.
+    Requires n < 1 (no singularity on the path; the solver's n are all ≤ 0).
+    ``1 − n s²`` is written ``c² + (1 − n) s²`` so that it has no cancellation.
+    """
+    j = np.asarray(j, dtype=np.float64)
+    sn = np.asarray(sn, dtype=np.float64)
+    cn = np.asarray(cn, dtype=np.float64)
+    dn = np.asarray(dn, dtype=np.float64)
+    n = np.asarray(n, dtype=np.float64)
+    mc = _as_mc(mc)
+    c2 = cn * cn
+    s2 = sn * sn
+    incomplete = sn * s2 * special.elliprj(c2, dn * dn, 1.0, c2 + (1.0 - n) * s2)
+    if np.all(j == 0.0):
+        return (n / 3.0) * incomplete
+    complete = special.elliprj(0.0, mc, 1.0, 1.0 - n)
+    return (n / 3.0) * (incomplete + 2.0 * j * complete)
+
+
+def _check_n(n: ArrayLike) -> NDArray[np.float64]:
+    n = np.asarray(n, dtype=np.float64)
+    if not np.all(n < 1.0):
+        bad = n[~(n < 1.0)].ravel()[0]
+        raise ValueError(f"characteristic n must be < 1 (hyperbolic case), got n={bad!r}")
+    return n
+
+
+def elliptic_pi(phi: ArrayLike, n: ArrayLike, mc: ArrayLike) -> NDArray[np.float64]:
+    """Incomplete elliptic integral of the third kind Π(φ, n|m) for any real φ, n < 1.
+
+    Π(φ, n|m) = ∫₀^φ dθ / ((1 − n sin²θ) √(1 − m sin²θ))  ([OLBC10] 19.2.7; the
+    convention of [BF54] and of Leroy's notes).  Computed as F(φ) + (Π − F) with
+    [OLBC10] 19.25.5, 19.25.14 and the quasi-periodicity 19.2.10.
+    """
+    n = _check_n(n)
+    mc = _as_mc(mc)
+    j, s, c = _split_angle(phi)
+    dn = np.sqrt(c * c + mc * s * s)
+    return elliptic_f(phi, mc) + pi_minus_f(j, s, c, dn, n, mc)
+
+
+def elliptic_pi_complete(n: ArrayLike, mc: ArrayLike) -> NDArray[np.float64]:
+    """Complete elliptic integral of the third kind Π(n|m), n < 1, from mc ([OLBC10] 19.25.2)."""
+    n = _check_n(n)
+    mc = _as_mc(mc)
+    return special.elliprf(0.0, mc, 1.0) + (n / 3.0) * special.elliprj(0.0, mc, 1.0, 1.0 - n)

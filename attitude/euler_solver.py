@@ -1,0 +1,594 @@
+"""The exact motion of a torque-free rigid body: ``EulerSolver``.
+
+Closed-form solution of Euler's equations and of the attitude, after Celledoni,
+Fassò, Säfström and Zanna [CFSZ07], with the corrections of Leroy [Leroy]
+(``shared/references/leroy-notes-on-celledoni-exact-free-rigid-body.md``): the sign
+of λ that fixes the precession direction, the separatrix with both free signs, the
+cancellation-free Δj and mc, and the attitude through the "preferred axes" and ψ(t).
+No numerical integration: evaluation at any time costs the same and does not drift.
+
+Glossary (the symbols of [Leroy], kept as names in the code)
+------------------------------------------------------------
+I1 ≤ I2 ≤ I3   principal moments, sorted (the user's body axes are permuted to them)
+Ijh            Ij − Ih
+m = (m1,m2,m3) body angular momentum in the preferred principal axes
+G              |m|, the norm of the angular momentum (conserved)
+T              kinetic energy, 2T = Σ mj²/Ij (conserved)
+Δj             G² − 2T Ij; we keep δj = Δj/G² (dimensionless), computed without
+               cancellation as in [Leroy] "The quantity Δj", so that no square of a
+               momentum can overflow or underflow.  Δ1 ≥ 0 ≥ Δ3; sign(Δ2) picks the case
+Bjh            √(±Ij Δh / Ijh), amplitudes of the components of m
+λ              the rate of the elliptic argument u = λ(t − t0) − ν
+λ1, λ2, λ3     |λ| in cases (ii), (iii), (i)
+ν              the phase: u(t0) = −ν
+mc             1 − k², complementary parameter of the Jacobi functions ([Leroy]
+               "The elliptic modulus"); k⁻² replaces k² in case (ii)
+K              K(mc), quarter period of the Jacobi functions in u
+n              characteristic of the elliptic integral of the third kind Π(φ, n|m)
+ψ              angle of the rotation about e1 (case i) or e3 (case ii) that completes
+               the attitude: Q(t) = R ∘ Y(ψ(t)) ∘ P(t) ∘ S
+S, P, Y, R     S: user body axes → preferred principal axes (a signed permutation,
+               a proper rotation); P(t): maps m(t) onto G e1 or G e3; Y: rotation by ψ
+               about that axis; R: constant, fixed by the initial attitude
+
+Cases (exact sign test on the computed δ2, no tolerance):
+  (i)   Δ2 < 0: m circulates about the axis of least inertia, m1 = B13 dn > 0
+  (ii)  Δ2 > 0: m circulates about the axis of greatest inertia, m3 = B31 dn > 0
+  (iii) Δ2 = 0: the separatrix, m1 = B13 sech, m3 = B31 sech, m2 = G th
+  sphere (I1 = I3) and rest (G = 0) are the two special cases whose formulas
+  would be 0/0; every other degenerate body (I1 = I2, I2 = I3, spin about an axis)
+  goes through the general formulas.
+
+References
+----------
+[CFSZ07] E. Celledoni, F. Fassò, N. Säfström, A. Zanna, "The exact computation of the
+    free rigid body motion and its use in splitting methods", SIAM J. Sci. Comput. 30
+    (2008) 2084–2112.
+[Leroy] P. Leroy, "On an article by Celledoni et al.", 2020 (corrections used here).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.spatial.transform import Rotation
+
+from attitude.elliptic import complete_first_kind, pi_minus_f, reduce_argument, reduced_sn_cn_dn
+from attitude.errors import InputError
+from attitude.quantities import as_si_array, as_si_scalar, as_vector3
+from attitude.quaternions import left_matrix, right_matrix
+
+__all__ = ["EulerSolver"]
+
+# Evaluations over many times run in slices of this many samples (see _in_chunks).
+_CHUNK = 16384
+
+
+class _Jacobi:
+    """sn, cn, dn of u = 2jK + r, with those of the reduced r (|r| ≤ K) kept for Π."""
+
+    def __init__(self, u: NDArray[np.float64], mc: float, K: float) -> None:
+        self.j, r = reduce_argument(u, K)
+        self.sn_r, self.cn_r, self.dn_r = reduced_sn_cn_dn(r, mc, K)
+        sign = 1.0 - 2.0 * np.mod(self.j, 2.0)  # (−1)^j: sn, cn change sign every 2K
+        self.sn = sign * self.sn_r
+        self.cn = sign * self.cn_r
+        self.dn = self.dn_r
+
+    def arctan_of_scaled_sc(self, κ: float) -> NDArray[np.float64]:
+        """arctg(κ sc(u)), continuous in u (κ > 0).
+
+        With φ = am(u) = jπ + atan2(sn r, cn r), arctg(κ tan φ) is continued through
+        φ + arctan((κ − 1) sn cn / (cn² + κ sn²)); the second term stays in
+        (−π/2, π/2) because its denominator is positive.
+        """
+        s, c = self.sn_r, self.cn_r
+        am = self.j * np.pi + np.arctan2(s, c)
+        return am + np.arctan((κ - 1.0) * s * c / (c * c + κ * s * s))
+
+
+def _unit_vector_phase(a: float, b: float) -> tuple[float, float]:
+    """(sin φ, cos φ) of the angle φ whose sine and cosine are proportional to (a, b)."""
+    h = math.hypot(a, b)
+    if h == 0.0:
+        return 0.0, 1.0
+    return a / h, b / h
+
+
+def _elliptic_phase(s: float, c: float, mc: float, K: float) -> float:
+    """ν = F(φ|m) for sin φ = s, cos φ = c, φ in (−π, π] ([Leroy] "Phase and initial value").
+
+    Carlson's form F = s R_F(c², 1 − m s², 1) holds for |φ| ≤ π/2; beyond,
+    F(±π − φ') = ±2K − F(φ') ([OLBC10] 19.2.10).  Working from (s, c) rather than
+    from φ = atan2 keeps ν accurate near φ = ±π/2, where dF/dφ = 1/dn is large
+    close to the separatrix.
+    """
+    from scipy.special import elliprf
+
+    c2 = c * c
+    f = s * float(elliprf(c2, c2 + mc * s * s, 1.0))
+    if c >= 0.0:
+        return f
+    return math.copysign(2.0 * K, s) - f
+
+
+class _FormulaI:
+    """Case (i), Δ2 < 0: [Leroy] "Case (i)" with σ = 1 (preferred axes make m1 > 0)."""
+
+    name = "i"
+    axis = 0  # P(t) maps m onto e1: m1 = B13 dn is the component that never vanishes
+
+    def __init__(self, I1, I2, I3, m0, G, δ1, δ2, δ3) -> None:
+        I12, I13, I21, I31, I32 = I1 - I2, I1 - I3, I2 - I1, I3 - I1, I3 - I2
+        self.B13 = G * math.sqrt(I1 * δ3 / I13)
+        self.B21 = G * math.sqrt(I2 * δ1 / I21)
+        self.B31 = G * math.sqrt(I3 * δ1 / I31)
+        # mc = Δ2 I31 / (Δ3 I21) ≤ 1; rounding may exceed 1 for a prolate top (mc = 1).
+        self.mc = min(1.0, δ2 * I31 / (δ3 * I21))
+        self.K = float(complete_first_kind(self.mc))
+        λ3 = G * math.sqrt(δ3 * I12 / (I1 * I2 * I3))
+        self.λ = -λ3  # the corrected sign: λ = −σ λ3
+        # m0 = (B13 dn ν, B21 sn ν, B31 cn ν); all factors scaled by G to stay O(1).
+        s, c = _unit_vector_phase((m0[1] / G) * (self.B31 / G), (m0[2] / G) * (self.B21 / G))
+        self.ν = _elliptic_phase(s, c, self.mc, self.K)
+        # ψ(t) = (G/I1) t + C Π(am u, n) − arctg(κ sc u)   [Leroy] "Integrals", case (i)
+        self.C = G * I13 / (self.λ * I1 * I3)
+        self.n = I1 * I32 / (I3 * I12)
+        self.κ = math.sqrt(I2 * I31 / (I3 * I21))
+        # Π(am u, n) = u + (Π − F) since F(am u) = u, and C λ = G/I3 − G/I1, so the
+        # secular part of ψ is (G/I3) t; the constant −C ν drops out of ψ(t) − ψ(t0).
+        self.ψ_rate = G / I3
+
+    def evaluate(self, τ: NDArray[np.float64], with_ψ: bool):
+        u = self.λ * τ - self.ν
+        f = _Jacobi(u, self.mc, self.K)
+        m = np.stack([self.B13 * f.dn, -self.B21 * f.sn, self.B31 * f.cn], axis=-1)
+        if not with_ψ:
+            return m, None
+        Π_minus_F = pi_minus_f(f.j, f.sn_r, f.cn_r, f.dn_r, self.n, self.mc)
+        ψ = self.ψ_rate * τ + self.C * Π_minus_F - f.arctan_of_scaled_sc(self.κ)
+        return m, ψ
+
+    @property
+    def period(self) -> float:
+        return 4.0 * self.K / abs(self.λ)
+
+
+class _FormulaII:
+    """Case (ii), Δ2 > 0: [Leroy] "Case (ii)" with σ = 1 (preferred axes make m3 > 0)."""
+
+    name = "ii"
+    axis = 2  # P(t) maps m onto e3: m3 = B31 dn never vanishes
+
+    def __init__(self, I1, I2, I3, m0, G, δ1, δ2, δ3) -> None:
+        I13, I21, I23, I31, I32 = I1 - I3, I2 - I1, I2 - I3, I3 - I1, I3 - I2
+        self.B13 = G * math.sqrt(I1 * δ3 / I13)
+        self.B23 = G * math.sqrt(I2 * δ3 / I23)
+        self.B31 = G * math.sqrt(I3 * δ1 / I31)
+        # mc = 1 − k⁻² = Δ2 I31 / (Δ1 I32) ≤ 1 (= 1 for an oblate top, up to rounding).
+        self.mc = min(1.0, δ2 * I31 / (δ1 * I32))
+        self.K = float(complete_first_kind(self.mc))
+        λ1 = G * math.sqrt(δ1 * I32 / (I1 * I2 * I3))
+        self.λ = -λ1  # the corrected sign: λ = −σ λ1
+        # m0 = (B13 cn ν, B23 sn ν, B31 dn ν); all factors scaled by G to stay O(1).
+        s, c = _unit_vector_phase((m0[1] / G) * (self.B13 / G), (m0[0] / G) * (self.B23 / G))
+        self.ν = _elliptic_phase(s, c, self.mc, self.K)
+        # ψ(t) = (G/I3) t + C Π(am u, n) + arctg(κ sc u)   [Leroy] "Integrals", case (ii)
+        self.C = G * I31 / (self.λ * I1 * I3)
+        self.n = I3 * I21 / (I1 * I23)
+        self.κ = math.sqrt(I2 * I31 / (I1 * I32))
+        # As in case (i): C λ = G/I1 − G/I3, so the secular part of ψ is (G/I1) t.
+        self.ψ_rate = G / I1
+
+    def evaluate(self, τ: NDArray[np.float64], with_ψ: bool):
+        u = self.λ * τ - self.ν
+        f = _Jacobi(u, self.mc, self.K)
+        m = np.stack([self.B13 * f.cn, -self.B23 * f.sn, self.B31 * f.dn], axis=-1)
+        if not with_ψ:
+            return m, None
+        Π_minus_F = pi_minus_f(f.j, f.sn_r, f.cn_r, f.dn_r, self.n, self.mc)
+        ψ = self.ψ_rate * τ + self.C * Π_minus_F + f.arctan_of_scaled_sc(self.κ)
+        return m, ψ
+
+    @property
+    def period(self) -> float:
+        return 4.0 * self.K / abs(self.λ)
+
+
+class _FormulaIII:
+    """Case (iii), Δ2 = 0, the separatrix: [Leroy] "Case (iii)", σ' = σ'' = 1."""
+
+    name = "iii"
+    mc = 0.0
+    period = math.inf
+
+    def __init__(self, I1, I2, I3, m0, G, δ1, δ2, δ3) -> None:
+        I13, I31 = I1 - I3, I3 - I1
+        self.G = G
+        self.B13 = G * math.sqrt(I1 * δ3 / I13)
+        self.B31 = G * math.sqrt(I3 * δ1 / I31)
+        self.λ = G * math.sqrt(-δ1 * δ3 / (I1 * I3))  # λ = σ'σ'' λ2
+        # th(−ν) = m02/G and sech(−ν) = √(m01² + m03²)/G, so sinh(−ν) is their ratio:
+        # no cancellation even when m02 is within an ulp of ±G.  A spin exactly about
+        # e2 gives ν = ∓∞ and, through IEEE infinities, m(t) = (0, ±G, 0) at all t.
+        with np.errstate(divide="ignore"):
+            self.ν = -float(np.arcsinh(np.float64(m0[1]) / math.hypot(m0[0], m0[2])))
+        # P(t) maps m onto e1 if B13 < B31, else onto e3 ([Leroy] "Case (iii)"), so that
+        # the coefficient (B − G)/B' of the arc tangent has a non-zero denominator.
+        self.axis = 0 if self.B13 < self.B31 else 2
+        self.ψ_rate = G / I2
+
+    def evaluate(self, τ: NDArray[np.float64], with_ψ: bool):
+        u = self.λ * τ - self.ν
+        with np.errstate(over="ignore"):
+            sech = 1.0 / np.cosh(u)
+        m = np.stack([self.B13 * sech, self.G * np.tanh(u), self.B31 * sech], axis=-1)
+        if not with_ψ:
+            return m, None
+        th_half = np.tanh(0.5 * u)
+        if self.axis == 0:
+            ψ = self.ψ_rate * τ - 2.0 * np.arctan((self.B13 - self.G) / self.B31 * th_half)
+        else:
+            ψ = self.ψ_rate * τ + 2.0 * np.arctan((self.B31 - self.G) / self.B13 * th_half)
+        return m, ψ
+
+
+class _Sphere:
+    """I1 = I2 = I3: ω = m/I is constant, the body spins about m at the rate G/I."""
+
+    name = "sphere"
+    axis = 2
+    mc = math.nan
+    period = math.inf
+
+    def __init__(self, I1, I2, I3, m0, G, δ1, δ2, δ3) -> None:
+        self.m0 = np.array(m0)
+        self.ψ_rate = G / I1
+
+    def evaluate(self, τ: NDArray[np.float64], with_ψ: bool):
+        m = np.broadcast_to(self.m0, (*τ.shape, 3)).copy()
+        return m, (self.ψ_rate * τ if with_ψ else None)
+
+
+class _Rest:
+    """G = 0: nothing moves."""
+
+    name = "rest"
+    axis = None
+    mc = math.nan
+    period = math.inf
+
+    def __init__(self, *args) -> None:
+        pass
+
+    def evaluate(self, τ: NDArray[np.float64], with_ψ: bool):
+        return np.zeros((*τ.shape, 3)), (np.zeros(τ.shape) if with_ψ else None)
+
+
+def _as_moments(inertia: Any) -> NDArray[np.float64]:
+    moments = as_vector3(inertia, "moment_of_inertia", "inertia")
+    if not np.all(moments > 0.0):
+        raise InputError(f"inertia: principal moments must be positive, got {moments.tolist()}")
+    return moments
+
+
+def _as_rotation(attitude: Any) -> Rotation:
+    if attitude is None:
+        return Rotation.identity()
+    if not isinstance(attitude, Rotation):
+        raise InputError(
+            "attitude must be a scipy.spatial.transform.Rotation (body -> inertial), "
+            f"got {type(attitude).__name__}: {attitude!r}"
+        )
+    if not attitude.single:
+        raise InputError(f"attitude must be a single rotation, got a stack of {len(attitude)}")
+    q = attitude.as_quat(scalar_first=True)
+    if not np.all(np.isfinite(q)):
+        raise InputError(f"attitude must be finite, got quaternion {q.tolist()}")
+    return attitude
+
+
+def _as_integers(*values: float) -> list[int]:
+    """The floats ``values`` times one common power of two, as exact integers."""
+    ratios = [float(v).as_integer_ratio() for v in values]
+    scale = max(q for _, q in ratios)  # every q is a power of two and divides scale
+    return [p * (scale // q) for p, q in ratios]
+
+
+def _exact_δ2(
+    I1: float, I2: float, I3: float, m1: float, m2: float, m3: float
+) -> tuple[int, float]:
+    """The sign of Δ2 and δ2 = Δ2/G², exact for the float inputs, rounded once.
+
+    δ2 = (m1² I12/I1 + m3² I32/I3)/G² is a difference of two nearly equal terms near
+    the separatrix: in floats it keeps only about |δ2|/eps of its digits (a relative
+    error of 1e-2 at |Δ2|/G² = 1e-14, which moves the flip period by 1e-8).  Floats
+    are dyadic rationals: with the moments and the momentum written as integers
+    times a common power of two, which cancels,
+        δ2 = (M1² (J1 − J2) J3 + M3² (J3 − J2) J1) / ((M1² + M2² + M3²) J1 J3),
+    a ratio of integers that Python divides with a single rounding.  The sign of the
+    integer numerator is the exact case test.
+    """
+    J1, J2, J3 = _as_integers(I1, I2, I3)
+    M1, M2, M3 = _as_integers(m1, m2, m3)
+    numerator = M1 * M1 * (J1 - J2) * J3 + M3 * M3 * (J3 - J2) * J1
+    denominator = (M1 * M1 + M2 * M2 + M3 * M3) * J1 * J3
+    return (numerator > 0) - (numerator < 0), numerator / denominator
+
+
+def _preferred_axes(moments: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
+    """Sorting permutation of the moments and the axis signs that make it proper.
+
+    The principal coordinates are x_p[k] = signs[k] · x_body[order[k]]; for an odd
+    permutation the middle axis is reversed so that the map is a rotation.
+    """
+    order = np.argsort(moments, kind="stable")
+    matrix = np.zeros((3, 3))
+    matrix[np.arange(3), order] = 1.0
+    signs = np.ones(3)
+    if np.linalg.det(matrix) < 0.0:
+        signs[1] = -1.0
+    return order, signs
+
+
+class EulerSolver:
+    """Exact torque-free motion of a rigid body from its state at ``t0``.
+
+    Parameters
+    ----------
+    inertia
+        The three principal moments of inertia along the body x, y, z axes, in any
+        order, kg m² (or a ``Quantity``).
+    angular_momentum
+        Body-frame angular momentum at ``t0``, N m s (kg m²/s).
+    attitude
+        ``scipy.spatial.transform.Rotation`` taking body coordinates to inertial
+        coordinates at ``t0``; identity when None.
+    t0
+        Epoch of the initial state, seconds (the solver's own time origin).
+
+    The attitude at t is ``Q(t) = R ∘ Y(ψ(t)) ∘ P(t) ∘ S`` (see the module glossary),
+    built so that ``Q(t0)`` is the given attitude and nothing is singular anywhere
+    on the sphere of momenta.  All evaluations accept a scalar or an array of times
+    (seconds, before or after ``t0``) and are vectorized.
+    """
+
+    def __init__(
+        self,
+        inertia: ArrayLike,
+        angular_momentum: ArrayLike,
+        attitude: Rotation | None = None,
+        t0: float = 0.0,
+    ) -> None:
+        moments = _as_moments(inertia)
+        m_body = as_vector3(angular_momentum, "angular_momentum", "angular_momentum")
+        self._initial_attitude = _as_rotation(attitude)
+        self._t0 = as_si_scalar(t0, "time", "t0")
+        self._moments = moments
+        self._initial_angular_momentum = m_body
+
+        order, signs = _preferred_axes(moments)
+        I1, I2, I3 = moments[order]
+        m = signs * m_body[order]
+        G = math.hypot(*m)  # math.hypot scales: no overflow or underflow of the squares
+        self._G = G
+        if G == 0.0:
+            δ1 = δ2 = δ3 = 0.0
+            formula = _Rest
+        else:
+            # δj = Δj/G², sums of terms of one sign except δ2 ([Leroy] "The quantity Δj").
+            x1, x2, x3 = m / G
+            δ1 = x2 * x2 * ((I2 - I1) / I2) + x3 * x3 * ((I3 - I1) / I3)
+            δ3 = x1 * x1 * ((I1 - I3) / I1) + x2 * x2 * ((I2 - I3) / I2)
+            sign_Δ2, δ2 = _exact_δ2(I1, I2, I3, *m)
+            if I1 == I3:
+                formula = _Sphere
+            elif sign_Δ2 < 0:
+                formula = _FormulaI
+            elif sign_Δ2 > 0:
+                formula = _FormulaII
+            else:
+                formula = _FormulaIII
+        # 2T = Σ mj²/Ij = G² (x1²/I1 + x2²/I2 + x3²/I3)
+        x = m / G if G > 0.0 else m
+        self._kinetic_energy = 0.5 * G * G * float(np.sum(x * x / np.array([I1, I2, I3])))
+
+        # Preferred axes ([Leroy] "An alternative quaternionic solution"): reverse axes
+        # (by a rotation of π) so that the components carrying dn or sech are ≥ 0.
+        flip1 = formula in (_FormulaI, _FormulaIII) and m[0] < 0.0
+        flip3 = formula in (_FormulaII, _FormulaIII, _Sphere) and m[2] < 0.0
+        flips = np.ones(3)
+        if flip1 and flip3:
+            flips[[0, 2]] = -1.0
+        elif flip1:
+            flips[[0, 1]] = -1.0
+        elif flip3:
+            flips[[1, 2]] = -1.0
+        signs = signs * flips
+        m = flips * m
+        self._order, self._signs = order, signs
+        self._formula = formula(I1, I2, I3, m, G, δ1, δ2, δ3)
+
+        # S: user body → preferred principal axes, a signed permutation with det +1.
+        S_matrix = np.zeros((3, 3))
+        S_matrix[np.arange(3), order] = signs
+        S = Rotation.from_matrix(S_matrix).as_quat(scalar_first=True)
+        # R = Q0 ∘ S⁻¹ ∘ P(t0)⁻¹ so that Q(t0) = Q0, with ψ measured from ψ(t0).
+        m_t0, ψ_t0 = self._formula.evaluate(np.zeros(1), with_ψ=True)
+        self._ψ_t0 = float(ψ_t0[0])
+        Q0 = self._initial_attitude.as_quat(scalar_first=True)
+        if self._formula.axis is None:
+            P0 = np.array([1.0, 0.0, 0.0, 0.0])
+        else:
+            P0 = self._p_quaternion(m_t0)[0]
+        S_inv = S * np.array([1.0, -1.0, -1.0, -1.0])
+        P0_inv = P0 * np.array([1.0, -1.0, -1.0, -1.0])
+        R = left_matrix(Q0) @ left_matrix(S_inv) @ P0_inv
+        # q(t) = R ⊗ (Y ⊗ P)(t) ⊗ S = L(R) Rr(S) (Y ⊗ P)(t): one constant 4×4 matrix.
+        # Kept transposed, with its columns reordered so that the product comes out
+        # scalar last, the layout Rotation.from_quat takes without a copy.
+        M = left_matrix(R) @ right_matrix(S)
+        self._M_T_scalar_last = np.ascontiguousarray(M[[1, 2, 3, 0]].T)
+        self._inertial_angular_momentum = self._initial_attitude.apply(m_body)
+
+    @classmethod
+    def from_angular_velocity(
+        cls,
+        inertia: ArrayLike,
+        angular_velocity: ArrayLike,
+        attitude: Rotation | None = None,
+        t0: float = 0.0,
+    ) -> EulerSolver:
+        """Build the solver from the body angular velocity at ``t0`` (rad/s)."""
+        moments = _as_moments(inertia)
+        ω = as_vector3(angular_velocity, "angular_velocity", "angular_velocity")
+        return cls(moments, moments * ω, attitude, t0)
+
+    # ----------------------------------------------------------------- evaluation
+
+    def _τ(self, t: Any) -> NDArray[np.float64]:
+        return as_si_array(t, "time", "t") - self._t0
+
+    def _to_body(self, m_preferred: NDArray[np.float64]) -> NDArray[np.float64]:
+        m_body = np.empty_like(m_preferred)
+        m_body[..., self._order] = m_preferred * self._signs
+        return m_body
+
+    def _p_quaternion(self, m: NDArray[np.float64]) -> NDArray[np.float64]:
+        """P(t) as scalar-first quaternions: the rotation taking m onto G e1 or G e3.
+
+        [Leroy] "Case (i)" (onto e1) and "Case (ii)" (onto e3) of "Integrals":
+        p0 = √((1 + ma/G)/2) and the other components over √(2G(G + ma)) = 2G p0,
+        where ma ≥ 0 is the preferred component, so that G + ma ≥ G never vanishes.
+        """
+        G = self._G
+        m1, m2, m3 = m[..., 0], m[..., 1], m[..., 2]
+        zero = np.zeros_like(m1)
+        if self._formula.axis == 0:
+            p0 = np.sqrt(0.5 * (1.0 + m1 / G))
+            return np.stack([p0, zero, m3 / (2.0 * G * p0), -m2 / (2.0 * G * p0)], axis=-1)
+        p0 = np.sqrt(0.5 * (1.0 + m3 / G))
+        return np.stack([p0, m2 / (2.0 * G * p0), -m1 / (2.0 * G * p0), zero], axis=-1)
+
+    def _momentum_chunk(self, τ: NDArray[np.float64]) -> NDArray[np.float64]:
+        m, _ = self._formula.evaluate(τ, with_ψ=False)
+        return self._to_body(m)
+
+    def _quaternion_chunk(self, τ: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Attitude quaternions at τ = t − t0, scalar LAST (x, y, z, w), body → inertial."""
+        m, ψ = self._formula.evaluate(τ, with_ψ=True)
+        half = 0.5 * (ψ - self._ψ_t0)
+        cy, sy = np.cos(half), np.sin(half)
+        p = self._p_quaternion(m)
+        p0, p1, p2, p3 = p[..., 0], p[..., 1], p[..., 2], p[..., 3]
+        # Y ⊗ P with Y = (cos ψ/2, sin ψ/2 e_axis); P has no component along e_axis.
+        if self._formula.axis == 0:
+            yp = np.stack([cy * p0, sy * p0, cy * p2 - sy * p3, cy * p3 + sy * p2], axis=-1)
+        else:
+            yp = np.stack([cy * p0, cy * p1 - sy * p2, cy * p2 + sy * p1, sy * p0], axis=-1)
+        return np.dot(yp, self._M_T_scalar_last)
+
+    @staticmethod
+    def _in_chunks(function, τ: NDArray[np.float64], width: int) -> NDArray[np.float64]:
+        """Apply ``function`` to τ in slices of ``_CHUNK`` elements.
+
+        A slice's temporaries stay in the processor's cache; over a million samples
+        this is about 1.7 times faster than one pass over the whole array.
+        """
+        flat = τ.ravel()
+        if flat.size <= _CHUNK:
+            return function(flat).reshape((*τ.shape, width))
+        out = np.empty((flat.size, width))
+        for start in range(0, flat.size, _CHUNK):
+            out[start : start + _CHUNK] = function(flat[start : start + _CHUNK])
+        return out.reshape((*τ.shape, width))
+
+    def angular_momentum(self, t: ArrayLike) -> NDArray[np.float64]:
+        """Body-frame angular momentum at ``t`` (N m s), shape ``np.shape(t) + (3,)``."""
+        return self._in_chunks(self._momentum_chunk, self._τ(t), 3)
+
+    def angular_velocity(self, t: ArrayLike) -> NDArray[np.float64]:
+        """Body-frame angular velocity at ``t`` (rad/s), shape ``np.shape(t) + (3,)``."""
+        return self.angular_momentum(t) / self._moments
+
+    def attitude(self, t: ArrayLike) -> Rotation:
+        """Rotation taking body coordinates to inertial coordinates at ``t``.
+
+        One ``Rotation`` for a scalar ``t``, a stack for a 1-D array.
+        """
+        τ = self._τ(t)
+        if τ.ndim > 1:
+            raise InputError(
+                f"t must be a scalar or a 1-D array for attitude(), got shape {τ.shape}"
+            )
+        if self._formula.axis is None:  # at rest
+            q = np.broadcast_to(self._initial_attitude.as_quat(), (*τ.shape, 4))
+        else:
+            q = self._in_chunks(self._quaternion_chunk, τ, 4)
+        return Rotation.from_quat(q)
+
+    # ----------------------------------------------------------------- properties
+
+    @property
+    def period(self) -> float:
+        """Period of the body-frame motion m(t), seconds: 4K/|λ|.
+
+        ``math.inf`` on the separatrix, for a sphere and at rest.  For a steady spin
+        about axis 1 or 3 (m constant) it is the period of the nearby motions.
+        """
+        return float(self._formula.period)
+
+    @property
+    def formula(self) -> str:
+        """Which closed form applies: 'i', 'ii', 'iii' (separatrix), 'sphere' or 'rest'."""
+        return self._formula.name
+
+    @property
+    def mc(self) -> float:
+        """Complementary parameter 1 − m of the Jacobi functions (0 on the separatrix)."""
+        return float(self._formula.mc)
+
+    @property
+    def t0(self) -> float:
+        """Epoch of the initial state, seconds."""
+        return self._t0
+
+    @property
+    def moments_of_inertia(self) -> NDArray[np.float64]:
+        """Principal moments along the body x, y, z axes, kg m² (as given)."""
+        return self._moments.copy()
+
+    @property
+    def initial_angular_momentum(self) -> NDArray[np.float64]:
+        """Body-frame angular momentum at ``t0``, N m s."""
+        return self._initial_angular_momentum.copy()
+
+    @property
+    def initial_attitude(self) -> Rotation:
+        """Attitude (body → inertial) at ``t0``."""
+        return self._initial_attitude
+
+    @property
+    def angular_momentum_norm(self) -> float:
+        """G = |m|, N m s (conserved)."""
+        return self._G
+
+    @property
+    def kinetic_energy(self) -> float:
+        """T = ½ Σ mj²/Ij, J (conserved)."""
+        return self._kinetic_energy
+
+    @property
+    def inertial_angular_momentum(self) -> NDArray[np.float64]:
+        """The angular momentum in inertial axes, N m s (conserved)."""
+        return self._inertial_angular_momentum.copy()
+
+    def __repr__(self) -> str:
+        return (
+            f"EulerSolver(inertia={self._moments.tolist()}, "
+            f"angular_momentum={self._initial_angular_momentum.tolist()}, t0={self._t0}, "
+            f"formula={self.formula!r}, period={self.period:.6g} s)"
+        )
