@@ -13,6 +13,6 @@ scalar first and say so.
 
 from attitude.errors import AttitudeError, InputError
 from attitude.euler_solver import EulerSolver
+from attitude.version import __version__
 
-__all__ = ["AttitudeError", "EulerSolver", "InputError"]
-__version__ = "0.1.0"
+__all__ = ["AttitudeError", "EulerSolver", "InputError", "__version__"]

@@ -7,7 +7,7 @@ that wants to tell our complaints apart from numpy's can catch ``InputError``.
 
 from __future__ import annotations
 
-__all__ = ["AttitudeError", "InputError"]
+__all__ = ["AttitudeError", "InertiaWarning", "InputError"]
 
 
 class AttitudeError(Exception):
@@ -19,4 +19,11 @@ class InputError(AttitudeError, ValueError):
 
     The message names the field and the value, so that it can be shown to a user
     as it is.
+    """
+
+
+class InertiaWarning(UserWarning):
+    """An inertia that no real body has (the triangle inequality Ia + Ib ≥ Ic fails).
+
+    The motion is still computed: the solver needs no such property.
     """

@@ -58,6 +58,7 @@ from scipy.spatial.transform import Rotation
 
 from attitude.elliptic import complete_first_kind, pi_minus_f, reduce_argument, reduced_sn_cn_dn
 from attitude.errors import InputError
+from attitude.inertia import principal_axes
 from attitude.quantities import as_si_array, as_si_scalar, as_vector3
 from attitude.quaternions import left_matrix, right_matrix
 
@@ -268,13 +269,6 @@ class _Rest:
         return np.zeros((*τ.shape, 3)), (np.zeros(τ.shape) if with_ψ else None)
 
 
-def _as_moments(inertia: Any) -> NDArray[np.float64]:
-    moments = as_vector3(inertia, "moment_of_inertia", "inertia")
-    if not np.all(moments > 0.0):
-        raise InputError(f"inertia: principal moments must be positive, got {moments.tolist()}")
-    return moments
-
-
 def _as_rotation(attitude: Any) -> Rotation:
     if attitude is None:
         return Rotation.identity()
@@ -341,7 +335,9 @@ class EulerSolver:
     ----------
     inertia
         The three principal moments of inertia along the body x, y, z axes, in any
-        order, kg m² (or a ``Quantity``).
+        order, or the symmetric 3×3 inertia tensor in body axes, kg m² (or a
+        ``Quantity``).  A tensor is diagonalized and every result is still given in
+        the body axes.
     angular_momentum
         Body-frame angular momentum at ``t0``, N m s (kg m²/s).
     attitude
@@ -363,16 +359,19 @@ class EulerSolver:
         attitude: Rotation | None = None,
         t0: float = 0.0,
     ) -> None:
-        moments = _as_moments(inertia)
+        axes = principal_axes(inertia)
         m_body = as_vector3(angular_momentum, "angular_momentum", "angular_momentum")
         self._initial_attitude = _as_rotation(attitude)
         self._t0 = as_si_scalar(t0, "time", "t0")
-        self._moments = moments
+        self._axes = axes
         self._initial_angular_momentum = m_body
 
-        order, signs = _preferred_axes(moments)
-        I1, I2, I3 = moments[order]
-        m = signs * m_body[order]
+        # Body → principal (the identity unless a full tensor was given), then sorted.
+        m_principal = m_body if axes.is_diagonal else axes.body_to_principal.apply(m_body)
+        order, signs = _preferred_axes(axes.moments)
+        I1, I2, I3 = axes.moments[order]
+        self._I_preferred = np.array([I1, I2, I3])
+        m = signs * m_principal[order]
         G = math.hypot(*m)  # math.hypot scales: no overflow or underflow of the squares
         self._G = G
         if G == 0.0:
@@ -409,12 +408,16 @@ class EulerSolver:
             flips[[1, 2]] = -1.0
         signs = signs * flips
         m = flips * m
-        self._order, self._signs = order, signs
         self._formula = formula(I1, I2, I3, m, G, δ1, δ2, δ3)
 
-        # S: user body → preferred principal axes, a signed permutation with det +1.
+        # S: user body → preferred principal axes: a signed permutation with det +1
+        # after the body → principal rotation.  Row vectors go back to the body as
+        # m_preferred @ S (exact when S is a signed permutation).
         S_matrix = np.zeros((3, 3))
         S_matrix[np.arange(3), order] = signs
+        if not axes.is_diagonal:
+            S_matrix = S_matrix @ axes.body_to_principal.as_matrix()
+        self._S_matrix = np.ascontiguousarray(S_matrix)
         S = Rotation.from_matrix(S_matrix).as_quat(scalar_first=True)
         # R = Q0 ∘ S⁻¹ ∘ P(t0)⁻¹ so that Q(t0) = Q0, with ψ measured from ψ(t0).
         m_t0, ψ_t0 = self._formula.evaluate(np.zeros(1), with_ψ=True)
@@ -443,19 +446,17 @@ class EulerSolver:
         t0: float = 0.0,
     ) -> EulerSolver:
         """Build the solver from the body angular velocity at ``t0`` (rad/s)."""
-        moments = _as_moments(inertia)
+        tensor = principal_axes(inertia).tensor
         ω = as_vector3(angular_velocity, "angular_velocity", "angular_velocity")
-        return cls(moments, moments * ω, attitude, t0)
+        return cls(inertia, tensor @ ω, attitude, t0)
 
     # ----------------------------------------------------------------- evaluation
 
     def _τ(self, t: Any) -> NDArray[np.float64]:
         return as_si_array(t, "time", "t") - self._t0
 
-    def _to_body(self, m_preferred: NDArray[np.float64]) -> NDArray[np.float64]:
-        m_body = np.empty_like(m_preferred)
-        m_body[..., self._order] = m_preferred * self._signs
-        return m_body
+    def _to_body(self, v_preferred: NDArray[np.float64]) -> NDArray[np.float64]:
+        return np.dot(v_preferred, self._S_matrix)
 
     def _p_quaternion(self, m: NDArray[np.float64]) -> NDArray[np.float64]:
         """P(t) as scalar-first quaternions: the rotation taking m onto G e1 or G e3.
@@ -476,6 +477,10 @@ class EulerSolver:
     def _momentum_chunk(self, τ: NDArray[np.float64]) -> NDArray[np.float64]:
         m, _ = self._formula.evaluate(τ, with_ψ=False)
         return self._to_body(m)
+
+    def _velocity_chunk(self, τ: NDArray[np.float64]) -> NDArray[np.float64]:
+        m, _ = self._formula.evaluate(τ, with_ψ=False)
+        return self._to_body(m / self._I_preferred)
 
     def _quaternion_chunk(self, τ: NDArray[np.float64]) -> NDArray[np.float64]:
         """Attitude quaternions at τ = t − t0, scalar LAST (x, y, z, w), body → inertial."""
@@ -512,7 +517,7 @@ class EulerSolver:
 
     def angular_velocity(self, t: ArrayLike) -> NDArray[np.float64]:
         """Body-frame angular velocity at ``t`` (rad/s), shape ``np.shape(t) + (3,)``."""
-        return self.angular_momentum(t) / self._moments
+        return self._in_chunks(self._velocity_chunk, self._τ(t), 3)
 
     def attitude(self, t: ArrayLike) -> Rotation:
         """Rotation taking body coordinates to inertial coordinates at ``t``.
@@ -524,11 +529,71 @@ class EulerSolver:
             raise InputError(
                 f"t must be a scalar or a 1-D array for attitude(), got shape {τ.shape}"
             )
+        return Rotation.from_quat(self._quaternions_scalar_last(τ))
+
+    def attitude_quaternion(self, t: ArrayLike, scalar_first: bool = True) -> NDArray[np.float64]:
+        """The attitude at ``t`` as unit quaternions, body → inertial, shape ``np.shape(t) + (4,)``.
+
+        Scalar first (w, x, y, z) by default.  The same rotation as ``attitude(t)``,
+        without building a ``Rotation``: for writing files and for callers that
+        assemble many segments.
+        """
+        q = self._quaternions_scalar_last(self._τ(t))
+        q /= np.linalg.norm(q, axis=-1, keepdims=True)
+        return q[..., [3, 0, 1, 2]] if scalar_first else q
+
+    def _quaternions_scalar_last(self, τ: NDArray[np.float64]) -> NDArray[np.float64]:
         if self._formula.axis is None:  # at rest
-            q = np.broadcast_to(self._initial_attitude.as_quat(), (*τ.shape, 4))
+            return np.broadcast_to(self._initial_attitude.as_quat(), (*τ.shape, 4)).copy()
+        return self._in_chunks(self._quaternion_chunk, τ, 4)
+
+    def spin_axis_cone(self) -> tuple[NDArray[np.float64], float, float] | None:
+        """The body axis about which m circulates, and the cone it describes about m.
+
+        In case (i) m circulates about the axis of least inertia (m1 = B13 dn u), in
+        case (ii) about the axis of greatest inertia (m3 = B31 dn u).  Returns that
+        axis as a unit vector in body coordinates, and the least and greatest angle
+        (rad) between it and the angular momentum: arccos(B/G) at dn = 1 and
+        arccos(B √mc/G) at dn = √mc, reached alternately every period/2 (the
+        nutation).  None on the separatrix, for a sphere and at rest.
+        """
+        f = self._formula
+        if f.name not in ("i", "ii"):
+            return None
+        B = f.B13 if f.name == "i" else f.B31
+        axis = self._to_body(np.eye(3)[f.axis])
+        G = self._G
+        return axis, math.acos(min(1.0, B / G)), math.acos(min(1.0, B * math.sqrt(f.mc) / G))
+
+    def flip_times(self, t_start: float, t_end: float) -> NDArray[np.float64]:
+        """Times in [t_start, t_end] at which the body flips (the Джанибеков effect).
+
+        A flip is a sign change of the momentum component along the intermediate
+        principal axis while the body turns over: m2 ∝ sn(u) vanishes at u = 2jK in
+        cases (i) and (ii), so the flips are the exact times t = t0 + (2jK + ν)/λ,
+        every period/2; on the separatrix there is one, at u = 0.
+
+        The body turns over only if the intermediate axis swings from near +m to
+        near −m: we count flips when the amplitude of m2 exceeds G/√2 (that axis
+        comes within 45° of the angular momentum).  Below, m2 changes sign too, but
+        as part of a nutation about the spin axis, not as a flip.  Empty also for a
+        body without a distinct intermediate axis (I1 = I2 or I2 = I3).
+        """
+        t_start = as_si_scalar(t_start, "time", "t_start")
+        t_end = as_si_scalar(t_end, "time", "t_end")
+        f = self._formula
+        I1, I2, I3 = self._I_preferred
+        if not (I1 < I2 < I3) or f.name not in ("i", "ii", "iii") or f.λ == 0.0:
+            return np.empty(0)
+        u_a, u_b = sorted((f.λ * (t_start - self._t0) - f.ν, f.λ * (t_end - self._t0) - f.ν))
+        if f.name == "iii":
+            zeros_u = np.array([0.0]) if u_a <= 0.0 <= u_b else np.empty(0)
         else:
-            q = self._in_chunks(self._quaternion_chunk, τ, 4)
-        return Rotation.from_quat(q)
+            if (f.B21 if f.name == "i" else f.B23) <= self._G * math.sqrt(0.5):
+                return np.empty(0)
+            j = np.arange(math.ceil(u_a / (2 * f.K)), math.floor(u_b / (2 * f.K)) + 1)
+            zeros_u = 2.0 * j * f.K
+        return np.sort(self._t0 + (zeros_u + f.ν) / f.λ)
 
     # ----------------------------------------------------------------- properties
 
@@ -558,8 +623,13 @@ class EulerSolver:
 
     @property
     def moments_of_inertia(self) -> NDArray[np.float64]:
-        """Principal moments along the body x, y, z axes, kg m² (as given)."""
-        return self._moments.copy()
+        """Principal moments, kg m²: as given, or ascending for a tensor."""
+        return self._axes.moments.copy()
+
+    @property
+    def inertia_tensor(self) -> NDArray[np.float64]:
+        """The inertia tensor in body axes, kg m²."""
+        return self._axes.tensor.copy()
 
     @property
     def initial_angular_momentum(self) -> NDArray[np.float64]:
@@ -588,7 +658,7 @@ class EulerSolver:
 
     def __repr__(self) -> str:
         return (
-            f"EulerSolver(inertia={self._moments.tolist()}, "
+            f"EulerSolver(inertia={self._axes.moments.tolist()}, "
             f"angular_momentum={self._initial_angular_momentum.tolist()}, t0={self._t0}, "
             f"formula={self.formula!r}, period={self.period:.6g} s)"
         )

@@ -11,9 +11,14 @@ PACKAGE = Path(__file__).parents[1] / "attitude"
 
 # In order; a module may import modules of its own layer or of earlier ones.
 LAYERS = [
-    ["errors", "quantities", "quaternions"],
-    ["elliptic"],
-    ["euler_solver"],
+    ["version", "errors", "quantities", "quaternions"],  # shared base
+    ["elliptic"],  # elliptic kernels
+    ["inertia", "euler_solver"],  # the Euler solver
+    ["timescales", "spacecraft", "events", "scenario"],  # spacecraft, scenario and events
+    ["trajectory", "motion_analysis"],  # trajectory
+    ["ephemeris", "orbit", "eclipse", "pointing", "intervals"],  # pointing (skyfield)
+    ["exports", "aem", "plots", "report"],  # reports and exports
+    ["scenario_file", "cli"],  # command line
 ]
 
 

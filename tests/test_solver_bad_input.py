@@ -17,8 +17,11 @@ GOOD_M = [0.1, 0.2, 0.3]
         ([1.0, -2.0, 3.0], r"must be positive, got \[1.0, -2.0, 3.0\]"),
         ([1.0, np.nan, 3.0], r"inertia must be finite, got nan at index 1"),
         ([1.0, 2.0, np.inf], r"inertia must be finite, got inf at index 2"),
-        ([1.0, 2.0], r"inertia must be a 3-vector, got shape \(2,\)"),
-        ([[1.0, 2.0, 3.0]], r"inertia must be a 3-vector, got shape \(1, 3\)"),
+        ([1.0, 2.0], r"inertia must be 3 principal moments or a 3x3 tensor, got shape \(2,\)"),
+        ([[1.0, 2.0, 3.0]], r"inertia must be 3 principal moments or a 3x3 tensor, got shape"),
+        ([[1, 0, 0], [0.5, 2, 0], [0, 0, 3]], r"inertia: tensor is not symmetric"),
+        ([[1, 0, 0], [0, -2, 0], [0, 0, 3]], r"inertia: tensor is not positive definite"),
+        ([[2, 3, 0], [3, 2, 0], [0, 0, 3]], r"tensor is not positive definite \(eigenvalues"),
         (["a", "b", "c"], r"inertia must be numeric"),
     ],
 )

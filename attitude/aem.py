@@ -1,0 +1,861 @@
+"""CCSDS Attitude Ephemeris Messages (AEM 2.0, KVN): a writer, and a small reader for round trips.
+
+The standard is CCSDS 504.0-B-2 (Attitude Data Messages, January 2024), section 4 (AEM
+content), section 6 (KVN syntax) and annex F (conventions).  Section numbers below refer
+to it.
+
+What is written
+---------------
+One message: the header (table 4-2), then one segment per :class:`AemSegment`, each a
+``META_START`` … ``META_STOP`` block (table 4-3) and a ``DATA_START`` … ``DATA_STOP``
+block (table 4-4).  Our scenarios start a new segment at each event: the attitude is
+continuous there but the rate jumps, and a new metadata block is how an AEM says
+"do not interpolate across this" (§4.2.4.8.3).
+
+- ``ATTITUDE_TYPE = QUATERNION/ANGVEL``: each data line is
+  ``EPOCH Q1 Q2 Q3 QC ANGVEL_X ANGVEL_Y ANGVEL_Z``.
+- ``REF_FRAME_A`` = ICRF (or GCRF), ``REF_FRAME_B`` = ``SC_BODY_1``, and
+  ``ANGVEL_FRAME = SC_BODY_1``: the rates are in body axes.  The keyword is optional in
+  table 4-3, but it is the only place where a file says which axes the rates use, so it
+  is always written.
+- ``TIME_SYSTEM``: the scenario's astropy scale, as named in the SANA time-systems
+  registry (annex B2): utc → UTC, tt → TT, tai → TAI, tdb → TDB, tcg → TCG, tcb → TCB.
+  Epochs are written in that scale, as ``YYYY-MM-DDThh:mm:ss.fffffffff`` (§6.8.9, 1 ns).
+  A UTC epoch inside a leap second is written ``…T23:59:60…`` (§4.2.4.7.3), which
+  astropy's ``isot`` does by itself.
+- ``START_TIME``/``STOP_TIME`` are the first and last epochs of the segment.
+  ``USEABLE_START_TIME``/``USEABLE_STOP_TIME`` are the same: each record carries the
+  exact attitude and rate, so the interpolation below needs no margin at the ends.
+- ``INTERPOLATION_METHOD = HERMITE``, ``INTERPOLATION_DEGREE = 3``, for segments of at
+  least four records.  Why Hermite: each record gives the attitude and, through its
+  angular velocity, the attitude's derivative (annex F kinematics,
+  Q̇ = ½ Q ⊗ (ω_B, 0)); inside a segment the motion is smooth.  Hermite uses both.
+  Lagrange would throw the rates away, and linear interpolation would also break the
+  quaternion norm.  Why 3: with a value and a first derivative at each of two
+  neighbouring records, the polynomial is a cubic.  On a rotation at rate ω with step h,
+  its error is at most (ωh/2)⁴/384 per component.  Choosing h is the caller's
+  responsibility.  Why at least four records: the standard does not say what "degree"
+  counts, and Orekit, for one, reads degree d as d + 1 records.  §4.2.4.8.4 asks that
+  every block hold enough records for the recommended method, so shorter segments get
+  no recommendation.
+- ``CREATION_DATE`` is the current UTC time, unless one is given (for reproducible
+  files).  The values of ``OBJECT_NAME``, ``OBJECT_ID``, ``CENTER_NAME`` and
+  ``ORIGINATOR`` come from the caller.
+
+Quaternion convention: how ours maps onto Q1 Q2 Q3 QC
+-----------------------------------------------------
+Ours: ``q = (w, x, y, z)``, scalar first, is the rotation that takes **body coordinates to
+inertial coordinates**: ``v_I = R(q) v_B``, with R(q) the usual (active) rotation matrix
+of q, ``scipy.spatial.transform.Rotation.from_quat(q, scalar_first=True).as_matrix()``.
+The columns of R(q) are therefore the body axes written in inertial coordinates: q is the
+rotation that carries the inertial basis vectors onto the body basis vectors.
+
+AEM (annex F2.1): the quaternion "from A to B" (here A = inertial, B = body) is "the
+rotation that transforms the basis vectors of frame A into the basis vectors of frame B",
+with Q1, Q2, Q3 = e·sin(φ/2) and QC = cos(φ/2), scalar **last** (annex J: the
+``QUATERNION_TYPE`` keyword of version 1 is gone).  The annex gives the coordinate transform
+``X_B = M_BA X_A``, where the first row of M_BA is
+``[Q1²−Q2²−Q3²+QC², 2(Q1Q2+Q3QC), 2(Q1Q3−Q2QC)]``.  This M_BA is exactly the transpose of
+the active rotation matrix of (Q1, Q2, Q3, QC).
+
+Both definitions name the same rotation, A's axes onto B's, so M_BA = R(q)ᵀ and the
+components are equal: **Q1 = x, Q2 = y, Q3 = z, QC = w**.  This is a reordering; there is
+no conjugation.
+
+The 90° example, which is annex F2.2's own.  A body whose x axis points along inertial +y
+is turned +90° about z: ``q = (cos 45°, 0, 0, sin 45°)``, so ``Q1 = Q2 = 0`` and
+``Q3 = QC = √½``.  This gives
+``M_BA = [[0, 1, 0], [−1, 0, 0], [0, 0, 1]]``.  The inertial +y axis, ``X_A = (0, 1, 0)``,
+has body coordinates ``X_B = (1, 0, 0)``: it is the body's x axis, as stated.
+
+Signs.  q and −q are the same attitude, but an interpolating reader needs neighbouring
+records in the same hemisphere.  The writer therefore writes the first record of the file
+with QC ≥ 0, and flips each later record whose dot product with the record before it is
+negative, across segment boundaries too.  The attitudes are unchanged.
+
+Angular velocity (annex F4): "from A to B" is the angular velocity of B with respect to
+A.  Here that is the body's angular velocity relative to inertial space, with
+``ANGVEL_FRAME = SC_BODY_1`` giving its components in body axes.  That is our
+``angular_velocity_body_rad_s``, converted to deg/s (§4.2.4.6).
+
+Numbers
+-------
+Values are written in floating-point notation with 16 significant digits, for example
+``7.071067811865476E-01``.  §6.8.4 allows at most 16 digits, in the mantissa of either
+notation.  17 digits would be needed to reproduce every double bit for bit; with 16, a
+quaternion component comes back within 5e-17 (half a unit in its 16th digit).  ``-0`` is
+written as 0 (§6.8.5 excludes it).  Data lines stay under the 254-character limit of
+§6.6.1.
+
+Text values (§6.8.6) must be all upper case or all lower case.  A mixed-case name is
+refused rather than changed: it identifies something.  Comments may use any case
+(§6.10.1.4).
+
+The write is atomic: everything is validated and formatted first.  The text then goes to
+a temporary file in the target's directory, and ``os.replace`` puts it in place, so a
+failed call leaves no file behind and never a half-written one.  Bad input raises
+:class:`~attitude.errors.InputError` naming the field and the value.
+
+The reader, :func:`read_aem`, reads back what this module writes (and the same content
+laid out differently, e.g. by another tool).  It refuses what it does not understand:
+other attitude types, other frames, version-1 keywords, a ``:60`` that is not a UTC leap
+second, non-unit quaternions, epochs that do not increase.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import secrets
+import warnings
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from attitude.errors import InputError
+from attitude.timescales import as_time, offline_time, tt_seconds
+
+if TYPE_CHECKING:
+    from astropy.time import Time
+
+__all__ = [
+    "BODY_FRAME",
+    "REFERENCE_FRAMES",
+    "TIME_SYSTEMS",
+    "AemSegment",
+    "read_aem",
+    "write_aem",
+]
+
+AEM_VERSION = "2.0"
+ATTITUDE_TYPE = "QUATERNION/ANGVEL"
+BODY_FRAME = "SC_BODY_1"
+# Our inertial axes are the ICRS axes.  The GCRS axes are the same axes; only the origin
+# differs, and an attitude does not depend on the origin.  Other frames (EME2000, ...)
+# would need a rotation, so they are refused rather than mislabelled.
+REFERENCE_FRAMES = ("ICRF", "GCRF")
+# astropy scale -> TIME_SYSTEM value (SANA time-systems registry, annex B2).
+TIME_SYSTEMS = {"utc": "UTC", "tt": "TT", "tai": "TAI", "tdb": "TDB", "tcg": "TCG", "tcb": "TCB"}
+_SCALES = {value: key for key, value in TIME_SYSTEMS.items()}
+
+# scipy's Rotation normalizes to a few ulp; anything further from 1 is a bug upstream
+# (a matrix row, a wrong array), not rounding.
+UNIT_NORM_TOLERANCE = 1e-12
+# §6.8.4: at most 16 digits (see the module docstring for why not 17).
+SIGNIFICANT_DIGITS = 16
+EPOCH_DECIMALS = 9  # 1 ns, astropy's finest isot precision
+MAX_LINE_CHARS = 254  # §6.6.1
+HERMITE_DEGREE = 3
+HERMITE_MIN_RECORDS = 4
+
+_NUMBER_FORMAT = f"%.{SIGNIFICANT_DIGITS - 1}E"
+_RECORD_FORMAT = "%s" + f" {_NUMBER_FORMAT}" * 7
+# Written epochs; a 4-digit year also keeps string order equal to time order.
+_EPOCH_WRITTEN = re.compile(rf"\d{{4}}-\d\d-\d\dT\d\d:\d\d:\d\d\.\d{{{EPOCH_DECIMALS}}}")
+# Epochs the reader accepts (calendar form of §6.8.9, up to 1 ns, optional Z for UTC).
+_EPOCH_READ = re.compile(r"(\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d)(?:\.(\d{1,9}))?(Z?)")
+# A decimal number in fixed or floating-point notation (§6.8.4), never nan or inf.
+_NUMBER_READ = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
+_KVN_LINE = re.compile(r"([A-Z][A-Z0-9_]*)\s*=\s*(.*)")
+_COMMENT_LINE = re.compile(r"COMMENT(?:\s(.*))?")
+
+# Table 4-2 and table 4-3, in their fixed order (§6.7.8).
+_HEADER_KEYWORDS = ("CCSDS_AEM_VERS", "CLASSIFICATION", "CREATION_DATE", "ORIGINATOR", "MESSAGE_ID")
+_METADATA_KEYWORDS = (
+    "OBJECT_NAME",
+    "OBJECT_ID",
+    "CENTER_NAME",
+    "REF_FRAME_A",
+    "REF_FRAME_B",
+    "TIME_SYSTEM",
+    "START_TIME",
+    "USEABLE_START_TIME",
+    "USEABLE_STOP_TIME",
+    "STOP_TIME",
+    "ATTITUDE_TYPE",
+    "EULER_ROT_SEQ",
+    "ANGVEL_FRAME",
+    "INTERPOLATION_METHOD",
+    "INTERPOLATION_DEGREE",
+)
+_METADATA_MANDATORY = (
+    "OBJECT_NAME",
+    "OBJECT_ID",
+    "REF_FRAME_A",
+    "REF_FRAME_B",
+    "TIME_SYSTEM",
+    "START_TIME",
+    "STOP_TIME",
+    "ATTITUDE_TYPE",
+    "ANGVEL_FRAME",  # optional in table 4-3, but we cannot read rates without it
+)
+
+
+@dataclass(frozen=True, eq=False)
+class AemSegment:
+    """One AEM segment: epochs, attitudes (our convention) and body rates, validated.
+
+    - ``times``: 1-D ``astropy.time.Time``, strictly increasing (compared in TT), any scale.
+    - ``quaternion_body_to_inertial_scalar_first``: (N, 4), unit quaternions (w, x, y, z)
+      taking body coordinates to inertial ones.
+    - ``angular_velocity_body_rad_s``: (N, 3), the body's angular velocity with respect
+      to inertial space, in body axes, rad/s.
+    - ``comments``: optional lines written at the start of the segment's metadata.
+
+    Bad values raise :class:`InputError` on construction.  The times are stored as a
+    copy and the arrays as read-only float64 copies.
+    """
+
+    times: Time
+    quaternion_body_to_inertial_scalar_first: NDArray[np.float64]
+    angular_velocity_body_rad_s: NDArray[np.float64]
+    comments: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        times = _checked_times(self.times)
+        n = len(times)
+        quaternions = _checked_array(
+            "quaternion_body_to_inertial_scalar_first",
+            self.quaternion_body_to_inertial_scalar_first,
+            n,
+            4,
+        )
+        _check_unit_norm("quaternion_body_to_inertial_scalar_first", quaternions)
+        rates = _checked_array(
+            "angular_velocity_body_rad_s", self.angular_velocity_body_rad_s, n, 3
+        )
+        object.__setattr__(self, "times", times)
+        object.__setattr__(self, "quaternion_body_to_inertial_scalar_first", quaternions)
+        object.__setattr__(self, "angular_velocity_body_rad_s", rates)
+        object.__setattr__(self, "comments", _checked_comments("comments", self.comments))
+
+
+def write_aem(
+    path: str | os.PathLike[str],
+    segments: Sequence[AemSegment],
+    *,
+    object_name: str,
+    object_id: str,
+    time_scale: str,
+    reference_frame: str = "ICRF",
+    center_name: str | None = "EARTH",
+    originator: str = "attitude",
+    creation_date: Time | str | None = None,
+    comments: Iterable[str] = (),
+) -> Path:
+    """Write ``segments`` to ``path`` as a CCSDS AEM 2.0 KVN file, atomically.  Returns the path.
+
+    - ``object_name``/``object_id``: ``OBJECT_NAME``/``OBJECT_ID`` (table 4-3), e.g.
+      ``"TESTSAT"``/``"2027-001A"``.  Text must be all upper or all lower case (§6.8.6).
+    - ``time_scale``: the scenario's astropy scale (utc, tt, tai, tdb, tcg, tcb); epochs are
+      converted to it and ``TIME_SYSTEM`` names it (annex B2).
+    - ``reference_frame``: ``REF_FRAME_A``, ``"ICRF"`` or ``"GCRF"``.
+    - ``center_name``: ``CENTER_NAME`` (the body orbited), or None to leave it out.
+    - ``originator``: ``ORIGINATOR`` (table 4-2).
+    - ``creation_date``: ``CREATION_DATE`` (a ``Time``, or an ISO string read as UTC); the
+      current UTC time when None.
+    - ``comments``: header ``COMMENT`` lines, one per item.
+
+    Consecutive segments may share their boundary epoch (an event) but must not overlap,
+    since ``USEABLE_START_TIME`` of a block must not precede ``USEABLE_STOP_TIME`` of the
+    one before (table 4-3).  Nothing is written if anything is wrong.
+    """
+    text = _format_message(
+        segments,
+        object_name=object_name,
+        object_id=object_id,
+        time_scale=time_scale,
+        reference_frame=reference_frame,
+        center_name=center_name,
+        originator=originator,
+        creation_date=creation_date,
+        comments=comments,
+    )
+    return _write_atomically(Path(path), text)
+
+
+def read_aem(path: str | os.PathLike[str]) -> tuple[list[AemSegment], dict[str, Any]]:
+    """Read an AEM 2.0 KVN file of the kind :func:`write_aem` writes.
+
+    Returns the segments, whose times are in the file's time system, quaternions in our
+    convention (body → inertial, scalar first) and rates in rad/s.  It also returns a
+    metadata dict: the header keywords as strings, ``"COMMENT"`` (a list), and
+    ``"segments"``, one dict per segment of its metadata keywords with
+    ``"COMMENT"`` and ``"DATA_COMMENT"`` lists.
+
+    Raises :class:`InputError` naming the line for anything it does not understand or
+    that breaks the standard: another version or attitude type, other frames, unknown or
+    repeated keywords, a wrong column count, a bad epoch, a non-unit quaternion, epochs
+    that do not increase, data outside ``START_TIME``/``STOP_TIME``.
+    """
+    path = Path(path)
+    try:
+        text = path.read_bytes().decode("ascii")
+    except UnicodeDecodeError as exc:
+        raise InputError(
+            f"{path}: an AEM is ASCII text (§6.6.3), byte {exc.start} is not"
+        ) from None
+    return _Parser(path, text).parse()
+
+
+# --- writing -------------------------------------------------------------------------
+
+
+def _format_message(
+    segments: Sequence[AemSegment],
+    *,
+    object_name: str,
+    object_id: str,
+    time_scale: str,
+    reference_frame: str,
+    center_name: str | None,
+    originator: str,
+    creation_date: Time | str | None,
+    comments: Iterable[str],
+) -> str:
+    """The whole message as text, after every check (nothing touches the disk here)."""
+    segments = _checked_segments(segments)
+    time_system = _time_system(time_scale)
+    frame = _reference_frame(reference_frame)
+    names = {
+        "OBJECT_NAME": _text_value("object_name", object_name),
+        "OBJECT_ID": _text_value("object_id", object_id),
+    }
+    center = None if center_name is None else _text_value("center_name", center_name)
+
+    lines = [f"CCSDS_AEM_VERS = {AEM_VERSION}"]
+    lines += [
+        f"COMMENT {line}" if line else "COMMENT" for line in _checked_comments("comments", comments)
+    ]
+    lines.append(f"CREATION_DATE = {_creation_date(creation_date)}")
+    lines.append(f"ORIGINATOR = {_text_value('originator', originator)}")
+
+    previous_last: NDArray[np.float64] | None = None  # last record written, AEM order
+    previous_stop = ""
+    for index, segment in enumerate(segments):
+        name = f"segments[{index}]"
+        epochs = _epoch_strings(segment.times, time_system, name)
+        if epochs[0] < previous_stop:  # same format and scale: string order is time order
+            raise InputError(
+                f"{name} starts at {epochs[0]} {time_system}, before segments[{index - 1}] "
+                f"stops ({previous_stop}); segments must not overlap (table 4-3)"
+            )
+        previous_stop = epochs[-1]
+        quaternions = _aem_quaternions(
+            segment.quaternion_body_to_inertial_scalar_first, previous_last
+        )
+        previous_last = quaternions[-1]
+        # rad/s -> deg/s (§4.2.4.6); "+ 0.0" turns -0 into 0, which §6.8.5 excludes.
+        values = np.hstack([quaternions, np.degrees(segment.angular_velocity_body_rad_s)]) + 0.0
+
+        lines += ["", "META_START"]
+        lines += [f"COMMENT {line}" if line else "COMMENT" for line in segment.comments]
+        lines += [f"{key} = {value}" for key, value in names.items()]
+        if center is not None:
+            lines.append(f"CENTER_NAME = {center}")
+        lines += [
+            f"REF_FRAME_A = {frame}",
+            f"REF_FRAME_B = {BODY_FRAME}",
+            f"TIME_SYSTEM = {time_system}",
+            f"START_TIME = {epochs[0]}",
+            f"USEABLE_START_TIME = {epochs[0]}",
+            f"USEABLE_STOP_TIME = {epochs[-1]}",
+            f"STOP_TIME = {epochs[-1]}",
+            f"ATTITUDE_TYPE = {ATTITUDE_TYPE}",
+            f"ANGVEL_FRAME = {BODY_FRAME}",
+        ]
+        if len(epochs) >= HERMITE_MIN_RECORDS:
+            lines += ["INTERPOLATION_METHOD = HERMITE", f"INTERPOLATION_DEGREE = {HERMITE_DEGREE}"]
+        lines += ["META_STOP", "", "DATA_START"]
+        lines += [
+            _RECORD_FORMAT % (epoch, *row)
+            for epoch, row in zip(epochs.tolist(), values.tolist(), strict=True)
+        ]
+        lines.append("DATA_STOP")
+
+    longest = max(lines, key=len)
+    if len(longest) > MAX_LINE_CHARS:  # only text values can get here; data lines are ~190
+        raise InputError(
+            f"line {longest[:40]!r}... has {len(longest)} characters, more than the "
+            f"{MAX_LINE_CHARS} of §6.6.1"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def _write_atomically(path: Path, text: str) -> Path:
+    """Write ``text`` to a temporary file beside ``path``, then ``os.replace`` it into place.
+
+    The temporary file is created with ``O_EXCL`` and mode 0o666, so the umask applies
+    as for any new file.  ``tempfile`` would make it 0o600, and the AEM would keep that.
+    """
+    data = text.encode("ascii")
+    temporary = path.with_name(f".{path.name}.{secrets.token_hex(8)}.tmp")
+    descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+    try:
+        with os.fdopen(descriptor, "wb") as stream:
+            stream.write(data)
+            stream.flush()
+            os.fsync(stream.fileno())
+        os.replace(temporary, path)
+    except BaseException:
+        temporary.unlink(missing_ok=True)
+        raise
+    return path
+
+
+def _checked_segments(segments: Sequence[AemSegment]) -> list[AemSegment]:
+    if isinstance(segments, AemSegment):
+        raise InputError("segments must be a sequence of AemSegment, got a single AemSegment")
+    try:
+        segments = list(segments)
+    except TypeError:
+        raise InputError(
+            f"segments must be a sequence of AemSegment, got {type(segments).__name__}"
+        ) from None
+    if not segments:
+        raise InputError("segments: an AEM needs at least one segment (table 4-1), got none")
+    for index, segment in enumerate(segments):
+        if not isinstance(segment, AemSegment):
+            raise InputError(
+                f"segments[{index}] must be an AemSegment, got {type(segment).__name__}"
+            )
+    return segments
+
+
+def _time_system(time_scale: str) -> str:
+    scale = str(time_scale).lower()
+    if scale not in TIME_SYSTEMS:
+        raise InputError(f"time_scale must be one of {', '.join(TIME_SYSTEMS)}, got {time_scale!r}")
+    return TIME_SYSTEMS[scale]
+
+
+def _reference_frame(reference_frame: str) -> str:
+    frame = str(reference_frame).upper()
+    if frame not in REFERENCE_FRAMES:
+        raise InputError(
+            f"reference_frame must be one of {', '.join(REFERENCE_FRAMES)} (the axes our "
+            f"attitudes are given in), got {reference_frame!r}"
+        )
+    return frame
+
+
+def _text_value(name: str, value: Any) -> str:
+    """A KVN text value (§6.8.6–6.8.8): printable ASCII, single blanks, one case."""
+    if not isinstance(value, str):
+        raise InputError(f"{name} must be a string, got {value!r}")
+    problem = None
+    if not value:
+        problem = "it is empty (§6.8.7)"
+    elif not (value.isascii() and value.isprintable()):
+        problem = "only printable ASCII is allowed (§6.6.3)"
+    elif value != value.strip() or "  " in value:
+        problem = "leading, trailing or repeated blanks are not significant in KVN (§6.8.8)"
+    elif value != value.upper() and value != value.lower():
+        problem = "text values must be all upper case or all lower case (§6.8.6)"
+    elif len(value) > MAX_LINE_CHARS - len("USEABLE_START_TIME = "):
+        problem = f"it is longer than a {MAX_LINE_CHARS}-character line allows (§6.6.1)"
+    if problem:
+        raise InputError(f"{name}: {value!r} cannot be written: {problem}")
+    return value
+
+
+def _checked_comments(name: str, comments: Iterable[str]) -> tuple[str, ...]:
+    """Comment lines: printable ASCII, one line each; trailing blanks dropped (§6.7.6)."""
+    if isinstance(comments, str):
+        comments = (comments,)
+    checked = []
+    for index, comment in enumerate(comments):
+        if not isinstance(comment, str):
+            raise InputError(f"{name}[{index}] must be a string, got {comment!r}")
+        if not (comment.isascii() and comment.isprintable()):
+            raise InputError(
+                f"{name}[{index}]: {comment!r} must be one line of printable ASCII (§6.6.3); "
+                "give several comments for several lines"
+            )
+        if len(comment) > MAX_LINE_CHARS - len("COMMENT "):
+            raise InputError(
+                f"{name}[{index}] has {len(comment)} characters; a comment line holds at most "
+                f"{MAX_LINE_CHARS - len('COMMENT ')} (§6.6.1)"
+            )
+        checked.append(comment.rstrip())
+    return tuple(checked)
+
+
+def _creation_date(creation_date: Time | str | None) -> str:
+    from astropy.time import Time
+
+    with offline_time():
+        if creation_date is None:
+            date = Time.now()
+        else:
+            date = as_time(creation_date, "utc", name="creation_date")
+            if not date.isscalar:
+                raise InputError(f"creation_date must be a single epoch, got shape {date.shape}")
+        text = Time(date.utc, precision=0).isot
+    if not re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d", text):
+        raise InputError(f"creation_date: {text!r} is outside the years 0000-9999 (§6.8.9)")
+    return text
+
+
+def _epoch_strings(times: Time, time_system: str, name: str) -> NDArray[np.str_]:
+    """``times`` as §6.8.9 strings in ``time_system``, to 1 ns, still strictly increasing."""
+    from astropy.time import Time
+
+    with offline_time():
+        # A new Time, so that setting the precision leaves the caller's object alone
+        # (``t.utc`` is ``t`` itself when t is already UTC).
+        epochs = np.asarray(
+            Time(getattr(times, _SCALES[time_system]), precision=EPOCH_DECIMALS).isot
+        )
+    # The times increase, so the first and last epochs bound the years.
+    for epoch in (epochs[0], epochs[-1]):
+        if not _EPOCH_WRITTEN.fullmatch(epoch):
+            raise InputError(
+                f"{name}.times: {epoch} {time_system} is outside the years 0000-9999 (§6.8.9)"
+            )
+    repeated = np.flatnonzero(epochs[1:] <= epochs[:-1])
+    if repeated.size:
+        i = int(repeated[0]) + 1
+        raise InputError(
+            f"{name}.times[{i - 1}] and [{i}] are both written {epochs[i]} {time_system}: epochs "
+            "closer than 1 ns would repeat a time tag (§4.2.4.8.1)"
+        )
+    return epochs
+
+
+def _aem_quaternions(
+    quaternions: NDArray[np.float64], previous: NDArray[np.float64] | None
+) -> NDArray[np.float64]:
+    """Our (w, x, y, z) as AEM (Q1, Q2, Q3, QC) = (x, y, z, w), signs made continuous.
+
+    The first record of the file gets QC ≥ 0.  Each later record gets the sign that makes
+    its dot product with the record before it non-negative, so that neighbours are in the
+    same hemisphere, as an interpolating reader needs.
+    """
+    aem = quaternions[:, [1, 2, 3, 0]]
+    first_dot = aem[0, 3] if previous is None else float(aem[0] @ previous)
+    dots = np.einsum("ij,ij->i", aem[1:], aem[:-1])
+    steps = np.where(np.concatenate(([first_dot], dots)) < 0.0, -1.0, 1.0)
+    return aem * np.cumprod(steps)[:, np.newaxis]
+
+
+# --- validation shared by the writer and the reader ----------------------------------
+
+
+def _checked_times(times: Any) -> Time:
+    from astropy.time import Time
+
+    if not isinstance(times, Time):
+        raise InputError(f"times must be an astropy.time.Time, got {type(times).__name__}")
+    if times.ndim != 1:
+        raise InputError(f"times must be 1-D, got shape {times.shape}")
+    if len(times) == 0:
+        raise InputError(
+            "times: an empty segment cannot be written; a segment needs at least one epoch"
+        )
+    if times.masked:
+        raise InputError("times: masked epochs cannot be written")
+    finite = np.isfinite(times.jd1) & np.isfinite(times.jd2)
+    if not finite.all():
+        raise InputError(f"times[{int(np.argmin(finite))}] is not a finite epoch")
+    if len(times) > 1:
+        # In TT seconds, from the two-part JDs (UTC's quasi-JD must not be differenced).
+        steps_s = tt_seconds(times[1:], times[:-1])
+        bad = np.flatnonzero(~(steps_s > 0.0))
+        if bad.size:
+            i = int(bad[0]) + 1
+            with offline_time():
+                shown = Time(times[i - 1 : i + 1], precision=EPOCH_DECIMALS).isot
+            raise InputError(
+                f"times must increase strictly (§4.2.4.8.1): times[{i}] = {shown[1]} "
+                f"{times.scale.upper()} is not after times[{i - 1}] = {shown[0]}"
+            )
+    return times.copy()  # a copy, like the arrays: a Time can be changed in place
+
+
+def _checked_array(name: str, value: ArrayLike, rows: int, columns: int) -> NDArray[np.float64]:
+    array = np.asarray(value)
+    if array.dtype.kind not in "biuf":
+        raise InputError(f"{name} must be numeric, got dtype {array.dtype}")
+    if array.shape != (rows, columns):
+        raise InputError(
+            f"{name} must have shape ({rows}, {columns}) (one row per epoch), got {array.shape}"
+        )
+    array = np.array(array, dtype=np.float64)  # a copy: the segment must not change later
+    finite = np.isfinite(array)
+    if not finite.all():
+        row, column = np.argwhere(~finite)[0]
+        raise InputError(f"{name} must be finite, got {array[row, column]} at [{row}, {column}]")
+    array.flags.writeable = False
+    return array
+
+
+def _check_unit_norm(name: str, quaternions: NDArray[np.float64]) -> None:
+    norms = np.sqrt(np.einsum("ij,ij->i", quaternions, quaternions))
+    worst = int(np.argmax(np.abs(norms - 1.0)))
+    if abs(norms[worst] - 1.0) > UNIT_NORM_TOLERANCE:
+        raise InputError(
+            f"{name}[{worst}] = {quaternions[worst].tolist()} has norm {norms[worst]:.17g}; "
+            f"a unit quaternion is needed (to {UNIT_NORM_TOLERANCE:g})"
+        )
+
+
+# --- reading -------------------------------------------------------------------------
+
+
+class _Parser:
+    """A line-by-line reader of one AEM 2.0 KVN message (section 4, section 6)."""
+
+    def __init__(self, path: Path, text: str) -> None:
+        self.path = path
+        # Blank lines may appear anywhere (§6.6.4); surrounding blanks are not significant.
+        self.lines = [
+            (number, line.strip())
+            for number, line in enumerate(text.splitlines(), start=1)
+            if line.strip()
+        ]
+        self.position = 0
+
+    def error(self, number: int | None, message: str) -> InputError:
+        where = str(self.path) if number is None else f"{self.path}:{number}"
+        return InputError(f"{where}: {message}")
+
+    def peek(self) -> tuple[int, str] | None:
+        return self.lines[self.position] if self.position < len(self.lines) else None
+
+    def take(self, expected: str) -> tuple[int, str]:
+        line = self.peek()
+        if line is None:
+            raise self.error(None, f"the file ends where {expected} is expected")
+        self.position += 1
+        return line
+
+    def expect(self, word: str) -> int:
+        number, line = self.take(word)
+        if line != word:
+            raise self.error(number, f"expected {word}, got {line!r}")
+        return number
+
+    def comments(self) -> list[str]:
+        found = []
+        while (line := self.peek()) is not None and (match := _COMMENT_LINE.fullmatch(line[1])):
+            found.append(match.group(1) or "")
+            self.position += 1
+        return found
+
+    def keywords(
+        self, allowed: Sequence[str], stop: str, where: str
+    ) -> tuple[dict[str, str], dict[str, int]]:
+        """``KEYWORD = value`` lines up to the line ``stop``: values, and their line numbers."""
+        values: dict[str, str] = {}
+        numbers: dict[str, int] = {}
+        while (line := self.peek()) is not None and line[1] != stop:
+            number, text = self.take(stop)
+            match = _KVN_LINE.fullmatch(text)
+            if match is None:
+                raise self.error(
+                    number, f"expected 'KEYWORD = value' or {stop} in the {where}, got {text!r}"
+                )
+            keyword, value = match.group(1), match.group(2).strip()
+            if keyword not in allowed:
+                raise self.error(number, f"keyword {keyword} is not allowed in an AEM 2.0 {where}")
+            if keyword in values:
+                raise self.error(number, f"keyword {keyword} is repeated in the {where}")
+            if not value:
+                raise self.error(number, f"{keyword} has no value (§6.8.7)")
+            values[keyword], numbers[keyword] = value, number
+        return values, numbers
+
+    def parse(self) -> tuple[list[AemSegment], dict[str, Any]]:
+        number, first = self.take("CCSDS_AEM_VERS")
+        match = _KVN_LINE.fullmatch(first)
+        if match is None or match.group(1) != "CCSDS_AEM_VERS":
+            raise self.error(
+                number, f"the first line must be CCSDS_AEM_VERS (§4.2.2.3), got {first!r}"
+            )
+        if match.group(2).strip() != AEM_VERSION:
+            raise self.error(
+                number, f"only AEM version {AEM_VERSION} is read, got {match.group(2).strip()!r}"
+            )
+        header: dict[str, Any] = {"CCSDS_AEM_VERS": AEM_VERSION, "COMMENT": self.comments()}
+        header.update(self.keywords(_HEADER_KEYWORDS[1:], "META_START", "header")[0])
+        for keyword in ("CREATION_DATE", "ORIGINATOR"):
+            if keyword not in header:
+                raise self.error(None, f"the header has no {keyword} (table 4-2)")
+
+        segments: list[AemSegment] = []
+        header["segments"] = []
+        previous_useable_stop = None
+        while self.peek() is not None:
+            index = len(segments)
+            segment, metadata, (useable_start, useable_stop), start_line = self.segment(index)
+            if (
+                previous_useable_stop is not None
+                and _seconds(useable_start, previous_useable_stop) < 0
+            ):
+                begins = metadata.get("USEABLE_START_TIME", metadata["START_TIME"])
+                raise self.error(
+                    start_line,
+                    f"segment {index} is useable from {begins}, before the previous "
+                    "segment's useable span ends (table 4-3)",
+                )
+            previous_useable_stop = useable_stop
+            segments.append(segment)
+            header["segments"].append(metadata)
+        if not segments:
+            raise self.error(None, "the file has no segment (table 4-1)")
+        return segments, header
+
+    def segment(self, index: int) -> tuple[AemSegment, dict[str, Any], tuple[Time, Time], int]:
+        start_line = self.expect("META_START")
+        metadata: dict[str, Any] = {"COMMENT": self.comments()}
+        values, numbers = self.keywords(_METADATA_KEYWORDS, "META_STOP", "metadata")
+        metadata.update(values)
+        self.expect("META_STOP")
+        for keyword in _METADATA_MANDATORY:
+            if keyword not in metadata:
+                raise self.error(start_line, f"segment {index} has no {keyword}")
+        self.check_metadata(metadata, numbers)
+        scale = _SCALES[metadata["TIME_SYSTEM"].upper()]
+
+        self.expect("DATA_START")
+        metadata["DATA_COMMENT"] = self.comments()
+        line_numbers, epochs, rows = [], [], []
+        while (line := self.take("DATA_STOP"))[1] != "DATA_STOP":
+            number, text = line
+            fields = text.split()
+            if len(fields) != 8:
+                raise self.error(
+                    number,
+                    f"a {ATTITUDE_TYPE} line has 8 fields (EPOCH Q1 Q2 Q3 QC ANGVEL_X ANGVEL_Y "
+                    f"ANGVEL_Z, table 4-4), got {len(fields)}: {text!r}",
+                )
+            bad = [field for field in fields[1:] if not _NUMBER_READ.fullmatch(field)]
+            if bad:
+                raise self.error(number, f"{bad[0]!r} is not a number (§6.8.4)")
+            line_numbers.append(number)
+            epochs.append(fields[0])
+            rows.append([float(field) for field in fields[1:]])
+        if not rows:
+            raise self.error(line[0], f"segment {index} has no data lines")
+
+        times = self.epochs(epochs, line_numbers, scale)
+        bounds = {
+            keyword: self.epochs([metadata[keyword]], [numbers[keyword]], scale)
+            for keyword in ("START_TIME", "USEABLE_START_TIME", "USEABLE_STOP_TIME", "STOP_TIME")
+            if keyword in metadata
+        }
+        useable = self.check_bounds(times, line_numbers, bounds, numbers)
+        values_array = np.array(rows)
+        try:
+            segment = AemSegment(
+                times,
+                values_array[:, [3, 0, 1, 2]],  # (Q1, Q2, Q3, QC) -> our (w, x, y, z)
+                np.radians(values_array[:, 4:]),  # deg/s -> rad/s
+                tuple(metadata["COMMENT"]),
+            )
+        except InputError as exc:
+            raise self.error(start_line, f"segment {index}: {exc}") from None
+        return segment, metadata, useable, start_line
+
+    def check_metadata(self, metadata: dict[str, Any], numbers: dict[str, int]) -> None:
+        known = {
+            "ATTITUDE_TYPE": (ATTITUDE_TYPE,),
+            "REF_FRAME_A": REFERENCE_FRAMES,
+            "REF_FRAME_B": (BODY_FRAME,),
+            "ANGVEL_FRAME": (BODY_FRAME,),
+            "TIME_SYSTEM": tuple(_SCALES),
+        }
+        for keyword, allowed in known.items():
+            if metadata[keyword].upper() not in allowed:
+                raise self.error(
+                    numbers[keyword],
+                    f"{keyword} = {metadata[keyword]} is not read; this reader knows "
+                    f"{', '.join(allowed)}",
+                )
+        if "EULER_ROT_SEQ" in metadata:
+            raise self.error(
+                numbers["EULER_ROT_SEQ"], f"EULER_ROT_SEQ does not apply to {ATTITUDE_TYPE}"
+            )
+        if "INTERPOLATION_METHOD" in metadata and "INTERPOLATION_DEGREE" not in metadata:
+            raise self.error(
+                numbers["INTERPOLATION_METHOD"],
+                "INTERPOLATION_METHOD needs INTERPOLATION_DEGREE (table 4-3)",
+            )
+        degree = metadata.get("INTERPOLATION_DEGREE")
+        if degree is not None and not re.fullmatch(r"\+?\d+", degree):
+            raise self.error(
+                numbers["INTERPOLATION_DEGREE"],
+                f"INTERPOLATION_DEGREE must be an integer, got {degree!r}",
+            )
+
+    def epochs(self, texts: list[str], numbers: list[int], scale: str) -> Time:
+        """§6.8.9 calendar epochs in ``scale``, refusing any that astropy would reinterpret.
+
+        astropy reads ``00:00:60`` in TT, or an invented UTC leap second, as the next
+        minute, so each epoch is written back and compared with its text.
+        """
+        from astropy.time import Time
+
+        canonical = []
+        for text, number in zip(texts, numbers, strict=True):
+            match = _EPOCH_READ.fullmatch(text)
+            if match is None or (match.group(3) and scale != "utc"):
+                raise self.error(
+                    number,
+                    f"{text!r} is not a YYYY-MM-DDThh:mm:ss[.d] {scale.upper()} epoch with at most "
+                    f"{EPOCH_DECIMALS} decimals (§6.8.9)",
+                )
+            canonical.append(
+                f"{match.group(1)}.{(match.group(2) or '').ljust(EPOCH_DECIMALS, '0')}"
+            )
+        try:
+            with offline_time(), warnings.catch_warnings():
+                # The comparison below rejects these; the warning would only repeat it.
+                warnings.filterwarnings("ignore", message=".*time is after end of day")
+                times = Time(canonical, format="isot", scale=scale, precision=EPOCH_DECIMALS)
+                written = np.asarray(times.isot)
+        except ValueError as exc:
+            raise self.error(
+                numbers[0], f"cannot read the epochs from {texts[0]!r}: {exc}"
+            ) from None
+        mismatch = np.flatnonzero(written != np.asarray(canonical))
+        if mismatch.size:
+            i = int(mismatch[0])
+            raise self.error(
+                numbers[i],
+                f"{texts[i]!r} is not a valid {scale.upper()} epoch "
+                f"(astropy reads it as {written[i]})",
+            )
+        return times
+
+    def check_bounds(
+        self, times: Time, line_numbers: list[int], bounds: dict[str, Time], numbers: dict[str, int]
+    ) -> tuple[Time, Time]:
+        """Data inside START_TIME…STOP_TIME, the useable span inside that (table 4-3)."""
+        start, stop = bounds["START_TIME"], bounds["STOP_TIME"]
+        if _seconds(times[:1], start) < 0.0:
+            raise self.error(line_numbers[0], "the first epoch is before START_TIME")
+        if _seconds(stop, times[-1:]) < 0.0:
+            raise self.error(line_numbers[-1], "the last epoch is after STOP_TIME")
+        useable_start = bounds.get("USEABLE_START_TIME", start)
+        useable_stop = bounds.get("USEABLE_STOP_TIME", stop)
+        if _seconds(useable_start, start) < 0.0 or _seconds(stop, useable_stop) < 0.0:
+            raise self.error(
+                numbers.get("USEABLE_START_TIME", numbers.get("USEABLE_STOP_TIME")),
+                "the useable span is not inside START_TIME ... STOP_TIME",
+            )
+        if _seconds(useable_stop, useable_start) < 0.0:
+            raise self.error(
+                numbers["USEABLE_STOP_TIME"], "USEABLE_STOP_TIME is before USEABLE_START_TIME"
+            )
+        return useable_start, useable_stop
+
+
+def _seconds(later: Time, earlier: Time) -> float:
+    """TT seconds from the single epoch ``earlier`` to the single epoch ``later``."""
+    return float(np.ravel(tt_seconds(later, earlier))[0])
