@@ -17,10 +17,23 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from attitude.intervals import Interval, total_duration
 from attitude.motion_analysis import SegmentMotion
+from attitude.pointing import PointingResult
 from attitude.trajectory import Trajectory
 
-__all__ = ["Column", "to_json", "trajectory_columns", "write_csv", "write_json"]
+__all__ = [
+    "Column",
+    "extremum",
+    "motion_summary",
+    "pointing_columns",
+    "pointing_summary",
+    "to_json",
+    "trajectory_columns",
+    "write_csv",
+    "write_intervals_csv",
+    "write_json",
+]
 
 QUATERNION_CONVENTION = (
     "quaternion q_body_to_icrf_(w,x,y,z): scalar first; rotates body coordinates into "
@@ -170,3 +183,163 @@ def motion_summary(trajectory: Trajectory, motion: list[SegmentMotion]) -> dict[
             "times": [scenario.format_epoch(t) for t in flips[:1000]],
         },
     }
+
+
+def extremum(
+    seconds: NDArray[np.float64], values: NDArray[np.float64], largest: bool
+) -> tuple[float, float]:
+    """(time, value) of the largest or smallest sample, refined by the parabola through
+    it and its two neighbours (exact for a smooth extremum to O(step³))."""
+    k = int(np.argmax(values) if largest else np.argmin(values))
+    if 0 < k < values.size - 1:
+        y0, y1, y2 = values[k - 1], values[k], values[k + 1]
+        h = seconds[k + 1] - seconds[k]
+        curvature = y0 - 2.0 * y1 + y2
+        if curvature != 0.0 and np.isclose(seconds[k] - seconds[k - 1], h):
+            shift = 0.5 * (y0 - y2) / curvature  # in steps, within (−1, 1) at an extremum
+            if abs(shift) < 1.0:
+                return float(seconds[k] + shift * h), float(y1 - 0.25 * (y0 - y2) * shift)
+    return float(seconds[k]), float(values[k])
+
+
+def pointing_columns(result: PointingResult) -> list[Column]:
+    """The pointing columns of the time series, on the same grid as the trajectory's."""
+    columns = [
+        Column(f"sun_icrf_{c}", result.sun_direction_icrf[:, i], "Sun direction (unit), ICRF axes")
+        for i, c in enumerate("xyz")
+    ]
+    if result.on_orbit:
+        columns.append(
+            Column("sunlit_fraction", result.sunlit_fraction, "visible fraction of the Sun's disc")
+        )
+        columns.append(
+            Column(
+                "earth_angular_radius_deg",
+                np.degrees(result.earth_angular_radius_rad),
+                "angular radius of the Earth seen from the spacecraft, deg",
+            )
+        )
+    for item in result.vectors:
+        name = item.vector.name
+        columns.append(
+            Column(
+                f"{name}_sun_angle_deg", np.degrees(item.sun_angle_rad), f"angle {name}–Sun, deg"
+            )
+        )
+        columns.append(
+            Column(
+                f"{name}_cos_incidence",
+                item.cos_incidence,
+                f"cosine of Sun incidence on {name} (0 if behind or in umbra, × visible fraction)",
+            )
+        )
+        if item.violated is not None:
+            columns.append(
+                Column(
+                    f"{name}_sun_exclusion_violated",
+                    item.violated.astype(float),
+                    f"1 if the Sun is inside {name}'s exclusion cone (and not in umbra)",
+                )
+            )
+        columns.append(
+            Column(
+                f"{name}_ra_deg",
+                np.degrees(item.right_ascension_rad),
+                f"{name} right ascension, deg",
+            )
+        )
+        columns.append(
+            Column(f"{name}_dec_deg", np.degrees(item.declination_rad), f"{name} declination, deg")
+        )
+        if item.nadir_angle_rad is not None:
+            columns.append(
+                Column(
+                    f"{name}_nadir_angle_deg",
+                    np.degrees(item.nadir_angle_rad),
+                    f"angle between {name} and nadir (the Earth's centre), deg",
+                )
+            )
+    return columns
+
+
+def _interval_rows(result: PointingResult) -> list[tuple[str, str, Interval]]:
+    rows = [("eclipse", "", i) for i in result.shadow] + [("umbra", "", i) for i in result.umbra]
+    for item in result.vectors:
+        rows += [("sun_exclusion_violation", item.vector.name, i) for i in item.violations]
+        rows += [("sun_visible", item.vector.name, i) for i in item.sun_visible]
+    return sorted(rows, key=lambda row: (row[0], row[1], row[2].start_s))
+
+
+def write_intervals_csv(path: Path, result: PointingResult, iso, preamble: list[str]) -> None:
+    """One row per interval: kind, body vector, start and end (ISO and TT s), duration.
+
+    ``iso``: a function from TT seconds to ISO texts in the scenario's time scale.
+    """
+    rows = _interval_rows(result)
+    starts = iso(np.array([r[2].start_s for r in rows])) if rows else []
+    ends = iso(np.array([r[2].end_s for r in rows])) if rows else []
+    with open(path, "w", encoding="utf-8", newline="") as stream:
+        for line in preamble:
+            stream.write(f"# {line}\n")
+        stream.write(
+            "kind,body_vector,start,end,start_s,end_s,duration_s,starts_before_span,ends_after_span\n"
+        )
+        for (kind, name, i), start, end in zip(rows, starts, ends, strict=True):
+            stream.write(
+                f"{kind},{name},{start},{end},{i.start_s:.9f},{i.end_s:.9f},{i.duration_s:.9f},"
+                f"{int(i.starts_before)},{int(i.ends_after)}\n"
+            )
+
+
+def _interval_totals(intervals: list[Interval]) -> dict[str, Any]:
+    return {
+        "count": len(intervals),
+        "total_s": total_duration(intervals),
+        "longest_s": max((i.duration_s for i in intervals), default=0.0),
+    }
+
+
+def pointing_summary(result: PointingResult, format_epoch) -> dict[str, Any]:
+    """Extrema with their times, violation and visibility totals, eclipses."""
+    t = result.seconds
+    vectors = {}
+    for item in result.vectors:
+        angle = np.degrees(item.sun_angle_rad)
+        t_min, a_min = extremum(t, angle, largest=False)
+        t_max, a_max = extremum(t, angle, largest=True)
+        entry = {
+            "kind": item.vector.kind,
+            "vector_body": item.vector.vector,
+            "sun_angle_min_deg": a_min,
+            "sun_angle_min_at": format_epoch(t_min),
+            "sun_angle_max_deg": a_max,
+            "sun_angle_max_at": format_epoch(t_max),
+            "sun_visible": _interval_totals(item.sun_visible),
+            "mean_cos_incidence": float(np.mean(item.cos_incidence)),
+        }
+        if item.vector.sun_exclusion_half_angle_rad is not None:
+            entry["sun_exclusion_half_angle_deg"] = math.degrees(
+                item.vector.sun_exclusion_half_angle_rad
+            )
+            entry["violations"] = _interval_totals(item.violations)
+            entry["violations"]["first"] = [
+                {
+                    "start": format_epoch(i.start_s),
+                    "end": format_epoch(i.end_s),
+                    "duration_s": i.duration_s,
+                }
+                for i in item.violations[:20]
+            ]
+        vectors[item.vector.name] = entry
+    summary: dict[str, Any] = {
+        "position": "TLE orbit" if result.on_orbit else "Earth centre",
+        "interval_precision_s": result.precision_s,
+        "body_vectors": vectors,
+    }
+    if result.on_orbit:
+        summary["eclipses"] = {
+            "shadow": _interval_totals(result.shadow),
+            "umbra": _interval_totals(result.umbra),
+            "sunlit_fraction_of_span": float(np.mean(result.sunlit_fraction)),
+        }
+    return summary

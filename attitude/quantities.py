@@ -24,6 +24,7 @@ SI_UNITS = {
     "angular_momentum": "kg m2 / s",
     "angular_velocity": "rad / s",
     "angle": "rad",
+    "length": "m",
 }
 
 

@@ -1,12 +1,17 @@
-"""A scenario run, from a loaded scenario file to its output folder.
+"""A scenario run, from a scenario to its report folder.
 
-``produce(scenario_file, out_dir)`` propagates the scenario and writes, atomically
-(into a temporary folder renamed into place at the end, so that a failed run leaves
-no half-written output):
+``produce(scenario, out_dir, pointing)`` propagates the scenario and writes into
+``out_dir``, atomically (everything goes into a temporary folder renamed into place
+at the end, so that a failed run leaves no half-written output and an older report
+untouched):
 
-- ``timeseries.csv``: attitude, rates, momentum and energy on the output grid;
-- ``summary.json``: the scenario, its segments and events, flips, precession,
-  nutation and conservation checks.
+- ``timeseries.csv``: attitude, rates, momentum, energy and, with a ``[pointing]``
+  section, the Sun angles, incidences, violations, boresight RA/Dec, nadir angles;
+- ``intervals.csv``: eclipses, constraint violations, Sun-visibility windows;
+- ``summary.json``: the scenario, its segments (flips, nutation, spin, precession),
+  extrema with their times, violation totals, flip times;
+- ``attitude.aem``: the attitude as a CCSDS AEM 2.0 file, a segment per event;
+- ``*.png`` and ``report.html``: the plots and a page that gathers everything.
 """
 
 from __future__ import annotations
@@ -20,17 +25,24 @@ from typing import Any
 
 import numpy as np
 
+from attitude.aem import AemSegment, write_aem
 from attitude.exports import (
     QUATERNION_CONVENTION,
     motion_summary,
+    pointing_columns,
+    pointing_summary,
     trajectory_columns,
     write_csv,
+    write_intervals_csv,
     write_json,
 )
 from attitude.motion_analysis import analyze
-from attitude.pointing import PointingSpec
+from attitude.plots import plot_angular_velocity, plot_eclipse, plot_polhode, plot_sun_angles
+from attitude.pointing import PointingSpec, compute_pointing
+from attitude.report_page import render_page
 from attitude.scenario import Scenario
-from attitude.trajectory import propagate
+from attitude.timescales import SAME_INSTANT_S
+from attitude.trajectory import Trajectory, propagate
 from attitude.version import __version__
 
 __all__ = ["Progress", "produce", "replace_directory"]
@@ -97,6 +109,59 @@ def _scenario_summary(scenario: Scenario, source: str) -> dict[str, Any]:
     }
 
 
+def aem_segments(trajectory: Trajectory, seconds: np.ndarray) -> list[AemSegment]:
+    """One AEM segment per stretch of motion, on the output grid, closed at the events.
+
+    A segment ends with its own (pre-event) state at the next event's epoch and the
+    next one starts with the post-event state there: the attitude is continuous but
+    the rate jumps, and an AEM reader must not interpolate across.
+    """
+    scenario = trajectory.scenario
+    segments = []
+    for segment in trajectory.segments:
+        start = max(segment.start_s, float(seconds[0]))
+        end = min(segment.end_s, float(seconds[-1]))
+        if end - start <= SAME_INSTANT_S:
+            continue  # before the output span, or a zero-length stretch between events
+        inside = seconds[(seconds > start + SAME_INSTANT_S) & (seconds < end - SAME_INSTANT_S)]
+        τ = np.concatenate([[start], inside, [end]])
+        segments.append(
+            AemSegment(
+                scenario.times(τ),
+                segment.solver.attitude_quaternion(τ),
+                segment.solver.angular_velocity(τ),
+                comments=(f"motion segment {trajectory.segments.index(segment)}",)
+                + ((f"started by {segment.event.kind}",) if segment.event else ()),
+            )
+        )
+    return segments
+
+
+def _aem_text(value: str) -> str:
+    """A text value the AEM accepts (printable ASCII, single blanks, one case)."""
+    text = "".join(c if c.isascii() and c.isprintable() else " " for c in value)
+    return " ".join(text.split()).upper() or "UNKNOWN"
+
+
+def _object_id(tle: tuple[str, str] | None) -> str:
+    """The international designator from a TLE (line 1, columns 10–17), e.g. 1998-067A."""
+    if tle is None:
+        return "UNKNOWN"
+    designator = tle[0][9:17].strip()
+    if len(designator) < 5 or not designator[:5].isdigit():
+        return "UNKNOWN"
+    year = int(designator[:2])
+    return f"{1900 + year if year >= 57 else 2000 + year}-{designator[2:]}"
+
+
+def _zoom_window(motion, start_s: float, stop_s: float) -> tuple[float, float] | None:
+    """A few turns of the first segment's spin, for the zoomed Sun-angle panel."""
+    spin = motion[0].spin_period_s
+    if spin is None or not np.isfinite(spin) or 3.0 * spin >= stop_s - start_s:
+        return None
+    return start_s, start_s + 3.0 * spin
+
+
 def produce(
     scenario: Scenario,
     out_dir: Path,
@@ -104,7 +169,7 @@ def produce(
     source: str = "",
     progress: Progress | None = None,
 ) -> dict[str, Any]:
-    """Propagate ``scenario`` and write its outputs into ``out_dir``; returns the summary.
+    """Propagate ``scenario`` and write its report into ``out_dir``; returns the summary.
 
     ``pointing``: the pointing outputs asked for; ``source``: the scenario file's
     name, for the headers.
@@ -119,40 +184,93 @@ def produce(
         seconds = scenario.output_seconds()
         progress(f"sampling {seconds.size} epochs")
         columns = trajectory_columns(trajectory, seconds)
-        epochs_iso = scenario.iso(seconds)
+        result = None
+        if not pointing.is_empty:
+            progress(
+                f"pointing: {len(pointing.body_vectors)} body vectors, "
+                f"{'TLE orbit' if pointing.tle else 'Earth centre'}, intervals"
+            )
+            result = compute_pointing(trajectory, pointing, seconds)
+            columns += pointing_columns(result)
         scale = scenario.time_scale
+        preamble = [
+            f"attitude {__version__}: {scenario.name} ({source})",
+            f"spacecraft: {scenario.spacecraft.name}",
+            f"epoch: {scenario.format_epoch(0.0)}; t_s = TT seconds since the epoch",
+            f"time_{scale}: ISO 8601 epochs in {scale.upper()}",
+            "frames: body = spacecraft body axes; icrf = ICRF axes (GCRS, geocentric)",
+            QUATERNION_CONVENTION,
+            "units: SI (s, rad/s, N m s, J), angles in deg where the name says _deg",
+        ]
         progress("writing timeseries.csv")
-        write_csv(
-            tmp / "timeseries.csv",
-            epochs_iso,
-            f"time_{scale}",
-            columns,
-            [
-                f"attitude {__version__}: {scenario.name} ({source})",
-                f"spacecraft: {scenario.spacecraft.name}",
-                f"epoch: {scenario.format_epoch(0.0)}; t_s = TT seconds since the epoch",
-                f"time_{scale}: ISO 8601 epochs in {scale.upper()}",
-                "frames: body = spacecraft body axes; icrf = ICRF axes (GCRS, geocentric)",
-                QUATERNION_CONVENTION,
-                "units: SI (s, rad/s, N m s, J)",
-            ],
-        )
-        summary = {
+        write_csv(tmp / "timeseries.csv", scenario.iso(seconds), f"time_{scale}", columns, preamble)
+        ω = trajectory.angular_velocity(seconds)
+        rate = np.linalg.norm(ω, axis=1)
+        peak = int(np.argmax(rate))
+        summary: dict[str, Any] = {
             "attitude_version": __version__,
             "scenario": _scenario_summary(scenario, source),
             "motion": motion_summary(trajectory, motion),
             "extrema": {
-                "max_rate_rad_s": float(
-                    np.max(
-                        np.linalg.norm(np.column_stack([c.values for c in columns[5:8]]), axis=1)
-                    )
-                ),
+                "max_rate_deg_s": float(np.degrees(rate[peak])),
+                "max_rate_at": scenario.format_epoch(float(seconds[peak])),
             },
         }
-        progress("writing summary.json")
+        files = ["timeseries.csv"]
+        if result is not None:
+            summary["pointing"] = pointing_summary(result, scenario.format_epoch)
+            write_intervals_csv(
+                tmp / "intervals.csv",
+                result,
+                scenario.iso,
+                [*preamble[:3], f"interval ends refined to {pointing.interval_precision_s:g} s"],
+            )
+            files.append("intervals.csv")
+        progress("writing attitude.aem (CCSDS AEM 2.0)")
+        write_aem(
+            tmp / "attitude.aem",
+            aem_segments(trajectory, seconds),
+            object_name=_aem_text(scenario.spacecraft.name),
+            object_id=_object_id(pointing.tle),
+            time_scale=scale,
+            comments=(f"{scenario.name}", f"computed by attitude {__version__}"),
+        )
+        files.append("attitude.aem")
+        progress("plotting")
+        images = {}
+        events = [t for t, _ in scenario.events]
+        images["Body angular velocity"] = plot_angular_velocity(
+            tmp / "angular_velocity.png", seconds, ω, events
+        )
+        images["Angular momentum direction in body axes (polhode)"] = plot_polhode(
+            tmp / "polhode.png",
+            trajectory.angular_momentum(seconds),
+            trajectory.segment_index(seconds),
+        )
+        if result is not None and result.vectors:
+            eclipse = result.sunlit_fraction < 1.0 if result.on_orbit else None
+            images["Sun angle on the body vectors"] = plot_sun_angles(
+                tmp / "sun_angles.png",
+                seconds,
+                {v.vector.name: np.degrees(v.sun_angle_rad) for v in result.vectors},
+                {
+                    v.vector.name: None
+                    if v.vector.sun_exclusion_half_angle_rad is None
+                    else float(np.degrees(v.vector.sun_exclusion_half_angle_rad))
+                    for v in result.vectors
+                },
+                eclipse,
+                zoom_s=_zoom_window(motion, float(seconds[0]), float(seconds[-1])),
+                bin_s=None if motion[0].spin_period_s is None else 2.0 * motion[0].spin_period_s,
+            )
+        if result is not None and result.on_orbit:
+            images["Eclipses"] = plot_eclipse(tmp / "eclipse.png", seconds, result.sunlit_fraction)
+        progress("writing summary.json and report.html")
         write_json(tmp / "summary.json", summary)
+        files.append("summary.json")
+        (tmp / "report.html").write_text(render_page(summary, images, files), encoding="utf-8")
         return summary
 
     summary = replace_directory(Path(out_dir), build)
-    progress(f"done: {Path(out_dir)}")
+    progress(f"done: {Path(out_dir)}/report.html")
     return summary

@@ -6,6 +6,8 @@
   (``mpmath.odefun``) at 25 significant digits.
 - ``half_period_mpmath``: the closed-form half period 2K/|λ| of m(t) at high
   precision, from mpmath's complete elliptic integral.
+- ``astropy_apparent_sun``: the apparent Sun from astropy's own ephemeris (ERFA
+  epv00), independent of the JPL DE421 the package reads through skyfield.
 
 Equations (body angular momentum m, body angular velocity ω = m/I, scalar-first
 quaternion q taking body to inertial coordinates):
@@ -147,3 +149,35 @@ def state_with_delta2(inertia_sorted, ratio, weight=0.5, rng=None):
     if rng is not None:
         x *= rng.choice([-1.0, 1.0], size=3)
     return x
+
+
+def astropy_apparent_sun(times):
+    """Apparent Sun direction (GCRS axes) and light-time distance (m), astropy's epv00.
+
+    The astrometric vector (light time, one iteration) from ``get_body_barycentric``,
+    then astropy's ICRS→GCRS transform applied to it *as a direction*, so that astropy
+    adds the aberration only (``get_body("sun")`` keeps the Sun's distance and then
+    applies a spurious self-deflection of up to 1.2"; see research-pointing.md §2.3).
+    """
+    from astropy import units as u
+    from astropy.constants import c as speed_of_light
+    from astropy.coordinates import (
+        GCRS,
+        ICRS,
+        UnitSphericalRepresentation,
+        get_body_barycentric,
+        solar_system_ephemeris,
+    )
+
+    from attitude.timescales import offline_time
+
+    with offline_time(), solar_system_ephemeris.set("builtin"):
+        earth = get_body_barycentric("earth", times)
+        light_time = (get_body_barycentric("sun", times) - earth).norm() / speed_of_light
+        astrometric = get_body_barycentric("sun", times - light_time) - earth
+        direction = ICRS(astrometric.represent_as(UnitSphericalRepresentation))
+        apparent = direction.transform_to(GCRS(obstime=times))
+        return (
+            np.moveaxis(apparent.cartesian.xyz.value, 0, -1),
+            astrometric.norm().to_value(u.m),
+        )

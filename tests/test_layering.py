@@ -17,7 +17,7 @@ LAYERS = [
     ["timescales", "spacecraft", "events", "scenario"],  # spacecraft, scenario and events
     ["trajectory", "motion_analysis"],  # trajectory
     ["ephemeris", "orbit", "eclipse", "pointing", "intervals"],  # pointing (skyfield)
-    ["exports", "aem", "plots", "report"],  # reports and exports
+    ["exports", "aem", "plots", "report_page", "report"],  # reports and exports
     ["scenario_file", "cli"],  # command line
 ]
 

@@ -1,0 +1,220 @@
+"""The report's HTML page: the summary as tables, the plots, links to the data files.
+
+A single self-contained file (inline CSS, images by relative link), built from the
+same summary dictionary as ``summary.json``, so the page and the file cannot
+disagree.
+"""
+
+from __future__ import annotations
+
+from html import escape
+from typing import Any
+
+__all__ = ["render_page"]
+
+_STYLE = """
+body { font-family: system-ui, sans-serif; margin: 2em auto; max-width: 1100px; color: #222; }
+h1 { font-size: 1.5em; } h2 { font-size: 1.2em; margin-top: 1.6em; border-bottom: 1px solid #ccc; }
+table { border-collapse: collapse; margin: 0.6em 0; font-size: 0.9em; }
+th, td { border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; }
+th { background: #f3f3f3; } td.n { text-align: right; font-variant-numeric: tabular-nums; }
+img { max-width: 100%; border: 1px solid #eee; margin: 0.5em 0; }
+.note { color: #555; font-size: 0.9em; }
+"""
+
+
+def _number(value: Any, digits: int = 6) -> str:
+    if value is None:
+        return "–"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        return f"{value:.{digits}g}"
+    return escape(str(value))
+
+
+def _table(header: list[str], rows: list[list[Any]]) -> str:
+    head = "".join(f"<th>{escape(h)}</th>" for h in header)
+    body = "".join(
+        "<tr>"
+        + "".join(
+            f'<td class="n">{_number(v)}</td>'
+            if isinstance(v, int | float) and not isinstance(v, bool)
+            else f"<td>{_number(v)}</td>"
+            for v in row
+        )
+        + "</tr>"
+        for row in rows
+    )
+    return f"<table><tr>{head}</tr>{body}</table>"
+
+
+def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str]) -> str:
+    """The HTML text of the report.
+
+    ``summary``: the dictionary written to summary.json; ``images``: caption → PNG
+    file name; ``files``: the data files of the folder, linked.
+    """
+    scenario = summary["scenario"]
+    motion = summary["motion"]
+    parts = [
+        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
+        f"<title>{escape(scenario['name'])}</title><style>{_STYLE}</style></head><body>",
+        f"<h1>{escape(scenario['name'])}</h1>",
+        f"<p class='note'>{escape(scenario['file'])}, computed by attitude "
+        f"{escape(summary['attitude_version'])} (exact torque-free motion, no integration).</p>",
+        _table(
+            [
+                "epoch",
+                "stop",
+                "output step (s)",
+                "samples",
+                "spacecraft",
+                "principal moments (kg m²)",
+            ],
+            [
+                [
+                    scenario["epoch"],
+                    scenario["stop"],
+                    scenario["output"]["step_s"],
+                    scenario["output"]["samples"],
+                    scenario["spacecraft"]["name"],
+                    ", ".join(
+                        f"{m:.6g}" for m in scenario["spacecraft"]["principal_moments_kg_m2"]
+                    ),
+                ]
+            ],
+        ),
+    ]
+    if scenario["events"]:
+        parts.append("<h2>Events</h2>")
+        parts.append(
+            _table(
+                ["epoch", "type", "label"],
+                [[e["epoch"], e["type"], e["label"]] for e in scenario["events"]],
+            )
+        )
+    parts.append("<h2>Motion</h2>")
+    parts.append(
+        _table(
+            [
+                "segment",
+                "from",
+                "closed form",
+                "body period (s)",
+                "flips",
+                "flip period (s)",
+                "nutation (deg)",
+                "nutation period (s)",
+                "spin period (s)",
+                "precession period (s)",
+                "kinetic energy (J)",
+                "|H| (N m s)",
+            ],
+            [
+                [
+                    s["index"],
+                    s["start"],
+                    s["formula"],
+                    s["body_period_s"],
+                    s["flip_count"],
+                    s["flip_period_s"],
+                    None
+                    if s["nutation_angle_min_deg"] is None
+                    else f"{s['nutation_angle_min_deg']:.4g} – {s['nutation_angle_max_deg']:.4g}",
+                    s["nutation_period_s"],
+                    s["spin_period_s"],
+                    s["precession_period_s"],
+                    s["kinetic_energy_J"],
+                    s["angular_momentum_norm_N_m_s"],
+                ]
+                for s in motion["segments"]
+            ],
+        )
+    )
+    flips = motion["flips"]
+    if flips["count"]:
+        shown = ", ".join(escape(t) for t in flips["times"][:12])
+        more = f" … ({flips['count']} in all)" if flips["count"] > 12 else ""
+        parts.append(f"<p>Flips (the Джанибеков effect): {shown}{more}</p>")
+    pointing = summary.get("pointing")
+    if pointing:
+        parts.append("<h2>Pointing</h2>")
+        parts.append(
+            f"<p class='note'>Spacecraft at: {escape(pointing['position'])}. Interval ends "
+            f"refined on the exact motion to {pointing['interval_precision_s']:g} s.</p>"
+        )
+        rows = []
+        for name, v in pointing["body_vectors"].items():
+            violations = v.get("violations")
+            rows.append(
+                [
+                    name,
+                    v["kind"],
+                    f"{v['sun_angle_min_deg']:.4f} at {v['sun_angle_min_at']}",
+                    f"{v['sun_angle_max_deg']:.4f} at {v['sun_angle_max_at']}",
+                    v.get("sun_exclusion_half_angle_deg"),
+                    None if violations is None else violations["count"],
+                    None if violations is None else violations["total_s"],
+                    None if violations is None else violations["longest_s"],
+                    v["sun_visible"]["total_s"],
+                    v["mean_cos_incidence"],
+                ]
+            )
+        parts.append(
+            _table(
+                [
+                    "body vector",
+                    "kind",
+                    "min Sun angle (deg)",
+                    "max Sun angle (deg)",
+                    "exclusion (deg)",
+                    "violations",
+                    "violated (s)",
+                    "longest (s)",
+                    "Sun visible (s)",
+                    "mean cos incidence",
+                ],
+                rows,
+            )
+        )
+        eclipses = pointing.get("eclipses")
+        if eclipses:
+            parts.append(
+                _table(
+                    [
+                        "eclipses (shadow)",
+                        "in shadow (s)",
+                        "umbra passes",
+                        "in umbra (s)",
+                        "sunlit fraction",
+                    ],
+                    [
+                        [
+                            eclipses["shadow"]["count"],
+                            eclipses["shadow"]["total_s"],
+                            eclipses["umbra"]["count"],
+                            eclipses["umbra"]["total_s"],
+                            eclipses["sunlit_fraction_of_span"],
+                        ]
+                    ],
+                )
+            )
+    parts.append("<h2>Plots</h2>")
+    for caption, name in images.items():
+        parts.append(
+            f"<figure><img src='{escape(name)}' alt='{escape(caption)}'>"
+            f"<figcaption class='note'>{escape(caption)}</figcaption></figure>"
+        )
+    parts.append("<h2>Files</h2><ul>")
+    parts += [f"<li><a href='{escape(f)}'>{escape(f)}</a></li>" for f in files]
+    parts.append("</ul>")
+    parts.append(
+        "<p class='note'>Frames: body = spacecraft body axes; ICRF axes for inertial vectors. "
+        "Quaternions are scalar first and rotate body coordinates into ICRF "
+        "(attitude.aem: CCSDS AEM 2.0, ICRF → SC_BODY_1, scalar last, as the standard says).</p>"
+    )
+    parts.append("</body></html>\n")
+    return "\n".join(parts)

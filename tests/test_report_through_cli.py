@@ -1,0 +1,138 @@
+"""The full report of a scenario with pointing, through the command line.
+
+The spinner scenario (TLE orbit, three body vectors, a thruster pulse) run with the
+network refused and warnings as errors.  Checked: every file is there and the page
+links them; the time series, the intervals and the summary agree with one another;
+the CCSDS AEM, read by an independent parser (ccsds-ndm-py), holds the CSV's
+attitude in the standard's order (scalar last) and its rates in deg/s.
+"""
+
+import json
+import socket
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from attitude.cli import main
+
+SCENARIO = Path(__file__).parents[1] / "scenarios" / "spinner_thruster_pulse.toml"
+
+
+def _read_csv(path: Path):
+    text = path.read_text()
+    preamble = sum(1 for line in text.splitlines() if line.startswith("#"))
+    return np.genfromtxt(
+        path, delimiter=",", skip_header=preamble, names=True, dtype=None, encoding="utf-8"
+    )
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory):
+    out = tmp_path_factory.mktemp("report") / "spinner"
+    with pytest.MonkeyPatch.context() as patch:
+
+        def refuse(*args, **kwargs):
+            raise AssertionError(f"network access attempted: {args}")
+
+        for target, name in (
+            (socket.socket, "connect"),
+            (socket.socket, "connect_ex"),
+            (socket, "create_connection"),
+            (socket, "getaddrinfo"),
+        ):
+            patch.setattr(target, name, refuse)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            assert main(["run", str(SCENARIO), "--out", str(out), "--quiet"]) == 0
+    return out
+
+
+def test_every_file_is_written_and_linked(report):
+    names = {p.name for p in report.iterdir()}
+    assert names == {
+        "timeseries.csv",
+        "intervals.csv",
+        "summary.json",
+        "attitude.aem",
+        "report.html",
+        "angular_velocity.png",
+        "polhode.png",
+        "sun_angles.png",
+        "eclipse.png",
+    }
+    page = (report / "report.html").read_text()
+    for name in names - {"report.html"}:
+        assert f"'{name}'" in page
+    for png in report.glob("*.png"):
+        data = png.read_bytes()
+        assert data[:8] == b"\x89PNG\r\n\x1a\n" and len(data) > 20_000
+
+
+def test_incidence_flags_and_intervals_agree(report):
+    data = _read_csv(report / "timeseries.csv")
+    fraction = data["sunlit_fraction"]
+    for name in ("top_panel", "side_panel", "star_tracker"):
+        angle = np.radians(data[f"{name}_sun_angle_deg"])
+        np.testing.assert_allclose(
+            data[f"{name}_cos_incidence"], np.maximum(np.cos(angle), 0.0) * fraction, atol=1e-12
+        )
+    intervals = _read_csv(report / "intervals.csv")
+    t = data["t_s"]
+    violation = intervals[(intervals["kind"] == "sun_exclusion_violation")]
+    inside = np.zeros(t.size, dtype=bool)
+    for row in violation:
+        inside |= (t >= row["start_s"]) & (t <= row["end_s"])
+    assert np.array_equal(inside, data["star_tracker_sun_exclusion_violated"].astype(bool))
+    summary = json.loads((report / "summary.json").read_text())
+    tracker = summary["pointing"]["body_vectors"]["star_tracker"]
+    assert tracker["violations"]["count"] == len(violation) > 100
+    assert tracker["violations"]["total_s"] == pytest.approx(
+        np.sum(violation["duration_s"]), rel=1e-9
+    )
+    eclipses = intervals[intervals["kind"] == "eclipse"]
+    assert summary["pointing"]["eclipses"]["shadow"]["count"] == len(eclipses) == 1
+    # In the umbra the panels get no light; in the penumbra (27 s here), part of it.
+    umbra = intervals[intervals["kind"] == "umbra"]
+    assert eclipses["start_s"][0] < umbra["start_s"][0] < umbra["end_s"][0] < eclipses["end_s"][0]
+    dark = (t >= umbra["start_s"][0]) & (t <= umbra["end_s"][0])
+    assert np.all(data["top_panel_cos_incidence"][dark] == 0.0)
+    penumbra = (t > eclipses["start_s"][0]) & (t < umbra["start_s"][0])
+    assert np.all((data["sunlit_fraction"][penumbra] > 0) & (data["sunlit_fraction"][penumbra] < 1))
+    # The extremum times are real: the minimum Sun angle of the tracker is below its limit.
+    assert (
+        tracker["sun_angle_min_deg"]
+        < tracker["sun_exclusion_half_angle_deg"]
+        == pytest.approx(35.0)
+    )
+
+
+def test_aem_holds_the_attitude_for_an_independent_parser(report):
+    ccsds_ndm = pytest.importorskip("ccsds_ndm")
+    if not hasattr(ccsds_ndm, "from_file"):
+        pytest.skip("the ccsds_ndm installed is not ccsds-ndm-py")
+    message = ccsds_ndm.from_file(str(report / "attitude.aem"))
+    message.validate(strict=True)
+    data = _read_csv(report / "timeseries.csv")
+    epochs = {text: i for i, text in enumerate(data["time_utc"])}
+    assert len(message.segments) == 2  # a new segment at the thruster pulse
+    matched = 0
+    for segment in message.segments:
+        assert (
+            segment.metadata.ref_frame_a == "ICRF" and segment.metadata.ref_frame_b == "SC_BODY_1"
+        )
+        assert segment.metadata.attitude_type == "QUATERNION/ANGVEL"
+        states = segment.data.attitude_states_numpy
+        texts = segment.data.attitude_states_epochs
+        # The first and last records are the segment's ends (the event's epoch, to the
+        # nanosecond of the text): compare the records of the output grid inside.
+        for text, state in zip(texts[1:-1], states[1:-1], strict=True):
+            i = epochs[text]
+            q_csv = np.array([data[f"q_body_to_icrf_{c}"][i] for c in "xyzw"])
+            ω_csv = np.degrees([data[f"omega_body_{c}_rad_s"][i] for c in "xyz"])
+            sign = np.sign(np.dot(q_csv, state[:4]))
+            np.testing.assert_allclose(sign * state[:4], q_csv, atol=2e-16 * 4)
+            np.testing.assert_allclose(state[4:], ω_csv, rtol=1e-15, atol=1e-15)
+            matched += 1
+    assert matched >= len(data) - 4
