@@ -50,42 +50,50 @@ class Column:
     description: str
 
 
+def _components(
+    name: str, values: NDArray[np.float64], axes: str, description: str
+) -> list[Column]:
+    """One column per component: ``name`` with ``{}`` replaced by each axis letter."""
+    return [Column(name.format(c), values[:, i], description) for i, c in enumerate(axes)]
+
+
 def trajectory_columns(trajectory: Trajectory, seconds: NDArray[np.float64]) -> list[Column]:
     """Attitude, rates, momentum and energy at ``seconds`` (TT s since the epoch)."""
-    q = trajectory.attitude_quaternion(seconds)
-    ω = trajectory.angular_velocity(seconds)
-    m = trajectory.angular_momentum(seconds)
-    H = trajectory.inertial_angular_momentum(seconds)
-    columns = [Column("t_s", seconds, "TT seconds since the scenario epoch")]
-    columns += [
-        Column(f"q_body_to_icrf_{c}", q[:, i], "attitude quaternion, scalar first, body -> ICRF")
-        for i, c in enumerate("wxyz")
-    ]
-    columns += [
-        Column(f"omega_body_{c}_rad_s", ω[:, i], "angular velocity, body axes, rad/s")
-        for i, c in enumerate("xyz")
-    ]
-    columns += [
-        Column(f"h_body_{c}_N_m_s", m[:, i], "angular momentum, body axes, N m s")
-        for i, c in enumerate("xyz")
-    ]
-    columns += [
-        Column(f"h_icrf_{c}_N_m_s", H[:, i], "angular momentum, ICRF axes, N m s")
-        for i, c in enumerate("xyz")
-    ]
-    columns.append(
+    return [
+        Column("t_s", seconds, "TT seconds since the scenario epoch"),
+        *_components(
+            "q_body_to_icrf_{}",
+            trajectory.attitude_quaternion(seconds),
+            "wxyz",
+            "attitude quaternion, scalar first, body -> ICRF",
+        ),
+        *_components(
+            "omega_body_{}_rad_s",
+            trajectory.angular_velocity(seconds),
+            "xyz",
+            "angular velocity, body axes, rad/s",
+        ),
+        *_components(
+            "h_body_{}_N_m_s",
+            trajectory.angular_momentum(seconds),
+            "xyz",
+            "angular momentum, body axes, N m s",
+        ),
+        *_components(
+            "h_icrf_{}_N_m_s",
+            trajectory.inertial_angular_momentum(seconds),
+            "xyz",
+            "angular momentum, ICRF axes, N m s",
+        ),
         Column(
             "kinetic_energy_J", trajectory.kinetic_energy(seconds), "rotational kinetic energy, J"
-        )
-    )
-    columns.append(
+        ),
         Column(
             "segment",
             trajectory.segment_index(seconds).astype(float),
             "index of the motion segment (0 = before the first event)",
-        )
-    )
-    return columns
+        ),
+    ]
 
 
 def write_csv(
@@ -204,10 +212,9 @@ def extremum(
 
 def pointing_columns(result: PointingResult) -> list[Column]:
     """The pointing columns of the time series, on the same grid as the trajectory's."""
-    columns = [
-        Column(f"sun_icrf_{c}", result.sun_direction_icrf[:, i], "Sun direction (unit), ICRF axes")
-        for i, c in enumerate("xyz")
-    ]
+    columns = _components(
+        "sun_icrf_{}", result.sun_direction_icrf, "xyz", "Sun direction (unit), ICRF axes"
+    )
     if result.on_orbit:
         columns.append(
             Column("sunlit_fraction", result.sunlit_fraction, "visible fraction of the Sun's disc")

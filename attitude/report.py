@@ -118,7 +118,7 @@ def aem_segments(trajectory: Trajectory, seconds: np.ndarray) -> list[AemSegment
     """
     scenario = trajectory.scenario
     segments = []
-    for segment in trajectory.segments:
+    for index, segment in enumerate(trajectory.segments):
         start = max(segment.start_s, float(seconds[0]))
         end = min(segment.end_s, float(seconds[-1]))
         if end - start <= SAME_INSTANT_S:
@@ -130,7 +130,7 @@ def aem_segments(trajectory: Trajectory, seconds: np.ndarray) -> list[AemSegment
                 scenario.times(τ),
                 segment.solver.attitude_quaternion(τ),
                 segment.solver.angular_velocity(τ),
-                comments=(f"motion segment {trajectory.segments.index(segment)}",)
+                comments=(f"motion segment {index}",)
                 + ((f"started by {segment.event.kind}",) if segment.event else ()),
             )
         )

@@ -22,19 +22,12 @@ from scipy.spatial.transform import Rotation
 from attitude.errors import InputError
 from attitude.events import AngularImpulse, AttitudeReset, InertiaChange
 from attitude.pointing import BodyVector, PointingSpec
+from attitude.quantities import SI_UNITS
 from attitude.scenario import InitialState, Scenario
 from attitude.spacecraft import Spacecraft
 from attitude.timescales import SCALES, as_time, time_from_tt_seconds
 
 __all__ = ["ScenarioFile", "ScenarioFileError", "load_scenario"]
-
-SI_UNITS = {
-    "time": "s",
-    "moment_of_inertia": "kg m2",
-    "angular_momentum": "kg m2 / s",
-    "angular_velocity": "rad / s",
-    "angle": "rad",
-}
 
 
 class ScenarioFileError(InputError):
@@ -277,7 +270,9 @@ def _pointing(root: _Table) -> PointingSpec:
             table.fail(f"expected the two lines of a TLE, got {lines!r}", "tle")
         tle = tuple(lines)
     precision = table.positive("interval_precision", "time", required=False)
-    return PointingSpec(vectors, tle, precision if precision is not None else 1e-3)
+    if precision is None:
+        return PointingSpec(vectors, tle)
+    return PointingSpec(vectors, tle, precision)
 
 
 def load_scenario(path: str | Path) -> ScenarioFile:
