@@ -31,13 +31,14 @@ S, P, Y, R     S: user body axes → preferred principal axes (a signed permutat
                a proper rotation); P(t): maps m(t) onto G e1 or G e3; Y: rotation by ψ
                about that axis; R: constant, fixed by the initial attitude
 
-Cases (exact sign test on the computed δ2, no tolerance):
+Cases (exact sign test on Δ2 of the float inputs, no tolerance):
   (i)   Δ2 < 0: m circulates about the axis of least inertia, m1 = B13 dn > 0
   (ii)  Δ2 > 0: m circulates about the axis of greatest inertia, m3 = B31 dn > 0
   (iii) Δ2 = 0: the separatrix, m1 = B13 sech, m3 = B31 sech, m2 = G th
-  sphere (I1 = I3) and rest (G = 0) are the two special cases whose formulas
-  would be 0/0; every other degenerate body (I1 = I2, I2 = I3, spin about an axis)
-  goes through the general formulas.
+  steady and rest are the special cases whose formulas would be 0/0 or ∞·0: the
+  sphere (I1 = I3), a rate λ that underflows (m within ~1e-160 G of an axis of a
+  symmetric body), and G = 0.  Every other degenerate body (I1 = I2, I2 = I3, spin
+  about any axis, the intermediate one included) goes through the general formulas.
 
 References
 ----------
@@ -66,6 +67,16 @@ __all__ = ["EulerSolver"]
 
 # Evaluations over many times run in slices of this many samples (see _in_chunks).
 _CHUNK = 16384
+# The kernels keep full accuracy down to this complementary parameter (tested to
+# 1e-300); below, a state is closer to the separatrix than double precision can follow.
+_SMALLEST_MC = 1e-300
+
+
+def _rate(G: float, numerator: float, I1: float, I2: float, I3: float) -> float:
+    """G √(numerator / (I1 I2 I3)), with the moments scaled by I3 so that their product
+    cannot underflow or overflow (the λ of [Leroy]: numerator = Δ3 I12/G², Δ1 I32/G²,
+    or −Δ1 Δ3 I2/G⁴)."""
+    return (G / I3) * math.sqrt(numerator / I3 / ((I1 / I3) * (I2 / I3)))
 
 
 class _Jacobi:
@@ -122,23 +133,22 @@ class _FormulaI:
     name = "i"
     axis = 0  # P(t) maps m onto e1: m1 = B13 dn is the component that never vanishes
 
-    def __init__(self, I1, I2, I3, m0, G, δ1, δ2, δ3) -> None:
+    def __init__(self, I1, I2, I3, m0, G, δ1, δ2, δ3, mc) -> None:
         I12, I13, I21, I31, I32 = I1 - I2, I1 - I3, I2 - I1, I3 - I1, I3 - I2
         self.B13 = G * math.sqrt(I1 * δ3 / I13)
         self.B21 = G * math.sqrt(I2 * δ1 / I21)
         self.B31 = G * math.sqrt(I3 * δ1 / I31)
-        # mc = Δ2 I31 / (Δ3 I21) ≤ 1; rounding may exceed 1 for a prolate top (mc = 1).
-        self.mc = min(1.0, δ2 * I31 / (δ3 * I21))
+        self.mc = mc  # Δ2 I31 / (Δ3 I21), from the exact Δj (see _ExactΔ)
         self.K = float(complete_first_kind(self.mc))
-        λ3 = G * math.sqrt(δ3 * I12 / (I1 * I2 * I3))
+        λ3 = _rate(G, δ3 * I12, I1, I2, I3)
         self.λ = -λ3  # the corrected sign: λ = −σ λ3
         # m0 = (B13 dn ν, B21 sn ν, B31 cn ν); all factors scaled by G to stay O(1).
         s, c = _unit_vector_phase((m0[1] / G) * (self.B31 / G), (m0[2] / G) * (self.B21 / G))
         self.ν = _elliptic_phase(s, c, self.mc, self.K)
         # ψ(t) = (G/I1) t + C Π(am u, n) − arctg(κ sc u)   [Leroy] "Integrals", case (i)
-        self.C = G * I13 / (self.λ * I1 * I3)
-        self.n = I1 * I32 / (I3 * I12)
-        self.κ = math.sqrt(I2 * I31 / (I3 * I21))
+        self.C = (G / self.λ) * (I13 / I1 / I3)  # grouped to stay in the float range
+        self.n = (I1 / I3) * (I32 / I12)
+        self.κ = math.sqrt((I2 / I3) * (I31 / I21))
         # Π(am u, n) = u + (Π − F) since F(am u) = u, and C λ = G/I3 − G/I1, so the
         # secular part of ψ is (G/I3) t; the constant −C ν drops out of ψ(t) − ψ(t0).
         self.ψ_rate = G / I3
@@ -164,23 +174,22 @@ class _FormulaII:
     name = "ii"
     axis = 2  # P(t) maps m onto e3: m3 = B31 dn never vanishes
 
-    def __init__(self, I1, I2, I3, m0, G, δ1, δ2, δ3) -> None:
+    def __init__(self, I1, I2, I3, m0, G, δ1, δ2, δ3, mc) -> None:
         I13, I21, I23, I31, I32 = I1 - I3, I2 - I1, I2 - I3, I3 - I1, I3 - I2
         self.B13 = G * math.sqrt(I1 * δ3 / I13)
         self.B23 = G * math.sqrt(I2 * δ3 / I23)
         self.B31 = G * math.sqrt(I3 * δ1 / I31)
-        # mc = 1 − k⁻² = Δ2 I31 / (Δ1 I32) ≤ 1 (= 1 for an oblate top, up to rounding).
-        self.mc = min(1.0, δ2 * I31 / (δ1 * I32))
+        self.mc = mc  # 1 − k⁻² = Δ2 I31 / (Δ1 I32), from the exact Δj (see _ExactΔ)
         self.K = float(complete_first_kind(self.mc))
-        λ1 = G * math.sqrt(δ1 * I32 / (I1 * I2 * I3))
+        λ1 = _rate(G, δ1 * I32, I1, I2, I3)
         self.λ = -λ1  # the corrected sign: λ = −σ λ1
         # m0 = (B13 cn ν, B23 sn ν, B31 dn ν); all factors scaled by G to stay O(1).
         s, c = _unit_vector_phase((m0[1] / G) * (self.B13 / G), (m0[0] / G) * (self.B23 / G))
         self.ν = _elliptic_phase(s, c, self.mc, self.K)
         # ψ(t) = (G/I3) t + C Π(am u, n) + arctg(κ sc u)   [Leroy] "Integrals", case (ii)
-        self.C = G * I31 / (self.λ * I1 * I3)
-        self.n = I3 * I21 / (I1 * I23)
-        self.κ = math.sqrt(I2 * I31 / (I1 * I32))
+        self.C = (G / self.λ) * (I31 / I1 / I3)  # grouped to stay in the float range
+        self.n = (I3 / I1) * (I21 / I23)
+        self.κ = math.sqrt((I2 / I1) * (I31 / I32))
         # As in case (i): C λ = G/I1 − G/I3, so the secular part of ψ is (G/I1) t.
         self.ψ_rate = G / I1
 
@@ -206,12 +215,12 @@ class _FormulaIII:
     mc = 0.0
     period = math.inf
 
-    def __init__(self, I1, I2, I3, m0, G, δ1, δ2, δ3) -> None:
+    def __init__(self, I1, I2, I3, m0, G, δ1, δ2, δ3, mc) -> None:
         I13, I31 = I1 - I3, I3 - I1
         self.G = G
         self.B13 = G * math.sqrt(I1 * δ3 / I13)
         self.B31 = G * math.sqrt(I3 * δ1 / I31)
-        self.λ = G * math.sqrt(-δ1 * δ3 / (I1 * I3))  # λ = σ'σ'' λ2
+        self.λ = _rate(G, -δ1 * δ3 * I2, I1, I2, I3)  # λ = σ'σ'' λ2 = G √(−δ1δ3/(I1 I3))
         # th(−ν) = m02/G and sech(−ν) = √(m01² + m03²)/G, so sinh(−ν) is their ratio:
         # no cancellation even when m02 is within an ulp of ±G.  A spin exactly about
         # e2 gives ν = ∓∞ and, through IEEE infinities, m(t) = (0, ±G, 0) at all t.
@@ -237,17 +246,24 @@ class _FormulaIII:
         return m, ψ
 
 
-class _Sphere:
-    """I1 = I2 = I3: ω = m/I is constant, the body spins about m at the rate G/I."""
+class _Steady:
+    """m fixed in the body: then m × ω = 0, so ω ∥ m and the body spins about m at |ω| = 2T/G.
 
-    name = "sphere"
+    The sphere (I1 = I2 = I3), where every m is fixed; and a state so close to a
+    principal axis of a symmetric body that the rate λ of cases (i)/(ii) underflows to
+    zero (components ~1e-160 G or less): m then cannot move within any representable
+    time, and the general formulas would give ∞·0.
+    """
+
+    name = "steady"
     axis = 2
     mc = math.nan
     period = math.inf
 
-    def __init__(self, I1, I2, I3, m0, G, δ1, δ2, δ3) -> None:
+    def __init__(self, I1, I2, I3, m0, G, δ1, δ2, δ3, mc) -> None:
         self.m0 = np.array(m0)
-        self.ψ_rate = G / I1
+        x = self.m0 / G
+        self.ψ_rate = G * float(np.sum(x * x / np.array([I1, I2, I3])))  # 2T/G
 
     def evaluate(self, τ: NDArray[np.float64], with_ψ: bool):
         m = np.broadcast_to(self.m0, (*τ.shape, 3)).copy()
@@ -292,25 +308,50 @@ def _as_integers(*values: float) -> list[int]:
     return [p * (scale // q) for p, q in ratios]
 
 
-def _exact_δ2(
-    I1: float, I2: float, I3: float, m1: float, m2: float, m3: float
-) -> tuple[int, float]:
-    """The sign of Δ2 and δ2 = Δ2/G², exact for the float inputs, rounded once.
+class _ExactΔ:
+    """Δ1, Δ2, Δ3 of the float inputs, exactly, and the ratios taken from them.
 
-    δ2 = (m1² I12/I1 + m3² I32/I3)/G² is a difference of two nearly equal terms near
-    the separatrix: in floats it keeps only about |δ2|/eps of its digits (a relative
-    error of 1e-2 at |Δ2|/G² = 1e-14, which moves the flip period by 1e-8).  Floats
-    are dyadic rationals: with the moments and the momentum written as integers
-    times a common power of two, which cancels,
-        δ2 = (M1² (J1 − J2) J3 + M3² (J3 − J2) J1) / ((M1² + M2² + M3²) J1 J3),
-    a ratio of integers that Python divides with a single rounding.  The sign of the
-    integer numerator is the exact case test.
+    Floats are dyadic rationals: with I_k = J_k 2^a and m_k = M_k 2^b for integers J,
+    M, the quantity of [Leroy] "The quantity Δj", Δj = Σ_k m_k² (I_k − I_j)/I_k, is
+    Δj = 2^{2b} D_j / P with P = J1 J2 J3 and the integer
+        D_j = Σ_{k≠j} M_k² (J_k − J_j) P/J_k,
+    and G² = 2^{2b} S with S = Σ M_k².  So δj = Δj/G² = D_j/(P S), and the
+    complementary parameter, a ratio of Δ's, is a ratio of integers: Python divides
+    each with a single rounding.  Why: near the separatrix Δ2 is a difference of
+    nearly equal terms (in floats it keeps only |δ2|/eps of its digits, a relative
+    error of 1e-2 at |Δ2|/G² = 1e-14, which moves the flip period by 1e-8); near a
+    principal axis δ1 or δ3 underflow in floats while mc, a ratio of two tiny
+    numbers, is of order one.  The sign of D2 is the exact case test.
     """
-    J1, J2, J3 = _as_integers(I1, I2, I3)
-    M1, M2, M3 = _as_integers(m1, m2, m3)
-    numerator = M1 * M1 * (J1 - J2) * J3 + M3 * M3 * (J3 - J2) * J1
-    denominator = (M1 * M1 + M2 * M2 + M3 * M3) * J1 * J3
-    return (numerator > 0) - (numerator < 0), numerator / denominator
+
+    def __init__(self, I1: float, I2: float, I3: float, m1: float, m2: float, m3: float):
+        J = _as_integers(I1, I2, I3)
+        M = _as_integers(m1, m2, m3)
+        P = J[0] * J[1] * J[2]
+        squares = [Mk * Mk for Mk in M]
+        self.J = J
+        self.D = [
+            sum(squares[k] * (J[k] - J[j]) * (P // J[k]) for k in range(3) if k != j)
+            for j in range(3)
+        ]
+        self.PS = P * sum(squares)
+
+    @property
+    def sign_Δ2(self) -> int:
+        return (self.D[1] > 0) - (self.D[1] < 0)
+
+    def δ(self, j: int) -> float:
+        """δj = Δj/G², correctly rounded (j = 1, 2, 3)."""
+        return self.D[j - 1] / self.PS
+
+    def mc(self, case: str) -> float:
+        """mc = Δ2 I31/(Δ3 I21) in case (i), Δ2 I31/(Δ1 I32) in case (ii) ([Leroy]
+        "The elliptic modulus"), correctly rounded, in [0, 1]."""
+        J1, J2, J3 = self.J
+        D1, D2, D3 = self.D
+        if case == "i":
+            return (D2 * (J3 - J1)) / (D3 * (J2 - J1))
+        return (D2 * (J3 - J1)) / (D1 * (J3 - J2))
 
 
 def _preferred_axes(moments: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
@@ -369,36 +410,51 @@ class EulerSolver:
         # Body → principal (the identity unless a full tensor was given), then sorted.
         m_principal = m_body if axes.is_diagonal else axes.body_to_principal.apply(m_body)
         order, signs = _preferred_axes(axes.moments)
-        I1, I2, I3 = axes.moments[order]
+        I1, I2, I3 = (float(v) for v in axes.moments[order])  # Python floats: no warnings
         self._I_preferred = np.array([I1, I2, I3])
         m = signs * m_principal[order]
         G = math.hypot(*m)  # math.hypot scales: no overflow or underflow of the squares
         self._G = G
+        mc = math.nan
+        if not math.isfinite(G / I1):
+            raise InputError(
+                f"angular_momentum {m_body.tolist()} with moments {axes.moments.tolist()}: the "
+                f"angular velocity |m|/I1 = {G / I1:g} rad/s is beyond the float range"
+            )
         if G == 0.0:
             δ1 = δ2 = δ3 = 0.0
             formula = _Rest
         else:
-            # δj = Δj/G², sums of terms of one sign except δ2 ([Leroy] "The quantity Δj").
-            x1, x2, x3 = m / G
-            δ1 = x2 * x2 * ((I2 - I1) / I2) + x3 * x3 * ((I3 - I1) / I3)
-            δ3 = x1 * x1 * ((I1 - I3) / I1) + x2 * x2 * ((I2 - I3) / I2)
-            sign_Δ2, δ2 = _exact_δ2(I1, I2, I3, *m)
+            exact = _ExactΔ(I1, I2, I3, *m)
+            δ1, δ2, δ3 = exact.δ(1), exact.δ(2), exact.δ(3)
             if I1 == I3:
-                formula = _Sphere
-            elif sign_Δ2 < 0:
-                formula = _FormulaI
-            elif sign_Δ2 > 0:
-                formula = _FormulaII
+                formula = _Steady  # the sphere
+            elif exact.sign_Δ2 < 0:
+                formula, mc = _FormulaI, exact.mc("i")
+                if _rate(G, δ3 * (I1 - I2), I1, I2, I3) == 0.0:  # λ3 underflows
+                    formula = _Steady
+            elif exact.sign_Δ2 > 0:
+                formula, mc = _FormulaII, exact.mc("ii")
+                if _rate(G, δ1 * (I3 - I2), I1, I2, I3) == 0.0:  # λ1 underflows
+                    formula = _Steady
             else:
                 formula = _FormulaIII
-        # 2T = Σ mj²/Ij = G² (x1²/I1 + x2²/I2 + x3²/I3)
+            if formula in (_FormulaI, _FormulaII) and mc < _SMALLEST_MC:
+                raise InputError(
+                    f"angular_momentum {m_body.tolist()}: the state is not on the separatrix "
+                    f"but so close to it that the complementary parameter of its motion, "
+                    f"mc = {mc:.3g}, is below {_SMALLEST_MC:g}: double precision cannot follow "
+                    "its period.  Put it exactly on the separatrix, or further from it"
+                )
+        # 2T = Σ mj²/Ij = G² (x1²/I1 + x2²/I2 + x3²/I3); Python floats: an energy
+        # beyond the float range is inf, without a numpy warning.
         x = m / G if G > 0.0 else m
-        self._kinetic_energy = 0.5 * G * G * float(np.sum(x * x / np.array([I1, I2, I3])))
+        self._kinetic_energy = 0.5 * G * (G * float(np.sum(x * x / np.array([I1, I2, I3]))))
 
         # Preferred axes ([Leroy] "An alternative quaternionic solution"): reverse axes
         # (by a rotation of π) so that the components carrying dn or sech are ≥ 0.
         flip1 = formula in (_FormulaI, _FormulaIII) and m[0] < 0.0
-        flip3 = formula in (_FormulaII, _FormulaIII, _Sphere) and m[2] < 0.0
+        flip3 = formula in (_FormulaII, _FormulaIII, _Steady) and m[2] < 0.0
         flips = np.ones(3)
         if flip1 and flip3:
             flips[[0, 2]] = -1.0
@@ -408,7 +464,7 @@ class EulerSolver:
             flips[[1, 2]] = -1.0
         signs = signs * flips
         m = flips * m
-        self._formula = formula(I1, I2, I3, m, G, δ1, δ2, δ3)
+        self._formula = formula(I1, I2, I3, m, G, δ1, δ2, δ3, mc)
 
         # S: user body → preferred principal axes: a signed permutation with det +1
         # after the body → principal rotation.  Row vectors go back to the body as
@@ -608,7 +664,8 @@ class EulerSolver:
 
     @property
     def formula(self) -> str:
-        """Which closed form applies: 'i', 'ii', 'iii' (separatrix), 'sphere' or 'rest'."""
+        """Which closed form applies: 'i', 'ii', 'iii' (separatrix), 'steady' (the sphere,
+        or m fixed to within float range) or 'rest'."""
         return self._formula.name
 
     @property

@@ -36,7 +36,7 @@ def test_sphere_rotation_along_random_axis():
     for _ in range(10):
         m0 = rng.normal(size=3) * 3
         solver = EulerSolver([2.5, 2.5, 2.5], m0, ATTITUDE0)
-        assert solver.formula == "sphere"
+        assert solver.formula == "steady"
         t = np.linspace(-30, 30, 301)
         np.testing.assert_array_equal(solver.angular_momentum(t), np.tile(m0, (301, 1)))
         expected = _constant_rate_attitude(m0 / 2.5, t)
@@ -196,3 +196,63 @@ def test_quantities_with_units_are_accepted():
         plain.angular_velocity(t),
         rtol=1e-12,
     )
+
+
+_EPS = np.finfo(float).eps
+_BODIES = [
+    (1.0, 1.0, 1.0),
+    (1.0, 1.0, 2.0),
+    (1.0, 2.0, 2.0),
+    (1.0, 1.0 + _EPS, 1.0 + 2 * _EPS),
+    (1.0, 2.0 - 2 * _EPS, 2.0),
+    (1e-9, 2e-9, 2.5e-9),
+    (1e9, 2e9, 2.5e9),
+    (3.0, 1.0, 2.0),
+    (1e-200, 1e-200, 2e-200),
+]
+_MOMENTA = [
+    (0.0, 0.0, 0.0),
+    (1.0, 0.0, 0.0),
+    (0.0, 1.0, 0.0),
+    (1.0, 1.0, 0.0),
+    (-1.0, 2.0, -3.0),
+    (1e-300, 1.0, 1e-300),
+    (1e-160, 0.0, 1e-160),
+    (5e-324, 0.0, 0.0),
+    (1.0, 1e-200, 0.0),
+    (1e-155, 1.0, 0.0),
+    (1e300, 1e300, 1e-300),
+]
+
+
+@pytest.mark.parametrize("inertia", _BODIES)
+def test_extreme_states_give_a_finite_motion_or_a_clear_error(inertia):
+    """Never a NaN: either a finite motion that conserves |m| and H, or an InputError.
+
+    The errors expected are states closer to the separatrix than double precision can
+    follow (mc < 1e-300) and angular velocities beyond the float range.
+    """
+    import warnings
+
+    t = np.array([-1e7, -3.3, 0.0, 1.7, 1e3, 1e7])
+    for momentum in _MOMENTA:
+        for signs in ((1, 1, 1), (-1, 1, -1), (1, -1, -1)):
+            m0 = np.array(momentum) * signs
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")
+                try:
+                    solver = EulerSolver(inertia, m0, ATTITUDE0)
+                except ValueError as error:
+                    assert "separatrix" in str(error) or "beyond the float range" in str(error)
+                    continue
+                q = solver.attitude_quaternion(t)
+                m = solver.angular_momentum(t)
+                ω = solver.angular_velocity(t)
+            assert np.all(np.isfinite(q)) and np.all(np.isfinite(m)) and np.all(np.isfinite(ω))
+            G = solver.angular_momentum_norm
+            if G > 1e-300:  # a subnormal momentum has too few digits to rotate
+                norms = np.hypot(np.hypot(m[:, 0] / G, m[:, 1] / G), m[:, 2] / G)
+                np.testing.assert_allclose(norms, 1.0, atol=1e-12)
+                H = solver.attitude(t).apply(m / G)
+                H0 = solver.inertial_angular_momentum / G
+                np.testing.assert_allclose(H, np.tile(H0, (t.size, 1)), atol=1e-12)
