@@ -37,7 +37,8 @@ def settings() -> list[Setting]:
     ]
 
 
-def _rhs(t: float, y: np.ndarray, inverse_inertia: np.ndarray) -> np.ndarray:
+def euler_rhs(t: float, y: np.ndarray, inverse_inertia: np.ndarray) -> np.ndarray:
+    """d/dt of (m, q): dm/dt = m × ω and dq/dt = ½ q ⊗ (0, ω), with ω = m · I⁻¹ (q scalar first)."""
     m = y[:3]
     w, x, yy, z = y[3:]
     o1, o2, o3 = m * inverse_inertia
@@ -62,7 +63,7 @@ def run(case: Case, setting: Setting, times: np.ndarray) -> PeerRun:
     y0 = np.concatenate([m0, case.q0])
     scale = np.concatenate([np.full(3, np.linalg.norm(m0)), np.ones(4)])
     solution = solve_ivp(
-        _rhs,
+        euler_rhs,
         (0.0, float(times[-1])),
         y0,
         method="DOP853",
