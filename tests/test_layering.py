@@ -68,3 +68,17 @@ def test_ci_runs_the_readme_test_command():
     install, _, run = test_line.partition("pip install ")[2].partition(" && ")
     assert f"pip install {install}" in ci
     assert run.strip() in ci
+
+
+def test_every_public_name_resolves_and_import_stays_light():
+    import subprocess
+    import sys
+
+    import attitude
+
+    for name in attitude.__all__:
+        assert getattr(attitude, name) is not None, name
+    # `import attitude` alone loads none of the heavy dependencies of the later layers.
+    code = "import sys, attitude; print(sorted({'astropy', 'skyfield', 'matplotlib'} & set(sys.modules)))"
+    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert loaded.stdout.strip() == "[]"
