@@ -79,6 +79,7 @@ def test_every_public_name_resolves_and_import_stays_light():
     for name in attitude.__all__:
         assert getattr(attitude, name) is not None, name
     # `import attitude` alone loads none of the heavy dependencies of the later layers.
-    code = "import sys, attitude; print(sorted({'astropy', 'skyfield', 'matplotlib'} & set(sys.modules)))"
-    loaded = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert loaded.stdout.strip() == "[]"
+    heavy = "{'astropy', 'skyfield', 'matplotlib'}"
+    code = f"import sys, attitude; print(sorted({heavy} & set(sys.modules)))"
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert run.stdout.strip() == "[]"
