@@ -168,8 +168,8 @@ def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str
                 [
                     "body vector",
                     "kind",
-                    "min Sun angle (deg)",
-                    "max Sun angle (deg)",
+                    "min Sun angle (deg, geometric: eclipses included)",
+                    "max Sun angle (deg, geometric)",
                     "exclusion (deg)",
                     "violations",
                     "violated (s)",
