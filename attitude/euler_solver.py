@@ -133,15 +133,19 @@ class _FormulaI:
     name = "i"
     axis = 0  # P(t) maps m onto e1: m1 = B13 dn is the component that never vanishes
 
-    def __init__(self, I1, I2, I3, m0, G, δ1, δ2, δ3, mc) -> None:
+    @staticmethod
+    def rate(G: float, I1: float, I2: float, I3: float, δ1: float, δ3: float) -> float:
+        """λ3 = G √(δ3 I12 / (I1 I2 I3)), the magnitude of λ."""
+        return _rate(G, δ3 * (I1 - I2), I1, I2, I3)
+
+    def __init__(self, I1, I2, I3, m0, G, δ1, δ3, mc) -> None:
         I12, I13, I21, I31, I32 = I1 - I2, I1 - I3, I2 - I1, I3 - I1, I3 - I2
         self.B13 = G * math.sqrt(I1 * δ3 / I13)
         self.B21 = G * math.sqrt(I2 * δ1 / I21)
         self.B31 = G * math.sqrt(I3 * δ1 / I31)
         self.mc = mc  # Δ2 I31 / (Δ3 I21), from the exact Δj (see _ExactΔ)
         self.K = float(complete_first_kind(self.mc))
-        λ3 = _rate(G, δ3 * I12, I1, I2, I3)
-        self.λ = -λ3  # the corrected sign: λ = −σ λ3
+        self.λ = -self.rate(G, I1, I2, I3, δ1, δ3)  # the corrected sign: λ = −σ λ3
         # m0 = (B13 dn ν, B21 sn ν, B31 cn ν); all factors scaled by G to stay O(1).
         s, c = _unit_vector_phase((m0[1] / G) * (self.B31 / G), (m0[2] / G) * (self.B21 / G))
         self.ν = _elliptic_phase(s, c, self.mc, self.K)
@@ -174,15 +178,19 @@ class _FormulaII:
     name = "ii"
     axis = 2  # P(t) maps m onto e3: m3 = B31 dn never vanishes
 
-    def __init__(self, I1, I2, I3, m0, G, δ1, δ2, δ3, mc) -> None:
+    @staticmethod
+    def rate(G: float, I1: float, I2: float, I3: float, δ1: float, δ3: float) -> float:
+        """λ1 = G √(δ1 I32 / (I1 I2 I3)), the magnitude of λ."""
+        return _rate(G, δ1 * (I3 - I2), I1, I2, I3)
+
+    def __init__(self, I1, I2, I3, m0, G, δ1, δ3, mc) -> None:
         I13, I21, I23, I31, I32 = I1 - I3, I2 - I1, I2 - I3, I3 - I1, I3 - I2
         self.B13 = G * math.sqrt(I1 * δ3 / I13)
         self.B23 = G * math.sqrt(I2 * δ3 / I23)
         self.B31 = G * math.sqrt(I3 * δ1 / I31)
         self.mc = mc  # 1 − k⁻² = Δ2 I31 / (Δ1 I32), from the exact Δj (see _ExactΔ)
         self.K = float(complete_first_kind(self.mc))
-        λ1 = _rate(G, δ1 * I32, I1, I2, I3)
-        self.λ = -λ1  # the corrected sign: λ = −σ λ1
+        self.λ = -self.rate(G, I1, I2, I3, δ1, δ3)  # the corrected sign: λ = −σ λ1
         # m0 = (B13 cn ν, B23 sn ν, B31 dn ν); all factors scaled by G to stay O(1).
         s, c = _unit_vector_phase((m0[1] / G) * (self.B13 / G), (m0[0] / G) * (self.B23 / G))
         self.ν = _elliptic_phase(s, c, self.mc, self.K)
@@ -215,7 +223,7 @@ class _FormulaIII:
     mc = 0.0
     period = math.inf
 
-    def __init__(self, I1, I2, I3, m0, G, δ1, δ2, δ3, mc) -> None:
+    def __init__(self, I1, I2, I3, m0, G, δ1, δ3, mc) -> None:
         I13, I31 = I1 - I3, I3 - I1
         self.G = G
         self.B13 = G * math.sqrt(I1 * δ3 / I13)
@@ -260,7 +268,7 @@ class _Steady:
     mc = math.nan
     period = math.inf
 
-    def __init__(self, I1, I2, I3, m0, G, δ1, δ2, δ3, mc) -> None:
+    def __init__(self, I1, I2, I3, m0, G, δ1, δ3, mc) -> None:
         self.m0 = np.array(m0)
         x = self.m0 / G
         self.ψ_rate = G * float(np.sum(x * x / np.array([I1, I2, I3])))  # 2T/G
@@ -422,23 +430,21 @@ class EulerSolver:
                 f"angular velocity |m|/I1 = {G / I1:g} rad/s is beyond the float range"
             )
         if G == 0.0:
-            δ1 = δ2 = δ3 = 0.0
+            δ1 = δ3 = 0.0
             formula = _Rest
         else:
             exact = _ExactΔ(I1, I2, I3, *m)
-            δ1, δ2, δ3 = exact.δ(1), exact.δ(2), exact.δ(3)
+            δ1, δ3 = exact.δ(1), exact.δ(3)
             if I1 == I3:
                 formula = _Steady  # the sphere
             elif exact.sign_Δ2 < 0:
                 formula, mc = _FormulaI, exact.mc("i")
-                if _rate(G, δ3 * (I1 - I2), I1, I2, I3) == 0.0:  # λ3 underflows
-                    formula = _Steady
             elif exact.sign_Δ2 > 0:
                 formula, mc = _FormulaII, exact.mc("ii")
-                if _rate(G, δ1 * (I3 - I2), I1, I2, I3) == 0.0:  # λ1 underflows
-                    formula = _Steady
             else:
                 formula = _FormulaIII
+            if formula in (_FormulaI, _FormulaII) and formula.rate(G, I1, I2, I3, δ1, δ3) == 0.0:
+                formula = _Steady  # λ underflows: see _Steady
             if formula in (_FormulaI, _FormulaII) and mc < _SMALLEST_MC:
                 raise InputError(
                     f"angular_momentum {m_body.tolist()}: the state is not on the separatrix "
@@ -464,7 +470,7 @@ class EulerSolver:
             flips[[1, 2]] = -1.0
         signs = signs * flips
         m = flips * m
-        self._formula = formula(I1, I2, I3, m, G, δ1, δ2, δ3, mc)
+        self._formula = formula(I1, I2, I3, m, G, δ1, δ3, mc)
 
         # S: user body → preferred principal axes: a signed permutation with det +1
         # after the body → principal rotation.  Row vectors go back to the body as
