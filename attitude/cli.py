@@ -14,9 +14,9 @@ import sys
 from pathlib import Path
 
 from attitude.errors import InputError
-from attitude.euler_solver import EulerSolver
 from attitude.report import Progress, produce
 from attitude.scenario_file import load_scenario
+from attitude.trajectory import propagate
 from attitude.version import __version__
 
 __all__ = ["main"]
@@ -26,12 +26,7 @@ def _describe(path: Path) -> str:
     loaded = load_scenario(path)
     scenario = loaded.scenario
     craft = scenario.spacecraft
-    state = scenario.initial_state
-    if state.angular_momentum is not None:
-        m0 = state.angular_momentum
-    else:
-        m0 = craft.inertia_tensor @ state.angular_velocity
-    solver = EulerSolver(craft.inertia_tensor, m0, state.attitude)
+    solver = propagate(scenario).segments[0].solver
     lines = [
         f"{path}: OK",
         f"  scenario    {scenario.name}",

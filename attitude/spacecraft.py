@@ -58,6 +58,11 @@ class Spacecraft:
         return self._name
 
     @property
+    def principal_axes(self) -> PrincipalAxes:
+        """The principal moments and the body → principal rotation (computed once)."""
+        return self._axes
+
+    @property
     def inertia_tensor(self) -> NDArray[np.float64]:
         """Inertia tensor in body axes, kg m²."""
         return self._axes.tensor.copy()

@@ -23,7 +23,6 @@ from scipy.spatial.transform import Rotation
 from attitude.errors import InputError
 from attitude.euler_solver import EulerSolver
 from attitude.events import Event, State
-from attitude.inertia import principal_axes
 from attitude.scenario import Scenario
 from attitude.timescales import SAME_INSTANT_S, tt_seconds
 
@@ -56,7 +55,7 @@ def _solver(state: State, t0: float) -> EulerSolver:
 def propagate(scenario: Scenario) -> Trajectory:
     """The exact motion of ``scenario`` over [epoch, stop], through its events."""
     initial = scenario.initial_state
-    axes = principal_axes(scenario.spacecraft.inertia_tensor)
+    axes = scenario.spacecraft.principal_axes
     if initial.angular_momentum is not None:
         m0 = initial.angular_momentum
     else:
