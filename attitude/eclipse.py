@@ -49,6 +49,7 @@ from attitude.errors import InputError
 from attitude.orbit import EARTH_EQUATORIAL_RADIUS_M
 from attitude.quantities import as_si_array, as_si_scalar
 from attitude.timescales import as_time, offline_time, time_from_tt_seconds, tt_seconds
+from attitude.vectors import angle_between
 
 __all__ = [
     "SUN_RADIUS_M",
@@ -92,11 +93,6 @@ def _length(value: Any, name: str) -> float:
     return float(array)
 
 
-def _angle_between(u: NDArray[np.float64], v: NDArray[np.float64]) -> NDArray[np.float64]:
-    """The angle between vectors, from atan2(|u×v|, u·v): accurate at every angle."""
-    return np.arctan2(np.linalg.norm(np.cross(u, v), axis=-1), np.sum(u * v, axis=-1))
-
-
 def shadow_angles(
     r_sat_m: ArrayLike,
     r_sun_m: ArrayLike,
@@ -121,7 +117,7 @@ def shadow_angles(
     _outside(to_sun_norm, sun_radius_m, to_sun, "r_sun_m - r_sat_m", "the Sun")
     a = np.arcsin(sun_radius_m / to_sun_norm)
     b = np.arcsin(earth_radius_m / r_norm)
-    c = _angle_between(-r, to_sun)
+    c = angle_between(-r, to_sun)
     return a, b, c
 
 

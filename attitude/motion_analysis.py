@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from attitude.trajectory import Segment, Trajectory
+from attitude.vectors import basis_across
 
 __all__ = ["SegmentMotion", "analyze"]
 
@@ -67,9 +68,7 @@ def _mean_period_about_momentum(segment: Segment, axis_body: NDArray[np.float64]
     count = int(min(_MAX_SAMPLES, max(1024, _SAMPLES_PER_TURN * turns)))
     t = solver.t0 + np.linspace(0.0, period, count + 1)
     axis = solver.attitude(t).apply(axis_body)
-    u = np.cross(h, [1.0, 0.0, 0.0] if abs(h[0]) < 0.9 else [0.0, 1.0, 0.0])
-    u /= np.linalg.norm(u)
-    v = np.cross(h, u)
+    u, v = basis_across(h)
     azimuth = np.unwrap(np.arctan2(axis @ v, axis @ u))
     advance = abs(azimuth[-1] - azimuth[0])
     return math.inf if advance == 0.0 else 2.0 * math.pi * period / advance
@@ -84,8 +83,7 @@ def _segment_motion(segment: Segment) -> SegmentMotion:
     if cone is not None:
         axis, nutation_min, nutation_max = cone
         # A body axis across the spin axis, for the rotation about H.
-        across = np.cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 1.0, 0.0])
-        spin = _mean_period_about_momentum(segment, across / np.linalg.norm(across))
+        spin = _mean_period_about_momentum(segment, basis_across(axis)[0])
         if nutation_max > 0.0:  # else a steady spin: the spin axis lies along H
             nutation_period = solver.period / 2.0
             moments = np.sort(solver.moments_of_inertia)

@@ -15,6 +15,8 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
+from attitude.vectors import basis_across
+
 __all__ = [
     "plot_angular_velocity",
     "plot_eclipse",
@@ -183,9 +185,7 @@ def plot_polhode(
     direction = h_body / np.linalg.norm(h_body, axis=1, keepdims=True)
     mean = np.mean(direction, axis=0)
     mean = mean / np.linalg.norm(mean) if np.linalg.norm(mean) > 1e-6 else direction[0]
-    e1 = np.cross(mean, [1.0, 0.0, 0.0] if abs(mean[0]) < 0.9 else [0.0, 1.0, 0.0])
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(mean, e1)
+    e1, e2 = basis_across(mean)
     step = max(1, direction.shape[0] // 5000)  # 3-D lines are slow to draw; 5000 is plenty
     radius = float(np.degrees(np.max(np.arccos(np.clip(direction @ mean, -1.0, 1.0)))))
     for k in np.unique(segments):

@@ -39,6 +39,7 @@ from attitude.orbit import EARTH_EQUATORIAL_RADIUS_M, TleOrbit
 from attitude.quantities import as_vector3
 from attitude.timescales import tt_seconds
 from attitude.trajectory import Trajectory
+from attitude.vectors import angle_between
 
 __all__ = ["BodyVector", "Geometry", "PointingResult", "PointingSpec", "compute_pointing"]
 
@@ -279,14 +280,11 @@ def compute_pointing(
     for body_vector in spec.body_vectors:
         v = body_vector.vector
         cosine = sun_body @ v
-        angle = np.arctan2(np.linalg.norm(np.cross(sun_body, v), axis=-1), cosine)
+        angle = angle_between(sun_body, v)
         icrf = attitude.apply(v)
         nadir = None
         if position is not None:
-            down = -position / np.linalg.norm(position, axis=-1, keepdims=True)
-            nadir = np.arctan2(
-                np.linalg.norm(np.cross(icrf, down), axis=-1), np.sum(icrf * down, -1)
-            )
+            nadir = angle_between(icrf, -position)
         half = body_vector.sun_exclusion_half_angle_rad
         result = VectorPointing(
             vector=body_vector,

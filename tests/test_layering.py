@@ -11,7 +11,7 @@ PACKAGE = Path(__file__).parents[1] / "attitude"
 
 # In order; a module may import modules of its own layer or of earlier ones.
 LAYERS = [
-    ["version", "errors", "quantities", "quaternions"],  # shared base
+    ["version", "errors", "quantities", "quaternions", "vectors"],  # shared base
     ["elliptic"],  # elliptic kernels
     ["inertia", "euler_solver"],  # the Euler solver
     ["timescales", "spacecraft", "events", "scenario"],  # spacecraft, scenario and events
