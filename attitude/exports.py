@@ -24,10 +24,12 @@ from attitude.trajectory import Trajectory
 
 __all__ = [
     "Column",
+    "Samples",
     "extremum",
     "motion_summary",
     "pointing_columns",
     "pointing_summary",
+    "sample",
     "to_json",
     "trajectory_columns",
     "write_csv",
@@ -57,40 +59,64 @@ def _components(
     return [Column(name.format(c), values[:, i], description) for i, c in enumerate(axes)]
 
 
-def trajectory_columns(trajectory: Trajectory, seconds: NDArray[np.float64]) -> list[Column]:
-    """Attitude, rates, momentum and energy at ``seconds`` (TT s since the epoch)."""
+@dataclass(frozen=True)
+class Samples:
+    """The trajectory evaluated once on the output grid, for the files and the plots."""
+
+    seconds: NDArray[np.float64]
+    quaternion: NDArray[np.float64]  # (w, x, y, z), body -> ICRF
+    angular_velocity: NDArray[np.float64]  # body, rad/s
+    angular_momentum: NDArray[np.float64]  # body, N m s
+    inertial_angular_momentum: NDArray[np.float64]  # ICRF, N m s
+    kinetic_energy: NDArray[np.float64]  # J
+    segment: NDArray[np.intp]
+
+
+def sample(trajectory: Trajectory, seconds: NDArray[np.float64]) -> Samples:
+    """``trajectory`` at ``seconds`` (TT s since the epoch)."""
+    return Samples(
+        seconds,
+        trajectory.attitude_quaternion(seconds),
+        trajectory.angular_velocity(seconds),
+        trajectory.angular_momentum(seconds),
+        trajectory.inertial_angular_momentum(seconds),
+        trajectory.kinetic_energy(seconds),
+        trajectory.segment_index(seconds),
+    )
+
+
+def trajectory_columns(samples: Samples) -> list[Column]:
+    """Attitude, rates, momentum and energy: the columns of the time series."""
     return [
-        Column("t_s", seconds, "TT seconds since the scenario epoch"),
+        Column("t_s", samples.seconds, "TT seconds since the scenario epoch"),
         *_components(
             "q_body_to_icrf_{}",
-            trajectory.attitude_quaternion(seconds),
+            samples.quaternion,
             "wxyz",
             "attitude quaternion, scalar first, body -> ICRF",
         ),
         *_components(
             "omega_body_{}_rad_s",
-            trajectory.angular_velocity(seconds),
+            samples.angular_velocity,
             "xyz",
             "angular velocity, body axes, rad/s",
         ),
         *_components(
             "h_body_{}_N_m_s",
-            trajectory.angular_momentum(seconds),
+            samples.angular_momentum,
             "xyz",
             "angular momentum, body axes, N m s",
         ),
         *_components(
             "h_icrf_{}_N_m_s",
-            trajectory.inertial_angular_momentum(seconds),
+            samples.inertial_angular_momentum,
             "xyz",
             "angular momentum, ICRF axes, N m s",
         ),
-        Column(
-            "kinetic_energy_J", trajectory.kinetic_energy(seconds), "rotational kinetic energy, J"
-        ),
+        Column("kinetic_energy_J", samples.kinetic_energy, "rotational kinetic energy, J"),
         Column(
             "segment",
-            trajectory.segment_index(seconds).astype(float),
+            samples.segment.astype(float),
             "index of the motion segment (0 = before the first event)",
         ),
     ]

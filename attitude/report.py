@@ -31,6 +31,7 @@ from attitude.exports import (
     motion_summary,
     pointing_columns,
     pointing_summary,
+    sample,
     trajectory_columns,
     write_csv,
     write_intervals_csv,
@@ -183,7 +184,8 @@ def produce(
         motion = analyze(trajectory)
         seconds = scenario.output_seconds()
         progress(f"sampling {seconds.size} epochs")
-        columns = trajectory_columns(trajectory, seconds)
+        samples = sample(trajectory, seconds)
+        columns = trajectory_columns(samples)
         result = None
         if not pointing.is_empty:
             progress(
@@ -204,8 +206,7 @@ def produce(
         ]
         progress("writing timeseries.csv")
         write_csv(tmp / "timeseries.csv", scenario.iso(seconds), f"time_{scale}", columns, preamble)
-        ω = trajectory.angular_velocity(seconds)
-        rate = np.linalg.norm(ω, axis=1)
+        rate = np.linalg.norm(samples.angular_velocity, axis=1)
         peak = int(np.argmax(rate))
         summary: dict[str, Any] = {
             "attitude_version": __version__,
@@ -240,12 +241,10 @@ def produce(
         images = {}
         events = [t for t, _ in scenario.events]
         images["Body angular velocity"] = plot_angular_velocity(
-            tmp / "angular_velocity.png", seconds, ω, events
+            tmp / "angular_velocity.png", seconds, samples.angular_velocity, events
         )
         images["Angular momentum direction in body axes (polhode)"] = plot_polhode(
-            tmp / "polhode.png",
-            trajectory.angular_momentum(seconds),
-            trajectory.segment_index(seconds),
+            tmp / "polhode.png", samples.angular_momentum, samples.segment
         )
         if result is not None and result.vectors:
             eclipse = result.sunlit_fraction < 1.0 if result.on_orbit else None
