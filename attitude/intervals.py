@@ -5,8 +5,8 @@ f > 0 (for a Sun exclusion cone: cos(Sun angle) − cos(half angle)).  It is sam
 on a search grid finer than the motion's fastest time scale, then every sign
 change is refined by bisection, all of them at once (vectorized), until the
 bracket is narrower than the stated precision: the ends do not depend on the
-output step.  Conditions combine as interval sets (intersection, difference),
-e.g. "the Sun is in the tracker's cone and the spacecraft is not in umbra".
+output step.  Conditions combine as interval sets (``difference``), e.g. "the Sun is
+in the tracker's cone and the spacecraft is not in umbra".
 
 A condition that becomes true and false again between two search samples is missed;
 the search step (see ``attitude.pointing``) is chosen so that no Sun crossing of a
@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Interval", "difference", "find_intervals", "intersection", "total_duration"]
+__all__ = ["Interval", "difference", "find_intervals", "total_duration"]
 
 
 @dataclass(frozen=True)
@@ -87,24 +87,6 @@ def find_intervals(
     if start is not None:
         intervals.append(Interval(float(start), float(grid_s[-1]), starts_before, True))
     return intervals
-
-
-def intersection(a: list[Interval], b: list[Interval]) -> list[Interval]:
-    """The intervals where both ``a`` and ``b`` hold (each list sorted, disjoint)."""
-    out, i, j = [], 0, 0
-    while i < len(a) and j < len(b):
-        start = max(a[i].start_s, b[j].start_s)
-        end = min(a[i].end_s, b[j].end_s)
-        if start < end:
-            # Cut by the span only where both are: else the later start is a crossing.
-            starts_before = a[i].starts_before and b[j].starts_before
-            ends_after = a[i].ends_after and b[j].ends_after
-            out.append(Interval(start, end, starts_before, ends_after))
-        if a[i].end_s < b[j].end_s:
-            i += 1
-        else:
-            j += 1
-    return out
 
 
 def difference(a: list[Interval], b: list[Interval]) -> list[Interval]:

@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import CubicHermiteSpline, CubicSpline
 
-from attitude.eclipse import eclipse_intervals, shadow_angles, sunlit_fraction
+from attitude.eclipse import eclipse_intervals, sunlit_fraction
 from attitude.ephemeris import sun_position_from_earth, sun_position_from_observer
 from attitude.errors import InputError
 from attitude.intervals import Interval, difference, find_intervals
@@ -175,10 +175,6 @@ class Geometry:
         if self._position is None:
             return np.ones(np.shape(seconds))
         return sunlit_fraction(self._position(seconds), self._sun_from_earth(seconds))
-
-    def shadow_angles(self, seconds: NDArray[np.float64]):
-        """(a, b, c) of ``attitude.eclipse.shadow_angles`` (on an orbit only)."""
-        return shadow_angles(self._position(seconds), self._sun_from_earth(seconds))
 
     def eclipse_intervals(
         self, start_s: float, stop_s: float

@@ -12,9 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.spatial.transform import Rotation
 
-__all__ = ["left_matrix", "right_matrix", "scalar_first"]
+__all__ = ["left_matrix", "right_matrix"]
 
 
 def left_matrix(a: ArrayLike) -> NDArray[np.float64]:
@@ -28,7 +27,3 @@ def right_matrix(b: ArrayLike) -> NDArray[np.float64]:
     w, x, y, z = np.asarray(b, dtype=np.float64)
     return np.array([[w, -x, -y, -z], [x, w, z, -y], [y, -z, w, x], [z, y, -x, w]])
 
-
-def scalar_first(rotation: Rotation) -> NDArray[np.float64]:
-    """The unit quaternion(s) of ``rotation``, scalar first (w, x, y, z)."""
-    return rotation.as_quat(scalar_first=True)
