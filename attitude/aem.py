@@ -1,4 +1,4 @@
-"""CCSDS Attitude Ephemeris Messages (AEM 2.0, KVN): a writer, and a small reader for round trips.
+"""CCSDS Attitude Ephemeris Messages (AEM 2.0, KVN): the writer.
 
 The standard is CCSDS 504.0-B-2 (Attitude Data Messages, January 2024), section 4 (AEM
 content), section 6 (KVN syntax) and annex F (conventions).  Section numbers below refer
@@ -96,10 +96,9 @@ a temporary file in the target's directory, and ``os.replace`` puts it in place,
 failed call leaves no file behind and never a half-written one.  Bad input raises
 :class:`~attitude.errors.InputError` naming the field and the value.
 
-The reader, :func:`read_aem`, reads back what this module writes (and the same content
-laid out differently, e.g. by another tool).  It refuses what it does not understand:
-other attitude types, other frames, version-1 keywords, a ``:60`` that is not a UTC leap
-second, non-unit quaternions, epochs that do not increase.
+There is no reader here: nothing in the package reads an AEM.  The tests read our files
+back with an independent parser, ccsds-ndm-py, and check what it does not (unit norms,
+increasing epochs, START/STOP_TIME against the data) themselves.
 """
 
 from __future__ import annotations
@@ -107,7 +106,6 @@ from __future__ import annotations
 import os
 import re
 import secrets
-import warnings
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -127,7 +125,6 @@ __all__ = [
     "REFERENCE_FRAMES",
     "TIME_SYSTEMS",
     "AemSegment",
-    "read_aem",
     "write_aem",
 ]
 
@@ -156,43 +153,6 @@ _NUMBER_FORMAT = f"%.{SIGNIFICANT_DIGITS - 1}E"
 _RECORD_FORMAT = "%s" + f" {_NUMBER_FORMAT}" * 7
 # Written epochs; a 4-digit year also keeps string order equal to time order.
 _EPOCH_WRITTEN = re.compile(rf"\d{{4}}-\d\d-\d\dT\d\d:\d\d:\d\d\.\d{{{EPOCH_DECIMALS}}}")
-# Epochs the reader accepts (calendar form of §6.8.9, up to 1 ns, optional Z for UTC).
-_EPOCH_READ = re.compile(r"(\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d)(?:\.(\d{1,9}))?(Z?)")
-# A decimal number in fixed or floating-point notation (§6.8.4), never nan or inf.
-_NUMBER_READ = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
-_KVN_LINE = re.compile(r"([A-Z][A-Z0-9_]*)\s*=\s*(.*)")
-_COMMENT_LINE = re.compile(r"COMMENT(?:\s(.*))?")
-
-# Table 4-2 and table 4-3, in their fixed order (§6.7.8).
-_HEADER_KEYWORDS = ("CCSDS_AEM_VERS", "CLASSIFICATION", "CREATION_DATE", "ORIGINATOR", "MESSAGE_ID")
-_METADATA_KEYWORDS = (
-    "OBJECT_NAME",
-    "OBJECT_ID",
-    "CENTER_NAME",
-    "REF_FRAME_A",
-    "REF_FRAME_B",
-    "TIME_SYSTEM",
-    "START_TIME",
-    "USEABLE_START_TIME",
-    "USEABLE_STOP_TIME",
-    "STOP_TIME",
-    "ATTITUDE_TYPE",
-    "EULER_ROT_SEQ",
-    "ANGVEL_FRAME",
-    "INTERPOLATION_METHOD",
-    "INTERPOLATION_DEGREE",
-)
-_METADATA_MANDATORY = (
-    "OBJECT_NAME",
-    "OBJECT_ID",
-    "REF_FRAME_A",
-    "REF_FRAME_B",
-    "TIME_SYSTEM",
-    "START_TIME",
-    "STOP_TIME",
-    "ATTITUDE_TYPE",
-    "ANGVEL_FRAME",  # optional in table 4-3, but we cannot read rates without it
-)
 
 
 @dataclass(frozen=True, eq=False)
@@ -276,30 +236,6 @@ def write_aem(
         comments=comments,
     )
     return _write_atomically(Path(path), text)
-
-
-def read_aem(path: str | os.PathLike[str]) -> tuple[list[AemSegment], dict[str, Any]]:
-    """Read an AEM 2.0 KVN file of the kind :func:`write_aem` writes.
-
-    Returns the segments, whose times are in the file's time system, quaternions in our
-    convention (body → inertial, scalar first) and rates in rad/s.  It also returns a
-    metadata dict: the header keywords as strings, ``"COMMENT"`` (a list), and
-    ``"segments"``, one dict per segment of its metadata keywords with
-    ``"COMMENT"`` and ``"DATA_COMMENT"`` lists.
-
-    Raises :class:`InputError` naming the line for anything it does not understand or
-    that breaks the standard: another version or attitude type, other frames, unknown or
-    repeated keywords, a wrong column count, a bad epoch, a non-unit quaternion, epochs
-    that do not increase, data outside ``START_TIME``/``STOP_TIME``.
-    """
-    path = Path(path)
-    try:
-        text = path.read_bytes().decode("ascii")
-    except UnicodeDecodeError as exc:
-        raise InputError(
-            f"{path}: an AEM is ASCII text (§6.6.3), byte {exc.start} is not"
-        ) from None
-    return _Parser(path, text).parse()
 
 
 # --- writing -------------------------------------------------------------------------
@@ -543,7 +479,7 @@ def _aem_quaternions(
     return aem * np.cumprod(steps)[:, np.newaxis]
 
 
-# --- validation shared by the writer and the reader ----------------------------------
+# --- validation of the segments ----------------------------------
 
 
 def _checked_times(times: Any) -> Time:
@@ -602,260 +538,3 @@ def _check_unit_norm(name: str, quaternions: NDArray[np.float64]) -> None:
             f"{name}[{worst}] = {quaternions[worst].tolist()} has norm {norms[worst]:.17g}; "
             f"a unit quaternion is needed (to {UNIT_NORM_TOLERANCE:g})"
         )
-
-
-# --- reading -------------------------------------------------------------------------
-
-
-class _Parser:
-    """A line-by-line reader of one AEM 2.0 KVN message (section 4, section 6)."""
-
-    def __init__(self, path: Path, text: str) -> None:
-        self.path = path
-        # Blank lines may appear anywhere (§6.6.4); surrounding blanks are not significant.
-        self.lines = [
-            (number, line.strip())
-            for number, line in enumerate(text.splitlines(), start=1)
-            if line.strip()
-        ]
-        self.position = 0
-
-    def error(self, number: int | None, message: str) -> InputError:
-        where = str(self.path) if number is None else f"{self.path}:{number}"
-        return InputError(f"{where}: {message}")
-
-    def peek(self) -> tuple[int, str] | None:
-        return self.lines[self.position] if self.position < len(self.lines) else None
-
-    def take(self, expected: str) -> tuple[int, str]:
-        line = self.peek()
-        if line is None:
-            raise self.error(None, f"the file ends where {expected} is expected")
-        self.position += 1
-        return line
-
-    def expect(self, word: str) -> int:
-        number, line = self.take(word)
-        if line != word:
-            raise self.error(number, f"expected {word}, got {line!r}")
-        return number
-
-    def comments(self) -> list[str]:
-        found = []
-        while (line := self.peek()) is not None and (match := _COMMENT_LINE.fullmatch(line[1])):
-            found.append(match.group(1) or "")
-            self.position += 1
-        return found
-
-    def keywords(
-        self, allowed: Sequence[str], stop: str, where: str
-    ) -> tuple[dict[str, str], dict[str, int]]:
-        """``KEYWORD = value`` lines up to the line ``stop``: values, and their line numbers."""
-        values: dict[str, str] = {}
-        numbers: dict[str, int] = {}
-        while (line := self.peek()) is not None and line[1] != stop:
-            number, text = self.take(stop)
-            match = _KVN_LINE.fullmatch(text)
-            if match is None:
-                raise self.error(
-                    number, f"expected 'KEYWORD = value' or {stop} in the {where}, got {text!r}"
-                )
-            keyword, value = match.group(1), match.group(2).strip()
-            if keyword not in allowed:
-                raise self.error(number, f"keyword {keyword} is not allowed in an AEM 2.0 {where}")
-            if keyword in values:
-                raise self.error(number, f"keyword {keyword} is repeated in the {where}")
-            if not value:
-                raise self.error(number, f"{keyword} has no value (§6.8.7)")
-            values[keyword], numbers[keyword] = value, number
-        return values, numbers
-
-    def parse(self) -> tuple[list[AemSegment], dict[str, Any]]:
-        number, first = self.take("CCSDS_AEM_VERS")
-        match = _KVN_LINE.fullmatch(first)
-        if match is None or match.group(1) != "CCSDS_AEM_VERS":
-            raise self.error(
-                number, f"the first line must be CCSDS_AEM_VERS (§4.2.2.3), got {first!r}"
-            )
-        if match.group(2).strip() != AEM_VERSION:
-            raise self.error(
-                number, f"only AEM version {AEM_VERSION} is read, got {match.group(2).strip()!r}"
-            )
-        header: dict[str, Any] = {"CCSDS_AEM_VERS": AEM_VERSION, "COMMENT": self.comments()}
-        header.update(self.keywords(_HEADER_KEYWORDS[1:], "META_START", "header")[0])
-        for keyword in ("CREATION_DATE", "ORIGINATOR"):
-            if keyword not in header:
-                raise self.error(None, f"the header has no {keyword} (table 4-2)")
-
-        segments: list[AemSegment] = []
-        header["segments"] = []
-        previous_useable_stop = None
-        while self.peek() is not None:
-            index = len(segments)
-            segment, metadata, (useable_start, useable_stop), start_line = self.segment(index)
-            if (
-                previous_useable_stop is not None
-                and _seconds(useable_start, previous_useable_stop) < 0
-            ):
-                begins = metadata.get("USEABLE_START_TIME", metadata["START_TIME"])
-                raise self.error(
-                    start_line,
-                    f"segment {index} is useable from {begins}, before the previous "
-                    "segment's useable span ends (table 4-3)",
-                )
-            previous_useable_stop = useable_stop
-            segments.append(segment)
-            header["segments"].append(metadata)
-        if not segments:
-            raise self.error(None, "the file has no segment (table 4-1)")
-        return segments, header
-
-    def segment(self, index: int) -> tuple[AemSegment, dict[str, Any], tuple[Time, Time], int]:
-        start_line = self.expect("META_START")
-        metadata: dict[str, Any] = {"COMMENT": self.comments()}
-        values, numbers = self.keywords(_METADATA_KEYWORDS, "META_STOP", "metadata")
-        metadata.update(values)
-        self.expect("META_STOP")
-        for keyword in _METADATA_MANDATORY:
-            if keyword not in metadata:
-                raise self.error(start_line, f"segment {index} has no {keyword}")
-        self.check_metadata(metadata, numbers)
-        scale = _SCALES[metadata["TIME_SYSTEM"].upper()]
-
-        self.expect("DATA_START")
-        metadata["DATA_COMMENT"] = self.comments()
-        line_numbers, epochs, rows = [], [], []
-        while (line := self.take("DATA_STOP"))[1] != "DATA_STOP":
-            number, text = line
-            fields = text.split()
-            if len(fields) != 8:
-                raise self.error(
-                    number,
-                    f"a {ATTITUDE_TYPE} line has 8 fields (EPOCH Q1 Q2 Q3 QC ANGVEL_X ANGVEL_Y "
-                    f"ANGVEL_Z, table 4-4), got {len(fields)}: {text!r}",
-                )
-            bad = [field for field in fields[1:] if not _NUMBER_READ.fullmatch(field)]
-            if bad:
-                raise self.error(number, f"{bad[0]!r} is not a number (§6.8.4)")
-            line_numbers.append(number)
-            epochs.append(fields[0])
-            rows.append([float(field) for field in fields[1:]])
-        if not rows:
-            raise self.error(line[0], f"segment {index} has no data lines")
-
-        times = self.epochs(epochs, line_numbers, scale)
-        bounds = {
-            keyword: self.epochs([metadata[keyword]], [numbers[keyword]], scale)
-            for keyword in ("START_TIME", "USEABLE_START_TIME", "USEABLE_STOP_TIME", "STOP_TIME")
-            if keyword in metadata
-        }
-        useable = self.check_bounds(times, line_numbers, bounds, numbers)
-        values_array = np.array(rows)
-        try:
-            segment = AemSegment(
-                times,
-                values_array[:, [3, 0, 1, 2]],  # (Q1, Q2, Q3, QC) -> our (w, x, y, z)
-                np.radians(values_array[:, 4:]),  # deg/s -> rad/s
-                tuple(metadata["COMMENT"]),
-            )
-        except InputError as exc:
-            raise self.error(start_line, f"segment {index}: {exc}") from None
-        return segment, metadata, useable, start_line
-
-    def check_metadata(self, metadata: dict[str, Any], numbers: dict[str, int]) -> None:
-        known = {
-            "ATTITUDE_TYPE": (ATTITUDE_TYPE,),
-            "REF_FRAME_A": REFERENCE_FRAMES,
-            "REF_FRAME_B": (BODY_FRAME,),
-            "ANGVEL_FRAME": (BODY_FRAME,),
-            "TIME_SYSTEM": tuple(_SCALES),
-        }
-        for keyword, allowed in known.items():
-            if metadata[keyword].upper() not in allowed:
-                raise self.error(
-                    numbers[keyword],
-                    f"{keyword} = {metadata[keyword]} is not read; this reader knows "
-                    f"{', '.join(allowed)}",
-                )
-        if "EULER_ROT_SEQ" in metadata:
-            raise self.error(
-                numbers["EULER_ROT_SEQ"], f"EULER_ROT_SEQ does not apply to {ATTITUDE_TYPE}"
-            )
-        if "INTERPOLATION_METHOD" in metadata and "INTERPOLATION_DEGREE" not in metadata:
-            raise self.error(
-                numbers["INTERPOLATION_METHOD"],
-                "INTERPOLATION_METHOD needs INTERPOLATION_DEGREE (table 4-3)",
-            )
-        degree = metadata.get("INTERPOLATION_DEGREE")
-        if degree is not None and not re.fullmatch(r"\+?\d+", degree):
-            raise self.error(
-                numbers["INTERPOLATION_DEGREE"],
-                f"INTERPOLATION_DEGREE must be an integer, got {degree!r}",
-            )
-
-    def epochs(self, texts: list[str], numbers: list[int], scale: str) -> Time:
-        """§6.8.9 calendar epochs in ``scale``, refusing any that astropy would reinterpret.
-
-        astropy reads ``00:00:60`` in TT, or an invented UTC leap second, as the next
-        minute, so each epoch is written back and compared with its text.
-        """
-        from astropy.time import Time
-
-        canonical = []
-        for text, number in zip(texts, numbers, strict=True):
-            match = _EPOCH_READ.fullmatch(text)
-            if match is None or (match.group(3) and scale != "utc"):
-                raise self.error(
-                    number,
-                    f"{text!r} is not a YYYY-MM-DDThh:mm:ss[.d] {scale.upper()} epoch with at most "
-                    f"{EPOCH_DECIMALS} decimals (§6.8.9)",
-                )
-            canonical.append(
-                f"{match.group(1)}.{(match.group(2) or '').ljust(EPOCH_DECIMALS, '0')}"
-            )
-        try:
-            with offline_time(), warnings.catch_warnings():
-                # The comparison below rejects these; the warning would only repeat it.
-                warnings.filterwarnings("ignore", message=".*time is after end of day")
-                times = Time(canonical, format="isot", scale=scale, precision=EPOCH_DECIMALS)
-                written = np.asarray(times.isot)
-        except ValueError as exc:
-            raise self.error(
-                numbers[0], f"cannot read the epochs from {texts[0]!r}: {exc}"
-            ) from None
-        mismatch = np.flatnonzero(written != np.asarray(canonical))
-        if mismatch.size:
-            i = int(mismatch[0])
-            raise self.error(
-                numbers[i],
-                f"{texts[i]!r} is not a valid {scale.upper()} epoch "
-                f"(astropy reads it as {written[i]})",
-            )
-        return times
-
-    def check_bounds(
-        self, times: Time, line_numbers: list[int], bounds: dict[str, Time], numbers: dict[str, int]
-    ) -> tuple[Time, Time]:
-        """Data inside START_TIME…STOP_TIME, the useable span inside that (table 4-3)."""
-        start, stop = bounds["START_TIME"], bounds["STOP_TIME"]
-        if _seconds(times[:1], start) < 0.0:
-            raise self.error(line_numbers[0], "the first epoch is before START_TIME")
-        if _seconds(stop, times[-1:]) < 0.0:
-            raise self.error(line_numbers[-1], "the last epoch is after STOP_TIME")
-        useable_start = bounds.get("USEABLE_START_TIME", start)
-        useable_stop = bounds.get("USEABLE_STOP_TIME", stop)
-        if _seconds(useable_start, start) < 0.0 or _seconds(stop, useable_stop) < 0.0:
-            raise self.error(
-                numbers.get("USEABLE_START_TIME", numbers.get("USEABLE_STOP_TIME")),
-                "the useable span is not inside START_TIME ... STOP_TIME",
-            )
-        if _seconds(useable_stop, useable_start) < 0.0:
-            raise self.error(
-                numbers["USEABLE_STOP_TIME"], "USEABLE_STOP_TIME is before USEABLE_START_TIME"
-            )
-        return useable_start, useable_stop
-
-
-def _seconds(later: Time, earlier: Time) -> float:
-    """TT seconds from the single epoch ``earlier`` to the single epoch ``later``."""
-    return float(np.ravel(tt_seconds(later, earlier))[0])
