@@ -7,7 +7,7 @@ The layers, each importing only the ones above it in this list (README "Layout")
 - ``attitude.spacecraft``, ``events``, ``scenario``, ``timescales``: the scenario layer
 - ``attitude.trajectory``, ``motion_analysis``: the propagated motion
 - ``attitude.ephemeris``, ``orbit``, ``eclipse``, ``pointing``, ``intervals``: pointing
-- ``attitude.exports``, ``aem``, ``plots``, ``report``: reports and exports
+- ``attitude.exports``, ``aem``, ``plots``, ``report_page``, ``report``: reports and exports
 - ``attitude.scenario_file``, ``cli``: scenario files and the command line
 
 The names below are importable from ``attitude`` directly; all but the solver and the
@@ -21,11 +21,23 @@ scalar first and say so.
 """
 
 from importlib import import_module
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from attitude.errors import AttitudeError, InertiaWarning, InputError
 from attitude.euler_solver import EulerSolver
 from attitude.version import __version__
+
+if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and IDEs
+    from attitude.aem import write_aem
+    from attitude.events import AngularImpulse, AttitudeReset, InertiaChange
+    from attitude.motion_analysis import analyze
+    from attitude.orbit import TleOrbit
+    from attitude.pointing import BodyVector, PointingSpec, compute_pointing
+    from attitude.report import produce
+    from attitude.scenario import InitialState, Scenario
+    from attitude.scenario_file import load_scenario
+    from attitude.spacecraft import Spacecraft
+    from attitude.trajectory import Trajectory, propagate
 
 _LAZY = {
     "Spacecraft": "attitude.spacecraft",
@@ -46,10 +58,39 @@ _LAZY = {
     "produce": "attitude.report",
 }
 
-__all__ = ["AttitudeError", "EulerSolver", "InertiaWarning", "InputError", "__version__", *_LAZY]
+# Spelled out (not built from _LAZY) so that linters and IDEs read it statically;
+# tests/test_layering.py checks that it, _LAZY and the TYPE_CHECKING imports agree.
+__all__ = [
+    "AngularImpulse",
+    "AttitudeError",
+    "AttitudeReset",
+    "BodyVector",
+    "EulerSolver",
+    "InertiaChange",
+    "InertiaWarning",
+    "InitialState",
+    "InputError",
+    "PointingSpec",
+    "Scenario",
+    "Spacecraft",
+    "TleOrbit",
+    "Trajectory",
+    "__version__",
+    "analyze",
+    "compute_pointing",
+    "load_scenario",
+    "produce",
+    "propagate",
+    "write_aem",
+]
 
 
 def __getattr__(name: str) -> Any:
     if name in _LAZY:
         return getattr(import_module(_LAZY[name]), name)
     raise AttributeError(f"module 'attitude' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    """The module's own names and the lazy ones, so that ``dir(attitude)`` shows the API."""
+    return sorted({*globals(), *_LAZY})

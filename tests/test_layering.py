@@ -83,3 +83,38 @@ def test_every_public_name_resolves_and_import_stays_light():
     code = f"import sys, attitude; print(sorted({heavy} & set(sys.modules)))"
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert run.stdout.strip() == "[]"
+
+
+def _readme_layout() -> list[list[str]]:
+    """The modules of each row of the README's "Layout" table, in order."""
+    import re
+
+    readme = (PACKAGE.parent / "README.md").read_text()
+    section = readme.split("\n## Layout\n", 1)[1].split("\n## ", 1)[0]
+    rows = [line for line in section.splitlines() if line.startswith("| ")][1:]  # no header
+    return [re.findall(r"`(\w+)\.py`", row.split("|")[2]) for row in rows]
+
+
+def test_readme_layout_table_matches_the_layers():
+    table = _readme_layout()
+    assert table, "README.md has no Layout table"
+    for index, (row, layer) in enumerate(zip(table, LAYERS, strict=False)):
+        assert sorted(row) == sorted(layer), f"README Layout row {index}: {row} vs LAYERS {layer}"
+    assert len(table) == len(LAYERS), f"README has {len(table)} layers, LAYERS {len(LAYERS)}"
+
+
+def test_lazy_names_are_declared_for_type_checkers_and_dir():
+    import attitude
+
+    init = PACKAGE / "__init__.py"
+    tree = ast.parse(init.read_text())
+    declared = {}  # name -> module, from the `if TYPE_CHECKING:` imports
+    for node in tree.body:
+        if isinstance(node, ast.If) and getattr(node.test, "id", None) == "TYPE_CHECKING":
+            for item in node.body:
+                assert isinstance(item, ast.ImportFrom)
+                declared.update({alias.name: item.module for alias in item.names})
+    assert declared == attitude._LAZY
+    eager = {"AttitudeError", "EulerSolver", "InertiaWarning", "InputError", "__version__"}
+    assert set(attitude.__all__) == eager | set(attitude._LAZY)
+    assert set(attitude.__all__) <= set(dir(attitude))
