@@ -23,7 +23,7 @@ if str(ROOT) not in sys.path:  # benchmarks/ is not installed: import it from th
     sys.path.insert(0, str(ROOT))
 
 from benchmarks import peer_basilisk, peer_orekit, reference  # noqa: E402
-from benchmarks.__main__ import main  # noqa: E402
+from benchmarks.__main__ import DATA, main, reference_code_hash  # noqa: E402
 from benchmarks.cases import CASES, delta2_over_G2  # noqa: E402
 
 QUARTER_TURN_Z = Rotation.from_rotvec([0.0, 0.0, np.pi / 2])  # body → inertial
@@ -116,3 +116,30 @@ def test_reference_reproduces_frb903_example():
 def test_case_three_is_at_the_requested_distance_from_the_separatrix():
     assert delta2_over_G2(CASES["near_separatrix_1h"]) == pytest.approx(-1e-10, rel=1e-6)
     assert delta2_over_G2(CASES["dzhanibekov_1h"]) > 0  # the two sides of the separatrix
+
+
+def test_cached_references_come_from_the_current_reference_code():
+    """benchmarks/data/*.npz are keyed on the code of benchmarks/reference.py: a change to
+    that code without regenerating them fails here (the runner would recompute them)."""
+    files = sorted(DATA.glob("reference_*.npz"))
+    assert files
+    for path in files:
+        meta = json.loads(str(np.load(path, allow_pickle=False)["meta"]))
+        assert meta["reference_code_sha256"] == reference_code_hash(), path.name
+
+
+def test_reference_code_hash_follows_the_code_not_the_prose(tmp_path):
+    source = Path(reference.__file__).read_text(encoding="utf-8")
+    assert "\nDPS = 40\n" in source
+    original = reference_code_hash(Path(reference.__file__))
+    prose = tmp_path / "prose.py"
+    prose.write_text(
+        source.replace('"""The independent', '"""Reworded: the independent', 1).replace(
+            "\nDPS = 40\n", "\n# a new comment\n\nDPS = 40  # and another\n", 1
+        ),
+        encoding="utf-8",
+    )
+    code = tmp_path / "code.py"
+    code.write_text(source.replace("\nDPS = 40\n", "\nDPS = 41\n", 1), encoding="utf-8")
+    assert reference_code_hash(prose) == original
+    assert reference_code_hash(code) != original
