@@ -18,14 +18,15 @@ Vectors are in the GCRS: ICRF axes, origin at the Earth's centre (or at the
 observer given), in metres, with shape ``times.shape + (3,)``.
 
 The Sun is given at its **apparent** place, what a Sun sensor measures (see
-:func:`sun_position_from_earth`).  Measured over 1900–2050 (research note
-``research-pointing.md`` §2.3, and ``tests/test_sun_against_astropy.py``):
+:func:`sun_position_from_earth`).  Measured over 1900–2050 (docs/pointing.md, "The
+Sun's direction: which place, which frame", with the published sources; and
+``tests/test_sun_against_astropy.py``):
 
 - light time (the Sun as it was ≈ 499 s earlier): shifts the direction by < 0.011";
 - annual aberration (the Earth's 30 km/s barycentric velocity): ≈ 20.5";
 - gravitational deflection: the Sun's deflection of its own light is zero by
   symmetry, and Jupiter's and Saturn's is < 1e-7" here, so it is not computed
-  (``deflectors=()``), which makes the call 2.7 times faster.
+  (``deflectors=()``), which makes the call about twice as fast.
 The result agrees with astropy's own ephemeris to 0.016".
 """
 

@@ -5,9 +5,13 @@ A float64 integrator cannot be the authority near the separatrix (DOP853 at rtol
 day) and mpmath's Taylor integrator would need ~11 h for a day.  So the reference is
 a *second* closed form, from a different derivation than the package's solver
 (Celledoni et al. with Leroy's corrections, preferred axes, Carlson kernels in
-float64): A. Jadczyk's formulas in
-``shared/references/jadczyk-attitude-matrix-and-quaternion-formulas.md``, evaluated
-with mpmath's ``ellipfun``, ``ellipk``, ``ellipf`` and ``ellippi`` at 40 digits.
+float64): A. Jadczyk's formulas, evaluated with mpmath's ``ellipfun``, ``ellipk``,
+``ellipf`` and ``ellippi`` at 40 digits.  They were published as blog posts (the
+"note" below): "Attitude matrix for m<1" (2017-03-07,
+http://arkadiusz-jadczyk.eu/blog/2017/03/07/), "The final answer for the Universe in
+which m<1" (2017-03-06, the quaternions, http://arkadiusz-jadczyk.eu/blog/2017/03/06/)
+and "Attitude matrix and quaternion path for m>1" (2017-03-22,
+http://arkadiusz-jadczyk.eu/blog/2017/03/attitude-matrix-quaternion-path-m1/).
 
 Jadczyk's setting: sorted moments I1 < I2 < I3, a unit angular momentum |L| = 1 and
 d = 2T/|L|².  We scale the problem to it: L = m/G, I'j = Ij/I2 and the dimensionless
@@ -24,7 +28,8 @@ time s = G t / I2, so that dL/ds = L × (I'⁻¹ L) and dq/ds = ½ q ⊗ (0, I'�
   q = (√((1+L3)/2) c, (L2 c + L1 s)/√(2(1+L3)), (L2 s − L1 c)/√(2(1+L3)), √((1+L3)/2) s).
 
 The sign of the arc tangent for m < 1 is that of the note's "Attitude matrix for m<1"
-post; its later quaternion post prints −arctan, which does not satisfy the kinematics:
+post; its quaternion post of the day before prints −arctan, which does not satisfy the
+kinematics:
 differentiating ψ against ψ' = d − (L2 L3' − L3 L2')/(1 + L1) (the rate about L left
 over by the minimal rotation L → e1) fixes it to +, and so do FRB 903's example and
 the odefun comparison below.
@@ -56,7 +61,8 @@ from numpy.typing import ArrayLike, NDArray
 DPS = 40
 
 # The FRB 903 example printed in the Jadczyk note ("Example Four"): a body → space
-# quaternion at t = 10, from the Fortran's quadrature option, good to about 8e-10.
+# quaternion at t = 10, from the Fortran's quadrature option (NP = 5), good to about
+# 8e-10 (ACM TOMS Algorithm 903, doi:10.1145/1731022.1731033).
 FRB903_INERTIA = (1.0, 1.012686988782515, 3.306237422473038)
 FRB903_MOMENTUM = (-0.544332842491675, 0.729131780907662, -0.414811526666455)
 FRB903_Q_AT_10 = (-0.3676198430772359, -0.6306293413288832, -0.6127232632258010, 0.3028737154869889)

@@ -157,7 +157,8 @@ def astropy_apparent_sun(times):
     The astrometric vector (light time, one iteration) from ``get_body_barycentric``,
     then astropy's ICRS→GCRS transform applied to it *as a direction*, so that astropy
     adds the aberration only (``get_body("sun")`` keeps the Sun's distance and then
-    applies a spurious self-deflection of up to 1.2"; see research-pointing.md §2.3).
+    applies a spurious self-deflection of several arcseconds; see docs/pointing.md, "The
+    Sun's direction: which place, which frame").
     """
     from astropy import units as u
     from astropy.constants import c as speed_of_light

@@ -1,19 +1,28 @@
 """EulerSolver against ACM TOMS Algorithm 903 (FRB, Celledoni and Zanna, 2010).
 
-The example quoted in shared/references/jadczyk-attitude-matrix-and-quaternion-formulas.md
-("Example Four"): I = (1, 1.012686988782515, 3.306237422473038),
+FRB: E. Celledoni, A. Zanna et al., "Algorithm 903: FRB–Fortran routines for the exact
+computation of free rigid body motions", ACM Trans. Math. Softw. 37(2), article 23
+(2010), doi:10.1145/1731022.1731033 (the code is CALGO 903).  The case is its fourth
+example as A. Jadczyk ran it and printed the Fortran's output: the quaternion in "The
+final answer for the Universe in which m<1" (http://arkadiusz-jadczyk.eu/blog/2017/03/06/),
+the matrix in "Attitude matrix for m<1" (http://arkadiusz-jadczyk.eu/blog/2017/03/07/).
+I = (1, 1.012686988782515, 3.306237422473038),
 m0 = (−0.544332842491675, 0.729131780907662, −0.414811526666455), identity attitude
 at t = 0, state at t = 10.
 
-Convention mapping (checked in shared/references/README.md against a rebuild of the
-Fortran): FRB's quaternion is scalar first and represents the body → space rotation
-(dq/dt = ½ q ⊗ (0, ω)): it is our ``attitude(t).as_quat(scalar_first=True)`` up to
-the sign of the whole quaternion.  The matrix printed in the reference is the
-transpose, Rᵀ, of our ``attitude(t).as_matrix()``.
+Convention mapping: FRB's quaternion is scalar first and represents the body → space
+rotation (dq/dt = ½ q ⊗ (0, ω)): it is our ``attitude(t).as_quat(scalar_first=True)``
+up to the sign of the whole quaternion.  The matrix the example prints ("transposed
+final Q") is the transpose, Rᵀ, of our ``attitude(t).as_matrix()``.  The tests below
+pin the mapping down: the printed numbers agree with ours only under it (R itself is
+0.1 away), and a 25-digit integration of Euler's equations and the kinematics,
+which knows nothing of FRB, agrees with the printed quaternion the same way.
 
-The Fortran was run with its quadrature option (NP = 5), not its exact elliptic
-integral, so its printed digits are good to about 1e-9 only: we reproduce them to
-1e-9, and check our own value to 1e-13 against a 25-digit mpmath integration.
+The Fortran ran with its quadrature option (NP = 5, the last line of the example's
+input, which the driver reads as the order of the method) rather than its exact elliptic
+integral of the third kind, so its printed digits are good to about 8e-10, not to all
+of them: we reproduce them to 1e-9, and check our own value to 1e-13 against the
+25-digit mpmath integration.
 """
 
 import numpy as np

@@ -1,14 +1,15 @@
 """The apparent Sun from DE421 (skyfield) against astropy's own ephemeris, 1900–2050.
 
 astropy's builtin ephemeris is ERFA's epv00 (VSOP2000-based), independent of JPL
-DE421.  The comparison follows research-pointing.md §2.3: the astrometric vector
-(light time, one iteration) from ``get_body_barycentric``, then astropy's ICRS→GCRS
-transform applied to it **as a direction** (a ``UnitSphericalRepresentation``), so
-that astropy adds the aberration only.  ``get_body("sun")`` itself is not used: it
-keeps the Sun's distance, and astropy then applies a spurious self-deflection of the
-Sun's light of up to 1.2" (its "Sun → object" vector is a ~6 km residual of random
-direction).  The pair agrees to 0.016" (research note, every 10 days); over the
-500 epochs here to 0.0143" (mean 0.0044"), and the distances to 3.5e-8 (5 km).
+DE421.  The comparison is the one docs/pointing.md describes ("The Sun's direction:
+which place, which frame"): the astrometric vector (light time, one iteration) from
+``get_body_barycentric``, then astropy's ICRS→GCRS transform applied to it **as a
+direction** (a ``UnitSphericalRepresentation``), so that astropy adds the aberration
+only.  ``get_body("sun")`` itself is not used: it keeps the Sun's distance, and astropy
+then deflects the Sun's light by the Sun along a "Sun → object" vector that is a
+few-km residual of arbitrary direction (erratic errors, up to 4.6" measured).  The
+pair agrees to 0.0156" every 10 days over 1900–2050; over the 500 epochs here to
+0.0143" (mean 0.0044"), and the distances to 3.5e-8 (5 km).
 """
 
 import numpy as np
