@@ -10,9 +10,10 @@ The layers, each importing only the ones above it in this list (README "Layout")
 - ``attitude.exports``, ``aem``, ``plots``, ``report``: reports and exports
 - ``attitude.scenario_file``, ``cli``: scenario files and the command line
 
-The names below are importable from ``attitude`` directly; all but the solver and the
-errors are loaded on first use, so that ``import attitude`` stays light (astropy,
-skyfield and matplotlib load only when needed).
+The names below are importable from ``attitude`` directly; all but the errors are
+loaded on first use, so that ``import attitude`` stays light (numpy, scipy, astropy,
+skyfield and matplotlib load only when needed), and the command line can install its
+signal handlers before anything heavy loads.
 
 Conventions: SI units (s, kg m², N m s, rad/s; astropy Quantities accepted at the
 public edge); an attitude is the ``scipy.spatial.transform.Rotation`` taking body
@@ -24,10 +25,10 @@ from importlib import import_module
 from typing import Any
 
 from attitude.errors import AttitudeError, InertiaWarning, InputError
-from attitude.euler_solver import EulerSolver
 from attitude.version import __version__
 
 _LAZY = {
+    "EulerSolver": "attitude.euler_solver",
     "Spacecraft": "attitude.spacecraft",
     "InitialState": "attitude.scenario",
     "Scenario": "attitude.scenario",
@@ -46,7 +47,7 @@ _LAZY = {
     "produce": "attitude.report",
 }
 
-__all__ = ["AttitudeError", "EulerSolver", "InertiaWarning", "InputError", "__version__", *_LAZY]
+__all__ = ["AttitudeError", "InertiaWarning", "InputError", "__version__", *_LAZY]
 
 
 def __getattr__(name: str) -> Any:
