@@ -17,8 +17,16 @@ LAYERS = [
     ["timescales", "spacecraft", "events", "scenario"],  # spacecraft, scenario and events
     ["trajectory", "motion_analysis"],  # trajectory
     ["ephemeris", "orbit", "eclipse", "pointing", "intervals"],  # pointing (skyfield)
-    ["exports", "aem", "plots", "report_page", "output_budget", "run_plan", "output_folder"],
-    ["report"],  # reports and exports
+    [  # reports and exports
+        "exports",
+        "aem",
+        "plots",
+        "report_page",
+        "output_budget",
+        "run_plan",
+        "output_folder",
+        "report",
+    ],
     ["scenario_file", "cli", "__main__"],  # command line
 ]
 
