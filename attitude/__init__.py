@@ -10,9 +10,10 @@ The layers, each importing only the ones above it in this list (README "Layout")
 - ``attitude.exports``, ``aem``, ``plots``, ``report_page``, ``report``: reports and exports
 - ``attitude.scenario_file``, ``cli``: scenario files and the command line
 
-The names below are importable from ``attitude`` directly; all but the solver and the
-errors are loaded on first use, so that ``import attitude`` stays light (astropy,
-skyfield and matplotlib load only when needed).
+The names below are importable from ``attitude`` directly; all but the errors are
+loaded on first use, so that ``import attitude`` stays light (numpy, scipy, astropy,
+skyfield and matplotlib load only when needed), and the command line can install its
+signal handlers before anything heavy loads.
 
 Conventions: SI units (s, kg m², N m s, rad/s; astropy Quantities accepted at the
 public edge); an attitude is the ``scipy.spatial.transform.Rotation`` taking body
@@ -24,11 +25,11 @@ from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
 from attitude.errors import AttitudeError, InertiaWarning, InputError
-from attitude.euler_solver import EulerSolver
 from attitude.version import __version__
 
 if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and IDEs
     from attitude.aem import write_aem
+    from attitude.euler_solver import EulerSolver
     from attitude.events import AngularImpulse, AttitudeReset, InertiaChange
     from attitude.motion_analysis import analyze
     from attitude.orbit import TleOrbit
@@ -40,6 +41,7 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.trajectory import Trajectory, propagate
 
 _LAZY = {
+    "EulerSolver": "attitude.euler_solver",
     "Spacecraft": "attitude.spacecraft",
     "InitialState": "attitude.scenario",
     "Scenario": "attitude.scenario",

@@ -115,7 +115,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from attitude.errors import InputError
-from attitude.timescales import as_time, offline_time, tt_seconds
+from attitude.timescales import as_time, iso_texts, offline_time, tt_seconds
 
 if TYPE_CHECKING:
     from astropy.time import Time
@@ -445,7 +445,7 @@ def _epoch_strings(times: Time, time_system: str, name: str) -> NDArray[np.str_]
         # A new Time, so that setting the precision leaves the caller's object alone
         # (``t.utc`` is ``t`` itself when t is already UTC).
         epochs = np.asarray(
-            Time(getattr(times, _SCALES[time_system]), precision=EPOCH_DECIMALS).isot
+            iso_texts(Time(getattr(times, _SCALES[time_system]), precision=EPOCH_DECIMALS))
         )
     # The times increase, so the first and last epochs bound the years.
     for epoch in (epochs[0], epochs[-1]):

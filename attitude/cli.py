@@ -1,81 +1,233 @@
-"""The command line: ``attitude run`` and ``attitude check``.
+"""The command line: ``attitude run`` and ``attitude check`` (also ``python -m attitude``).
 
     attitude run SCENARIO.toml --out DIR   propagate, write the outputs into DIR
-    attitude check SCENARIO.toml           validate the file and describe it
+    attitude check SCENARIO.toml           validate the file and describe the run
 
-Exit status: 0 on success, 2 for a bad scenario file (one message naming the file,
-the key and the value), 1 when the outputs cannot be written.
+``check`` goes through the same checks as ``run`` up to the sampling
+(``attitude.run_plan``): what ``check`` accepts, ``run`` computes.  ``--out`` given to
+``check`` also checks the folder and its free space.
+
+The output folder (``attitude.output_folder``): ``run`` writes into a new or empty
+folder, or one it wrote before, where it replaces only its own previous outputs; it
+never removes or overwrites a file it did not write.
+
+Exit status, with one line on stderr and never a traceback:
+0 success; 2 a bad scenario file, a run that cannot fit, or an output folder that is
+not ours (the line names the file, the key and the value); 1 the outputs cannot be
+written (a full disk, a folder we may not write); 130 interrupted (Ctrl-C), 143
+terminated (SIGTERM), 129 hung up (SIGHUP), and nothing of the run is left behind;
+3 a bug (an exception this tool did not expect; ``ATTITUDE_TRACEBACK=1`` shows its
+traceback).  Warnings are one line each, ``attitude: warning: FILE: KEY: ...``, and so
+are notes (``attitude: note: ...``: a clamped precision, a far TLE epoch).
+
+This module imports the package only inside :func:`main`, after the signal handlers
+are installed, so that even a Ctrl-C while numpy loads ends with one line.
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import signal
 import sys
+import threading
 from pathlib import Path
-
-from attitude.errors import InputError
-from attitude.report import Progress, produce
-from attitude.scenario_file import load_scenario
-from attitude.trajectory import propagate
-from attitude.version import __version__
 
 __all__ = ["main"]
 
+_SIGNAL_EXIT = {signal.SIGINT: 130, signal.SIGTERM: 143}
+if hasattr(signal, "SIGHUP"):
+    _SIGNAL_EXIT[signal.SIGHUP] = 129
+_SIGNAL_TEXT = {130: "interrupted", 143: "terminated", 129: "hung up"}
 
-def _describe(path: Path) -> str:
-    loaded = load_scenario(path)
+
+class _Stopped(BaseException):
+    """A signal asked the run to stop (raised by the handler, like KeyboardInterrupt)."""
+
+    def __init__(self, number: int) -> None:
+        super().__init__(number)
+        self.number = number
+
+
+def _raise_stopped(number: int, frame) -> None:
+    raise _Stopped(number)
+
+
+def _one_line(text: str) -> str:
+    return " / ".join(line.strip() for line in str(text).splitlines() if line.strip())
+
+
+def _error(message: str) -> None:
+    print(f"attitude: error: {_one_line(message)}", file=sys.stderr, flush=True)
+
+
+def _parser() -> argparse.ArgumentParser:
+    from attitude.version import __version__
+
+    parser = argparse.ArgumentParser(prog="attitude", description="Exact spacecraft attitude.")
+    parser.add_argument("-V", "--version", action="version", version=f"attitude {__version__}")
+    commands = parser.add_subparsers(dest="command", required=True)
+    run = commands.add_parser("run", help="propagate a scenario and write its outputs")
+    run.add_argument("scenario", type=Path, help="scenario file (TOML)")
+    run.add_argument(
+        "--out",
+        type=Path,
+        required=True,
+        help="output folder: new, empty, or written by attitude before (only its own "
+        "files are replaced; a folder holding other files is refused)",
+    )
+    run.add_argument("--quiet", action="store_true", help="no progress messages")
+    check = commands.add_parser("check", help="validate a scenario file and describe the run")
+    check.add_argument("scenario", type=Path, help="scenario file (TOML)")
+    check.add_argument("--out", type=Path, help="also check this output folder and its free space")
+    return parser
+
+
+def _describe(loaded, plan) -> str:
+    """What ``attitude check`` prints: the run as it will be done."""
+    import math
+
+    import numpy as np
+
     scenario = loaded.scenario
     craft = scenario.spacecraft
-    solver = propagate(scenario).segments[0].solver
     lines = [
-        f"{path}: OK",
+        f"{loaded.path}: OK",
         f"  scenario    {scenario.name}",
         f"  epoch       {scenario.format_epoch(0.0)}",
-        f"  span        {scenario.stop_s:g} s, output every {scenario.step_s:g} s from "
-        f"{scenario.format_epoch(scenario.start_s)} ({scenario.output_seconds().size} samples)",
+        f"  span        {scenario.stop_s:.12g} s, to {scenario.format_epoch(scenario.stop_s)}",
+        f"  output      every {scenario.step_s:.12g} s from "
+        f"{scenario.format_epoch(scenario.start_s)}",
+        f"  outputs     {plan.budget.describe()}",
         f"  spacecraft  {craft.name}, principal moments {craft.principal_moments.tolist()} kg m²",
-        f"  motion      formula {solver.formula}, period {solver.period:.6g} s at the epoch",
-        f"  events      {len(scenario.events)}",
     ]
+    initial = scenario.initial_state
+    if initial.angular_velocity is not None:
+        lines.append(
+            "  rate        "
+            f"{np.degrees(initial.angular_velocity).tolist()} deg/s (body, at the epoch)"
+        )
+    for index, item in enumerate(plan.motion):
+        period = "" if math.isinf(item.period_s) else f", body period {item.period_s:.6g} s"
+        flips = f", {item.flip_count} flips" if item.flip_count else ""
+        lines.append(
+            f"  segment {index}   from {scenario.format_epoch(item.start_s)}: {item.motion} "
+            f"(formula {item.formula}{period}{flips})"
+        )
+    lines.append(f"  events      {len(scenario.events)}")
     lines += [
-        f"    {scenario.format_epoch(t)}  {event.kind}{f' ({event.label})' if event.label else ''}"
+        f"    {scenario.format_epoch(t)} (+{t:.12g} s)  {event.kind}"
+        f"{f' ({event.label})' if event.label else ''}"
         for t, event in scenario.events
     ]
     spec = loaded.pointing
     if not spec.is_empty:
         lines.append(
             f"  pointing    {len(spec.body_vectors)} body vectors, orbit: "
-            f"{'TLE' if spec.tle else 'Earth centre'}"
+            f"{'TLE' if spec.tle else 'Earth centre'}, interval ends to "
+            f"{spec.interval_precision_s:g} s"
         )
+        for vector in spec.body_vectors:
+            half = vector.sun_exclusion_half_angle_deg
+            lines.append(
+                f"    {vector.name}: {vector.kind}, {vector.vector.tolist()} (body)"
+                + ("" if half is None else f", Sun exclusion half angle {half:.12g} deg")
+            )
+    lines += [f"  note        {note}" for note in plan.notes]
     return "\n".join(lines)
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="attitude", description="Exact spacecraft attitude.")
-    parser.add_argument("--version", action="version", version=f"attitude {__version__}")
-    commands = parser.add_subparsers(dest="command", required=True)
-    run = commands.add_parser("run", help="propagate a scenario and write its outputs")
-    run.add_argument("scenario", type=Path, help="scenario file (TOML)")
-    run.add_argument("--out", type=Path, required=True, help="output folder (replaced)")
-    run.add_argument("--quiet", action="store_true", help="no progress messages")
-    check = commands.add_parser("check", help="validate a scenario file")
-    check.add_argument("scenario", type=Path, help="scenario file (TOML)")
-    args = parser.parse_args(argv)
+def _run(args, state: dict) -> int:
+    """``run`` or ``check``, with every warning shown as one line naming the file."""
+    import warnings
+
+    def show_warning(message, category, filename, lineno, file=None, line=None):
+        text = _one_line(str(message))
+        name = state.get("file")
+        if name and not text.startswith(f"{name}:"):
+            text = f"{name}: {text}"
+        print(f"attitude: warning: {text}", file=sys.stderr, flush=True)
+
+    with warnings.catch_warnings():
+        warnings.showwarning = show_warning
+        return _checked_run(args, state)
+
+
+def _checked_run(args, state: dict) -> int:
+    from attitude.errors import InputError
+    from attitude.output_budget import check_fits
+    from attitude.output_folder import OutputFolderError, claim
+    from attitude.report import OUTPUT_NAMES, Progress, produce
+    from attitude.run_plan import plan_run
+    from attitude.scenario_file import ScenarioFileError, load_scenario
 
     try:
-        if args.command == "check":
-            print(_describe(args.scenario))
-            return 0
-        progress = Progress(None if args.quiet else lambda line: print(line, file=sys.stderr))
         loaded = load_scenario(args.scenario)
-        produce(loaded.scenario, args.out, loaded.pointing, loaded.path.name, progress)
+        state["file"] = loaded.path.name
+        plan = plan_run(loaded.scenario, loaded.pointing)
+        if args.command == "check":
+            if args.out is not None:
+                check_fits(plan.budget, args.out)
+                claim(args.out, OUTPUT_NAMES, dry_run=True)
+            print(_describe(loaded, plan), flush=True)
+            return 0
+        claim(args.out, OUTPUT_NAMES, dry_run=True)  # a folder that is not ours: say so first
+        for note in plan.notes:
+            print(f"attitude: note: {loaded.path.name}: {note}", file=sys.stderr, flush=True)
+        progress = Progress(None if args.quiet else lambda line: print(line, file=sys.stderr))
+        produce(loaded.scenario, args.out, loaded.pointing, loaded.path.name, progress, plan)
         return 0
-    except InputError as exc:
-        print(f"attitude: error: {exc}", file=sys.stderr)
+    except (ScenarioFileError, OutputFolderError) as exc:
+        _error(str(exc))
         return 2
-    except OSError as exc:  # the file system: a full disk, a folder we cannot write
-        print(f"attitude: error: {exc}", file=sys.stderr)
+    except InputError as exc:
+        name = state.get("file") or args.scenario.name
+        _error(f"{name}: {exc}")
+        return 2
+    except MemoryError:
+        _error(f"{args.scenario.name}: out of memory: use a longer output.step or a shorter span")
         return 1
+    except BrokenPipeError:
+        raise  # stdout closed by the reader: see main
+    except OSError as exc:  # the file system: a full disk, a folder we cannot write
+        where = f" ({exc.filename})" if getattr(exc, "filename", None) else ""
+        _error(f"{exc.strerror or exc}{where}")
+        return 1
+
+
+def main(argv: list[str] | None = None) -> int:
+    state: dict = {}
+    previous = {}
+    in_main_thread = threading.current_thread() is threading.main_thread()
+    try:
+        if in_main_thread:
+            for number in _SIGNAL_EXIT:
+                if number != signal.SIGINT:
+                    previous[number] = signal.signal(number, _raise_stopped)
+        args = _parser().parse_args(argv)
+        return _run(args, state)
+    except KeyboardInterrupt:
+        _error("interrupted; nothing of this run was left behind")
+        return 130
+    except _Stopped as stop:
+        code = _SIGNAL_EXIT[stop.number]
+        _error(f"{_SIGNAL_TEXT[code]}; nothing of this run was left behind")
+        return code
+    except BrokenPipeError:  # `attitude check x | head -1`
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 0
+    except Exception as exc:  # a bug: one line, and the traceback on request
+        if os.environ.get("ATTITUDE_TRACEBACK"):
+            raise
+        _error(
+            f"internal error: {type(exc).__name__}: {exc} (a bug: please report it; "
+            "ATTITUDE_TRACEBACK=1 shows the traceback)"
+        )
+        return 3
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
 
 
 if __name__ == "__main__":

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from attitude.intervals import Interval, total_duration
-from attitude.motion_analysis import SegmentMotion
+from attitude.motion_analysis import LISTED_FLIPS, SegmentMotion
 from attitude.pointing import PointingResult
 from attitude.trajectory import Trajectory
 
@@ -29,6 +29,7 @@ __all__ = [
     "motion_summary",
     "pointing_columns",
     "pointing_summary",
+    "right_ascension_deg",
     "sample",
     "to_json",
     "trajectory_columns",
@@ -172,6 +173,34 @@ def write_json(path: Path, data: dict[str, Any]) -> None:
     )
 
 
+_MOTION_TEXT = {
+    "periodic": "periodic: m(t) repeats every body period",
+    "steady spin": "steady spin: m is fixed in the body and the body turns about it; "
+    "no period of m, no flips, no nutation",
+    "separatrix": "separatrix: no period; m leaves the intermediate axis and returns to it "
+    "asymptotically, so the body turns over at most once",
+    "rest": "at rest: no motion",
+}
+
+
+def _flips_summary(scenario, motion: list[SegmentMotion]) -> dict[str, Any]:
+    """All flips: their count, and their times up to LISTED_FLIPS (an event's epoch can
+    end one segment and start the next with the same flip: it counts once)."""
+    listed = np.concatenate([item.flip_times_s for item in motion]) if motion else np.empty(0)
+    listed, repeated = np.unique(listed, return_counts=True)
+    count = sum(item.flip_count for item in motion) - int(np.sum(repeated - 1))
+    listed = listed[:LISTED_FLIPS]
+    complete = listed.size == count
+    return {
+        "count": count,
+        "times_s": listed,
+        "times": [scenario.format_epoch(t) for t in listed[:1000]],
+        "note": None
+        if complete
+        else f"times_s lists the first {listed.size} of {count} flips (closed form)",
+    }
+
+
 def motion_summary(trajectory: Trajectory, motion: list[SegmentMotion]) -> dict[str, Any]:
     """The JSON summary of the motion: segments, events, flips, precession, nutation."""
     scenario = trajectory.scenario
@@ -188,9 +217,11 @@ def motion_summary(trajectory: Trajectory, motion: list[SegmentMotion]) -> dict[
                 if event is None
                 else {"type": event.kind, "label": event.label or None},
                 "formula": item.formula,
+                "motion": item.motion,
+                "motion_description": _MOTION_TEXT[item.motion],
                 "body_period_s": item.period_s,
                 "flip_period_s": item.flip_period_s,
-                "flip_count": int(item.flip_times_s.size),
+                "flip_count": item.flip_count,
                 "spin_axis_body": item.spin_axis_body,
                 "nutation_angle_min_deg": None
                 if item.nutation_min_rad is None
@@ -203,20 +234,10 @@ def motion_summary(trajectory: Trajectory, motion: list[SegmentMotion]) -> dict[
                 "precession_period_s": item.precession_period_s,
                 "kinetic_energy_J": item.kinetic_energy_J,
                 "angular_momentum_icrf_N_m_s": item.inertial_angular_momentum_N_m_s,
-                "angular_momentum_norm_N_m_s": float(
-                    np.linalg.norm(item.inertial_angular_momentum_N_m_s)
-                ),
+                "angular_momentum_norm_N_m_s": item.angular_momentum_norm_N_m_s,
             }
         )
-    flips = trajectory.flip_times()
-    return {
-        "segments": segments,
-        "flips": {
-            "count": int(flips.size),
-            "times_s": flips,
-            "times": [scenario.format_epoch(t) for t in flips[:1000]],
-        },
-    }
+    return {"segments": segments, "flips": _flips_summary(scenario, motion)}
 
 
 def extremum(
@@ -234,6 +255,13 @@ def extremum(
             if abs(shift) < 1.0:
                 return float(seconds[k] + shift * h), float(y1 - 0.25 * (y0 - y2) * shift)
     return float(seconds[k]), float(values[k])
+
+
+def right_ascension_deg(radians: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Right ascensions in degrees, in [0, 360): an angle a hair below 2π rounds to
+    360.0 in degrees, which is written as 0."""
+    degrees = np.mod(np.degrees(radians), 360.0)
+    return np.where(degrees >= 360.0, 0.0, degrees)
 
 
 def pointing_columns(result: PointingResult) -> list[Column]:
@@ -277,7 +305,7 @@ def pointing_columns(result: PointingResult) -> list[Column]:
         columns.append(
             Column(
                 f"{name}_ra_deg",
-                np.degrees(item.right_ascension_rad),
+                right_ascension_deg(item.right_ascension_rad),
                 f"{name} right ascension, deg",
             )
         )
@@ -351,9 +379,7 @@ def pointing_summary(result: PointingResult, format_epoch) -> dict[str, Any]:
             "mean_cos_incidence": float(np.mean(item.cos_incidence)),
         }
         if item.vector.sun_exclusion_half_angle_rad is not None:
-            entry["sun_exclusion_half_angle_deg"] = math.degrees(
-                item.vector.sun_exclusion_half_angle_rad
-            )
+            entry["sun_exclusion_half_angle_deg"] = item.vector.sun_exclusion_half_angle_deg
             entry["violations"] = _interval_totals(item.violations)
             entry["violations"]["first"] = [
                 {

@@ -53,6 +53,8 @@ def _refine(
     a, b = a.copy(), b.copy()
     while a.size and np.max(b - a) > precision_s:
         mid = 0.5 * (a + b)
+        if np.all((mid == a) | (mid == b)):
+            break  # the brackets are one float wide: no finer time exists
         same_as_a = (f(mid) > 0.0) == inside_at_a
         a = np.where(same_as_a, mid, a)
         b = np.where(same_as_a, b, mid)

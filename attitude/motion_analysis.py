@@ -17,6 +17,19 @@ For each segment of torque-free motion:
   for a steady spin, whose spin axis lies along H.
 Mean rates are measured on the closed-form attitude over one period T of m(t),
 after which the body's orientation relative to H repeats up to a rotation about H.
+
+Segments without a period are stated as what they are (``SegmentMotion.motion``):
+
+- ``"steady spin"``: m is fixed in the body (a sphere, a spin exactly about a
+  principal axis, the intermediate one included, or m in the plane of two equal
+  moments), so ω ∥ m and the body turns about H at |ω| = 2T/G: the spin period is
+  2π/|ω|, and there are no flips, no nutation, no precession;
+- ``"separatrix"``: m on the separatrix (Δ2 = 0) but not at the intermediate axis:
+  no period; m leaves the intermediate axis and returns to it asymptotically, so the
+  body turns over at most once (at u = 0) and nothing repeats;
+- ``"rest"``: G = 0.
+Flips are counted from the closed form without listing them all: at most
+:data:`LISTED_FLIPS` flip times are kept (a day of a fast tumbler has millions).
 """
 
 from __future__ import annotations
@@ -30,12 +43,14 @@ from numpy.typing import NDArray
 from attitude.trajectory import Segment, Trajectory
 from attitude.vectors import basis_across
 
-__all__ = ["SegmentMotion", "analyze"]
+__all__ = ["LISTED_FLIPS", "SegmentMotion", "analyze"]
 
 # Sampling of one body period for the mean precession rate: enough points per turn
 # of the spin axis that the unwrapped azimuth cannot skip a turn.
 _SAMPLES_PER_TURN = 32
 _MAX_SAMPLES = 1_000_000
+# The flip times kept per segment; beyond, flips are counted, not listed.
+LISTED_FLIPS = 10_000
 
 
 @dataclass(frozen=True)
@@ -45,8 +60,10 @@ class SegmentMotion:
     start_s: float
     end_s: float
     formula: str
-    period_s: float
-    flip_times_s: NDArray[np.float64]
+    motion: str  # "periodic", "steady spin", "separatrix" or "rest"
+    period_s: float  # inf when the motion has no period
+    flip_count: int
+    flip_times_s: NDArray[np.float64]  # the first LISTED_FLIPS of them
     flip_period_s: float | None
     spin_axis_body: NDArray[np.float64] | None
     nutation_min_rad: float | None
@@ -56,6 +73,7 @@ class SegmentMotion:
     precession_period_s: float | None
     kinetic_energy_J: float
     inertial_angular_momentum_N_m_s: NDArray[np.float64]
+    angular_momentum_norm_N_m_s: float  # G, with no overflow of the squares
 
 
 def _mean_period_about_momentum(segment: Segment, axis_body: NDArray[np.float64]) -> float:
@@ -74,16 +92,72 @@ def _mean_period_about_momentum(segment: Segment, axis_body: NDArray[np.float64]
     return math.inf if advance == 0.0 else 2.0 * math.pi * period / advance
 
 
+def _is_steady(segment: Segment) -> bool:
+    """True if m is fixed in the body: ω = I⁻¹m is parallel to m (then dm/dt = m × ω = 0
+    and m stays), tested exactly in principal axes, as the solver sees the state."""
+    solver = segment.solver
+    if solver.formula == "steady":
+        return True
+    if solver.formula == "rest":
+        return False
+    axes = segment.state.inertia
+    m = segment.state.angular_momentum
+    if not axes.is_diagonal:
+        m = axes.body_to_principal.apply(m)
+    ω = m / axes.moments
+    return not np.any(np.cross(m, ω))
+
+
+def _steady_spin_period(segment: Segment) -> float | None:
+    """2π/|ω| for a steady spin (ω = I⁻¹m ∥ m: the body turns about H at |ω| = 2T/G),
+    with m scaled first so that neither |m|² nor T can underflow or overflow; None if
+    |ω| is below the float range (m of 1e-300 N m s)."""
+    m = segment.state.angular_momentum
+    scale = float(np.max(np.abs(m)))
+    ω = np.linalg.solve(segment.state.inertia.tensor, m / scale)
+    rate = scale * float(np.linalg.norm(ω))
+    return 2.0 * math.pi / rate if rate > 0.0 and math.isfinite(2.0 * math.pi / rate) else None
+
+
+def _flips(segment: Segment) -> tuple[int, NDArray[np.float64], float | None]:
+    """(count, the first LISTED_FLIPS flip times, flip period) over the segment.
+
+    In cases (i) and (ii) the flips come every half period T/2 when the body turns
+    over; their number over a long segment is counted from the first one, not by
+    listing them (the solver's ``flip_times`` lists every one).
+    """
+    solver = segment.solver
+    start, end = segment.start_s, segment.end_s
+    if solver.formula not in ("i", "ii"):
+        flips = solver.flip_times(start, end)  # the separatrix: at most one
+        return int(flips.size), flips, None
+    half = solver.period / 2.0
+    first = solver.flip_times(solver.t0, solver.t0 + solver.period)
+    if first.size == 0:
+        return 0, np.empty(0), None  # m2 changes sign in a nutation, not a flip
+    if (end - start) / half < LISTED_FLIPS:
+        flips = solver.flip_times(start, end)
+        return int(flips.size), flips, half
+    # Flips at first[0] + j T/2 for every integer j: count those in [start, end].
+    count = math.floor((end - first[0]) / half) - math.ceil((start - first[0]) / half) + 1
+    listed = solver.flip_times(start, start + (LISTED_FLIPS - 0.5) * half)
+    return count, listed[:LISTED_FLIPS], half
+
+
 def _segment_motion(segment: Segment) -> SegmentMotion:
     solver = segment.solver
-    flips = solver.flip_times(segment.start_s, segment.end_s)
-    turns_over = solver.flip_times(solver.t0, solver.t0 + solver.period).size > 0
-    cone = solver.spin_axis_cone()
+    count, flips, flip_period = _flips(segment)
     axis = nutation_min = nutation_max = nutation_period = spin = precession = None
+    steady = solver.formula == "steady" or _is_steady(segment)
+    if steady:
+        count, flips, flip_period = 0, np.empty(0), None
+        spin = _steady_spin_period(segment)
+    cone = solver.spin_axis_cone()
     if cone is not None:
         axis, nutation_min, nutation_max = cone
-        # A body axis across the spin axis, for the rotation about H.
-        spin = _mean_period_about_momentum(segment, basis_across(axis)[0])
+        if not steady:
+            # A body axis across the spin axis, for the rotation about H.
+            spin = _mean_period_about_momentum(segment, basis_across(axis)[0])
         if nutation_max > 0.0:  # else a steady spin: the spin axis lies along H
             nutation_period = solver.period / 2.0
             moments = np.sort(solver.moments_of_inertia)
@@ -91,13 +165,23 @@ def _segment_motion(segment: Segment) -> SegmentMotion:
                 precession = 2.0 * math.pi * moments[1] / solver.angular_momentum_norm
             else:
                 precession = _mean_period_about_momentum(segment, axis)
+    if solver.formula == "rest":
+        motion = "rest"
+    elif steady or (cone is not None and nutation_max == 0.0):
+        motion = "steady spin"
+    elif solver.formula == "iii":
+        motion = "separatrix"
+    else:
+        motion = "periodic"
     return SegmentMotion(
         start_s=segment.start_s,
         end_s=segment.end_s,
         formula=solver.formula,
-        period_s=solver.period,
+        motion=motion,
+        period_s=solver.period if motion == "periodic" else math.inf,
+        flip_count=count,
         flip_times_s=flips,
-        flip_period_s=solver.period / 2.0 if turns_over else None,
+        flip_period_s=flip_period,
         spin_axis_body=axis,
         nutation_min_rad=nutation_min,
         nutation_max_rad=nutation_max,
@@ -106,6 +190,7 @@ def _segment_motion(segment: Segment) -> SegmentMotion:
         precession_period_s=precession,
         kinetic_energy_J=solver.kinetic_energy,
         inertial_angular_momentum_N_m_s=solver.inertial_angular_momentum,
+        angular_momentum_norm_N_m_s=solver.angular_momentum_norm,
     )
 
 

@@ -122,6 +122,25 @@ class TleOrbit:
         shape = (*times.shape, 3)
         return position_m.reshape(shape), velocity_m_s.reshape(shape)
 
+    def sgp4_failure(self, times: Any) -> str | None:
+        """Why SGP4 fails at the first of ``times`` where it does (e.g. the satellite
+        has decayed by then), or None: a check of a whole span at SGP4's own cost
+        (about a microsecond an epoch), without the rotation to the GCRS."""
+        times = as_time(times, name="times")
+        with offline_time():
+            utc = times.utc
+            jd1, jd2 = np.ravel(utc.jd1), np.ravel(utc.jd2)
+        errors, _, _ = self.satellite.model.sgp4_array(jd1, jd2)
+        failed = np.flatnonzero(errors)
+        if failed.size == 0:
+            return None
+        from sgp4.api import SGP4_ERRORS
+
+        index = int(failed[0])
+        with offline_time():
+            when = times.ravel()[index].utc.isot if times.ndim else times.utc.isot
+        return f"SGP4 fails from {when} UTC on: {SGP4_ERRORS[int(errors[index])]}"
+
     def _sgp4(self, jd1, jd2) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """skyfield's GCRS position and velocity at TT (jd1, jd2), as (n, 3) arrays."""
         at = self.satellite.at(timescale().tt_jd(jd1, jd2))

@@ -182,7 +182,19 @@ def plot_polhode(
     sphere.plot_wireframe(
         np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v), color="0.85", linewidth=0.5
     )
-    direction = h_body / np.linalg.norm(h_body, axis=1, keepdims=True)
+    # Directions only where there is momentum (none at rest), scaled first so that no
+    # square overflows (|h| of 1e160 is a valid state).
+    scale = np.max(np.abs(h_body), axis=1, keepdims=True)
+    moving = scale[:, 0] > 0.0
+    if not np.any(moving):
+        flat.text(0.5, 0.5, "at rest: no angular momentum", ha="center", va="center")
+        flat.set_axis_off()
+        sphere.set_axis_off()
+        figure.suptitle(title or "Angular momentum direction in body axes (polhode)")
+        return _save(figure, path)
+    segments = segments[moving]
+    direction = h_body[moving] / scale[moving]
+    direction /= np.linalg.norm(direction, axis=1, keepdims=True)
     mean = np.mean(direction, axis=0)
     mean = mean / np.linalg.norm(mean) if np.linalg.norm(mean) > 1e-6 else direction[0]
     e1, e2 = basis_across(mean)

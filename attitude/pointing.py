@@ -32,16 +32,32 @@ from numpy.typing import NDArray
 from scipy.interpolate import CubicHermiteSpline, CubicSpline
 
 from attitude.eclipse import eclipse_intervals, sunlit_fraction
-from attitude.ephemeris import sun_position_from_earth, sun_position_from_observer
+from attitude.ephemeris import (
+    skyfield_times,
+    sun_position_from_earth,
+    sun_position_from_observer,
+)
 from attitude.errors import InputError
 from attitude.intervals import Interval, difference, find_intervals
 from attitude.orbit import EARTH_EQUATORIAL_RADIUS_M, TleOrbit
-from attitude.quantities import as_vector3
+from attitude.quantities import as_si_scalar, as_vector3
 from attitude.timescales import tt_seconds
 from attitude.trajectory import Trajectory
 from attitude.vectors import angle_between
 
-__all__ = ["BodyVector", "Geometry", "PointingResult", "PointingSpec", "compute_pointing"]
+__all__ = [
+    "TLE_NOTED_AFTER_DAYS",
+    "TLE_REFUSED_AFTER_DAYS",
+    "BodyVector",
+    "Geometry",
+    "PointingResult",
+    "PointingSpec",
+    "check_pointing",
+    "compute_pointing",
+    "interval_precision",
+    "node_seconds",
+    "search_grid_count",
+]
 
 KINDS = ("panel", "instrument", "star_tracker", "other")
 
@@ -53,13 +69,16 @@ class BodyVector:
     ``sun_exclusion_half_angle_rad``: the Sun must stay outside this cone about the
     vector (a star tracker or a sensitive instrument); None for no constraint.
     ``kind``: 'panel' (its Sun incidence is reported), 'instrument', 'star_tracker'
-    or 'other'.
+    or 'other'.  ``sun_exclusion_half_angle_deg``: the same angle in degrees, as the
+    user wrote it (30, not degrees(radians(30)) = 29.999999999999996), for the
+    reports; computed from the radians when not given.
     """
 
     name: str
     vector: NDArray[np.float64]
     sun_exclusion_half_angle_rad: float | None = None
     kind: str = "other"
+    sun_exclusion_half_angle_deg: float | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", self.name):
@@ -67,7 +86,7 @@ class BodyVector:
                 f"body vector name must be letters, digits and _ (it names CSV columns), "
                 f"got {self.name!r}"
             )
-        vector = as_vector3(self.vector, "angle", f"body vector {self.name!r}")
+        vector = as_vector3(self.vector, "dimensionless", f"body vector {self.name!r}")
         norm = np.linalg.norm(vector)
         if not norm > 0.0:
             raise InputError(f"body vector {self.name!r} must be non-zero, got {vector.tolist()}")
@@ -75,6 +94,22 @@ class BodyVector:
         if self.kind not in KINDS:
             raise InputError(
                 f"body vector {self.name!r}: kind must be one of {KINDS}, got {self.kind!r}"
+            )
+        half = self.sun_exclusion_half_angle_rad
+        if half is not None:
+            half = as_si_scalar(half, "angle", f"body vector {self.name!r} exclusion half angle")
+            if not 0.0 < half < math.pi:
+                raise InputError(
+                    f"body vector {self.name!r}: sun exclusion half angle must be between "
+                    f"0 and 180 deg, got {math.degrees(half):g} deg"
+                )
+            object.__setattr__(self, "sun_exclusion_half_angle_rad", half)
+            if self.sun_exclusion_half_angle_deg is None:
+                object.__setattr__(self, "sun_exclusion_half_angle_deg", math.degrees(half))
+        elif self.sun_exclusion_half_angle_deg is not None:
+            raise InputError(
+                f"body vector {self.name!r}: sun_exclusion_half_angle_deg without the angle "
+                "in radians"
             )
 
 
@@ -108,9 +143,7 @@ class PointingSpec:
                     "name": v.name,
                     "vector_body": v.vector.tolist(),
                     "kind": v.kind,
-                    "sun_exclusion_half_angle_deg": None
-                    if v.sun_exclusion_half_angle_rad is None
-                    else float(np.degrees(v.sun_exclusion_half_angle_rad)),
+                    "sun_exclusion_half_angle_deg": v.sun_exclusion_half_angle_deg,
                 }
                 for v in self.body_vectors
             ],
@@ -127,6 +160,108 @@ _SUN_NODE_STEP_S = 600.0
 _SAMPLES_PER_TURN = 64
 # Search step of the eclipse edges (attitude.eclipse.eclipse_intervals).
 _ECLIPSE_STEP_S = 30.0
+# SGP4 elements are for days to weeks around their epoch: beyond the first limit a
+# run says that eclipse times are approximate, beyond the second it is refused.
+TLE_NOTED_AFTER_DAYS = 30.0
+TLE_REFUSED_AFTER_DAYS = 365.0
+
+
+def node_seconds(stop_s: float, on_orbit: bool) -> NDArray[np.float64]:
+    """The TT seconds at which the Sun (and the orbit) are sampled for a span [0, stop_s]:
+    a step beyond each end, so that the interpolation covers the span with margin."""
+    step = _ORBIT_NODE_STEP_S if on_orbit else _SUN_NODE_STEP_S
+    count = max(4, math.ceil(stop_s / step) + 3)
+    return -step + step * np.arange(count)
+
+
+def search_grid_count(trajectory: Trajectory, start_s: float, stop_s: float) -> int:
+    """The number of samples of the interval search grid on [start_s, stop_s]: enough
+    per turn of the fastest rotation of any segment (see :func:`_search_grid`)."""
+    return int(_search_step(trajectory, trajectory.scenario.step_s, (stop_s - start_s)))
+
+
+def _search_step(trajectory: Trajectory, step_s: float, span_s: float | None = None):
+    """The search step on the output step ``step_s`` (or, with ``span_s``, the count)."""
+    turn_s = min(
+        2.0
+        * math.pi
+        * float(np.min(segment.solver.moments_of_inertia))
+        / max(segment.solver.angular_momentum_norm, 1e-300)
+        for segment in trajectory.segments
+    )
+    step = min(step_s, turn_s / _SAMPLES_PER_TURN)
+    if span_s is None:
+        return step
+    return max(math.ceil(span_s / step) + 1, 2)
+
+
+def interval_precision(spec: PointingSpec, stop_s: float) -> tuple[float, str | None]:
+    """The precision to which interval ends are refined, and why it differs if it does.
+
+    Bisection cannot narrow a bracket below the spacing of floats at its time: a
+    precision finer than twice that spacing at the end of the span (1e-13 s asked
+    over a day, where TT seconds resolve 1.5e-11 s) would never be reached, so it is
+    raised to it, and the note says so.
+    """
+    resolution = 2.0 * float(np.spacing(max(stop_s, 1.0)))
+    asked = spec.interval_precision_s
+    if asked >= resolution:
+        return asked, None
+    return resolution, (
+        f"interval_precision {asked:g} s is finer than TT seconds resolve over the span "
+        f"(2 ulp at {stop_s:g} s): interval ends are refined to {resolution:.3g} s"
+    )
+
+
+def check_pointing(trajectory: Trajectory, spec: PointingSpec) -> list[str]:
+    """Everything the pointing of ``spec`` needs, checked before anything is sampled.
+
+    The TLE (its lines, its elements, SGP4 at every orbit node of the span, its epoch
+    within :data:`TLE_REFUSED_AFTER_DAYS` of the span), and the Sun ephemeris over the
+    span with the margins the interpolation adds.  Raises :class:`InputError` whose
+    message starts with the key (``pointing.tle: ...``, ``output: ...``); returns notes
+    for the user (a TLE far from its epoch, a clamped interval precision).
+    """
+    scenario = trajectory.scenario
+    if spec.is_empty:
+        return []
+    notes = []
+    _, note = interval_precision(spec, scenario.stop_s)
+    if note:
+        notes.append(f"pointing.interval_precision: {note}")
+    nodes = node_seconds(scenario.stop_s, spec.tle is not None)
+    try:
+        skyfield_times(scenario.times(nodes[[0, -1]]), name="span")
+    except InputError as exc:
+        raise InputError(
+            f"output: the span with its {abs(nodes[0]):g} s margins needs the Sun over "
+            f"{scenario.format_epoch(nodes[0])} to {scenario.format_epoch(nodes[-1])}: "
+            f"{str(exc).removeprefix('span: ')}"
+        ) from None
+    if spec.tle is not None:
+        try:
+            orbit = TleOrbit(*spec.tle, name=scenario.spacecraft.name)
+        except InputError as exc:
+            raise InputError(f"pointing.tle: {exc}") from None
+        days = (
+            float(np.max(np.abs(tt_seconds(scenario.times(nodes[[0, -1]]), orbit.epoch)))) / 86400.0
+        )
+        if days > TLE_REFUSED_AFTER_DAYS:
+            raise InputError(
+                f"pointing.tle: the span reaches {days:.0f} days from the TLE's epoch "
+                f"{orbit.epoch.isot} UTC: SGP4 elements describe an orbit for days to weeks "
+                f"around their epoch (this tool refuses beyond {TLE_REFUSED_AFTER_DAYS:g} "
+                "days): use elements from near the span"
+            )
+        if days > TLE_NOTED_AFTER_DAYS:
+            notes.append(
+                f"pointing.tle: the span reaches {days:.0f} days from the TLE's epoch: SGP4 "
+                "drifts by kilometres a day, so eclipse times are approximate"
+            )
+        failure = orbit.sgp4_failure(scenario.times(nodes))
+        if failure:
+            raise InputError(f"pointing.tle: {failure}")
+    return notes
 
 
 class Geometry:
@@ -140,9 +275,7 @@ class Geometry:
         scenario = trajectory.scenario
         self.scenario = scenario
         self.orbit = None if tle is None else TleOrbit(*tle, name=scenario.spacecraft.name)
-        step = _SUN_NODE_STEP_S if self.orbit is None else _ORBIT_NODE_STEP_S
-        count = max(4, math.ceil(scenario.stop_s / step) + 3)
-        nodes = -step + step * np.arange(count)
+        nodes = node_seconds(scenario.stop_s, self.orbit is not None)
         times = scenario.times(nodes)
         sun_earth = sun_position_from_earth(times)
         self._sun_from_earth = CubicSpline(nodes, sun_earth, axis=0)
@@ -231,16 +364,15 @@ class PointingResult:
     on_orbit: bool
 
 
+def _right_ascension(icrf: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Right ascension in [0, 2π): mod 2π of a tiny negative angle rounds to 2π itself."""
+    ra = np.mod(np.arctan2(icrf[:, 1], icrf[:, 0]), 2.0 * math.pi)
+    return np.where(ra >= 2.0 * math.pi, 0.0, ra)
+
+
 def _search_grid(trajectory: Trajectory, start_s: float, stop_s: float, step_s: float):
     """A grid on [start_s, stop_s] fine enough for the fastest rotation of any segment."""
-    turn_s = min(
-        2.0
-        * math.pi
-        * float(np.min(segment.solver.moments_of_inertia))
-        / max(segment.solver.angular_momentum_norm, 1e-300)
-        for segment in trajectory.segments
-    )
-    step = min(step_s, turn_s / _SAMPLES_PER_TURN)
+    step = _search_step(trajectory, step_s)
     count = math.ceil((stop_s - start_s) / step) + 1
     return np.linspace(start_s, stop_s, max(count, 2))
 
@@ -286,13 +418,13 @@ def compute_pointing(
             vector=body_vector,
             sun_angle_rad=angle,
             cos_incidence=np.maximum(cosine, 0.0) * fraction,
-            right_ascension_rad=np.mod(np.arctan2(icrf[:, 1], icrf[:, 0]), 2.0 * math.pi),
+            right_ascension_rad=_right_ascension(icrf),
             declination_rad=np.arcsin(np.clip(icrf[:, 2], -1.0, 1.0)),
             nadir_angle_rad=nadir,
             violated=None if half is None else (angle < half) & (fraction > 0.0),
         )
         # In umbra the Sun is hidden: it neither blinds a sensor nor lights a panel.
-        precision = spec.interval_precision_s
+        precision = interval_precision(spec, trajectory.scenario.stop_s)[0]
         on_grid = sun_body_grid @ v
         visible = find_intervals(sun_cosine(v), grid, precision, on_grid)
         result.sun_visible = difference(visible, umbra)
@@ -314,6 +446,6 @@ def compute_pointing(
         vectors=vectors,
         shadow=shadow,
         umbra=umbra,
-        precision_s=spec.interval_precision_s,
+        precision_s=interval_precision(spec, trajectory.scenario.stop_s)[0],
         on_orbit=geometry.on_orbit,
     )

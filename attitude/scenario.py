@@ -13,6 +13,13 @@ Time rules (what a user can rely on):
   anything the scenario outputs, and is almost certainly a mistake).  An event at
   ``stop`` exactly is applied: the output at ``stop`` is the post-event state.
 - At an event's epoch every output is the **post-event** state.
+- An event's ``epoch`` is a ``Time`` (or ISO string in the epoch's scale), or a
+  number of TT seconds after the scenario epoch (a float or a time ``Quantity``),
+  taken exactly as given.
+- Every epoch of the span lies in the years 0001–9999 of the epoch's scale (the
+  years that ISO 8601 and the CCSDS files write with four digits).
+- The output grid must be representable: a step that TT seconds resolve at the end
+  of the span (see :meth:`Scenario.output_count`).
 """
 
 from __future__ import annotations
@@ -28,9 +35,20 @@ from attitude.errors import InputError
 from attitude.events import Event
 from attitude.quantities import as_si_scalar, as_vector3
 from attitude.spacecraft import Spacecraft
-from attitude.timescales import SAME_INSTANT_S, as_time, time_from_tt_seconds, tt_seconds
+from attitude.timescales import (
+    SAME_INSTANT_S,
+    as_time,
+    check_year_range,
+    iso_texts,
+    offline_time,
+    time_from_tt_seconds,
+    tt_seconds,
+)
 
 __all__ = ["InitialState", "Scenario"]
+
+# Ten thousand Julian years: no span of years 0001–9999 is longer.
+_LONGEST_SPAN_S = 1e4 * 365.25 * 86400.0
 
 
 @dataclass(frozen=True)
@@ -132,6 +150,7 @@ class Scenario:
         self.epoch = as_time(epoch, name="epoch")
         if not self.epoch.isscalar:
             raise InputError(f"epoch must be a single epoch, got {len(self.epoch)} of them")
+        check_year_range(self.epoch, "epoch")
         scale = self.epoch.scale
 
         if (stop is None) == (duration is None):
@@ -142,6 +161,10 @@ class Scenario:
             self.stop_s = float(tt_seconds(as_time(stop, scale, name="stop"), self.epoch))
         if not self.stop_s > 0.0:
             raise InputError(f"the span must end after the epoch, got {self.stop_s:g} s")
+        if self.stop_s > _LONGEST_SPAN_S:
+            raise InputError(f"the span must be shorter than 10,000 years, got {self.stop_s:g} s")
+        with offline_time():
+            check_year_range(getattr(time_from_tt_seconds(self.epoch, self.stop_s), scale), "stop")
         self.start_s = (
             0.0 if start is None else float(tt_seconds(as_time(start, scale, "start"), self.epoch))
         )
@@ -154,12 +177,17 @@ class Scenario:
         self.step_s = span / 1000.0 if step is None else as_si_scalar(step, "time", "step")
         if not self.step_s > 0.0:
             raise InputError(f"step must be positive, got {self.step_s:g} s")
+        resolution = float(np.spacing(self.stop_s))
+        if self.step_s < 4.0 * resolution:
+            raise InputError(
+                f"step {self.step_s:g} s is below what TT seconds resolve at the end of the "
+                f"span ({self.stop_s:g} s, resolution {resolution:.3g} s): the output grid "
+                "would repeat epochs"
+            )
 
         timed = []
         for index, event in enumerate(events):
-            offset = float(
-                tt_seconds(as_time(event.epoch, scale, f"events[{index}].epoch"), self.epoch)
-            )
+            offset = self._event_offset(event.epoch, f"events[{index}].epoch")
             if abs(offset) <= SAME_INSTANT_S:
                 offset = 0.0
             elif abs(offset - self.stop_s) <= SAME_INSTANT_S:
@@ -173,6 +201,18 @@ class Scenario:
             timed.append((offset, index, event))
         timed.sort(key=lambda item: (item[0], item[1]))
         self.events: list[tuple[float, Event]] = [(offset, event) for offset, _, event in timed]
+        # The place of each event (in time order) in the list given: events[i].
+        self.event_indices: list[int] = [index for _, index, _ in timed]
+
+    def _event_offset(self, epoch: Any, name: str) -> float:
+        """TT seconds after the epoch of an event's epoch (Time, ISO text or seconds)."""
+        from astropy.time import Time
+
+        if isinstance(epoch, Time | str):
+            return float(tt_seconds(as_time(epoch, self.epoch.scale, name), self.epoch))
+        if isinstance(epoch, bool):
+            raise InputError(f"{name} must be a Time or seconds after the epoch, got {epoch!r}")
+        return as_si_scalar(epoch, "time", name)
 
     @property
     def time_scale(self) -> str:
@@ -181,8 +221,6 @@ class Scenario:
 
     def times(self, seconds: Any):
         """``Time`` (in the scenario's scale) of TT ``seconds`` after the epoch."""
-        from attitude.timescales import offline_time
-
         t = time_from_tt_seconds(self.epoch, seconds)
         with offline_time():
             t = getattr(t, self.time_scale)
@@ -195,10 +233,15 @@ class Scenario:
 
     def iso(self, seconds: Any) -> Any:
         """ISO 8601 texts (in the scenario's scale) of TT ``seconds`` after the epoch."""
-        from attitude.timescales import offline_time
+        return iso_texts(self.times(seconds))
 
-        with offline_time():  # formatting a UTC epoch runs ERFA's leap-second code
-            return self.times(seconds).isot
+    def output_count(self) -> int:
+        """The number of output epochs (start, start + step, ..., and stop), without
+        building the grid: a span of 1e9 s every 1e-3 s is 1e12 epochs."""
+        steps = (self.stop_s - self.start_s) / self.step_s * (1 + 1e-12)
+        count = int(steps) + 1  # steps is finite and ≥ 0: step is checked above
+        last = self.start_s + self.step_s * (count - 1)
+        return count + (1 if self.stop_s - last > 1e-9 * self.step_s else 0)
 
     def output_seconds(self) -> NDArray[np.float64]:
         """The output grid: start, start + step, ..., and stop (TT s since the epoch)."""

@@ -17,6 +17,7 @@ ERFA's "dubious year" warning is silenced.  It restores astropy's settings on ex
 from __future__ import annotations
 
 import contextlib
+import re
 import warnings
 from collections.abc import Iterator
 from typing import Any
@@ -30,6 +31,8 @@ __all__ = [
     "SAME_INSTANT_S",
     "SCALES",
     "as_time",
+    "check_year_range",
+    "iso_texts",
     "offline_time",
     "time_from_tt_seconds",
     "tt_seconds",
@@ -85,11 +88,65 @@ def as_time(value: Any, scale: str | None = None, name: str = "epoch"):
     scale = "utc" if scale is None else str(scale).lower()
     if scale not in SCALES:
         raise InputError(f"{name}: time scale must be one of {', '.join(SCALES)}, got {scale!r}")
+    import erfa
+
     try:
-        with offline_time():
+        with offline_time(), warnings.catch_warnings():
+            # ERFA reads hh:mm:60 as the next minute with only a warning, on any day:
+            # a second 60 exists only in a UTC leap second, so anything else is refused.
+            warnings.filterwarnings("error", category=erfa.ErfaWarning, message=".*end of day")
             return Time(value, scale=scale, precision=9)
-    except (ValueError, TypeError) as exc:
-        raise InputError(f"{name}: not an ISO 8601 epoch: {value!r} ({exc})") from None
+    except erfa.ErfaWarning:
+        raise InputError(
+            f"{name}: {value!r} names a second that does not exist: :60 is a leap second, "
+            f"which only UTC has, and only at the end of the days that IERS announced"
+        ) from None
+    except (ValueError, TypeError, OverflowError) as exc:
+        raise InputError(f"{name}: not an ISO 8601 epoch: {value!r}{_reason(str(exc))}") from None
+
+
+def _reason(text: str) -> str:
+    """What astropy says about an ISO text, in a few words: its 'isot' line, where ERFA
+    names the bad field ('bad day'), if there is one."""
+    for line in text.splitlines():
+        if line.startswith("- 'isot': "):
+            found = re.search(r'of "([^"]+)"', line)
+            return f" ({found.group(1)})" if found else ""
+    return ""
+
+
+# Julian dates of 0001-01-01T00:00 and 10000-01-01T00:00 (proleptic Gregorian, as
+# astropy writes ISO dates): epochs must lie between, in their own scale.
+_FIRST_JD, _END_JD = 1721425.5, 5373484.5
+
+
+def check_year_range(times, name: str) -> None:
+    """Raise :class:`InputError` unless every epoch of ``times`` (a ``Time``) lies in
+    the years 0001–9999 of its own scale: the years ISO 8601 writes with four digits."""
+    jd = np.ravel(np.asarray(times.jd1) + np.asarray(times.jd2))
+    outside = ~((jd >= _FIRST_JD) & (jd < _END_JD))
+    if np.any(outside):
+        first = times.ravel()[np.flatnonzero(outside)[0]] if times.ndim else times
+        try:
+            with offline_time():
+                shown = first.isot
+        except (ValueError, OverflowError):
+            shown = f"Julian date {float(jd[outside][0]):.1f}"
+        raise InputError(
+            f"{name}: epochs must lie in the years 0001-9999, got {shown} {times.scale.upper()}"
+        )
+
+
+def iso_texts(times) -> Any:
+    """``times.isot`` with four-digit years, as ISO 8601 writes them (astropy writes
+    the year 1 as ``1-…``): a str for a scalar ``Time``, else an array of str."""
+    with offline_time():
+        texts = np.asarray(times.isot)
+    short = np.char.find(texts, "-") < 4
+    if np.any(short):
+        texts = texts.astype(f"U{texts.dtype.itemsize // 4 + 3}")
+        texts[short] = [text.zfill(len(text) + 4 - text.index("-")) for text in texts[short]]
+    return str(texts) if texts.ndim == 0 else texts
 
 
 def tt_seconds(times, epoch) -> NDArray[np.float64]:

@@ -13,6 +13,7 @@ torque-free motion is far below anything this package reports).
 from __future__ import annotations
 
 import itertools
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -48,12 +49,48 @@ class Segment:
     before: State | None = None
 
 
-def _solver(state: State, t0: float) -> EulerSolver:
-    return EulerSolver(state.inertia.tensor, state.angular_momentum, state.attitude, t0=t0)
+# The time representation must resolve this fraction of the fastest turn of the body.
+_RESOLVED_FRACTION_OF_A_TURN = 1e-3
+
+
+def _solver(state: State, t0: float, where: str) -> EulerSolver:
+    try:
+        return EulerSolver(state.inertia.tensor, state.angular_momentum, state.attitude, t0=t0)
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
+
+
+def _check_resolved(solver: EulerSolver, start_s: float, end_s: float, where: str) -> None:
+    """Refuse a motion faster than TT seconds (floats) can follow over [start_s, end_s].
+
+    The body turns at most at |ω| ≤ G/I_min, once every 2π I_min/G seconds, and m(t)
+    repeats every period T.  Where the spacing of floats near end_s exceeds a
+    thousandth of the shorter of the two, every output would be noise: the elliptic
+    phase λt, exact for the t given, is exact for a t that no one meant.
+    """
+    G = solver.angular_momentum_norm
+    if G == 0.0:
+        return
+    turn_s = 2.0 * math.pi * (float(np.min(solver.moments_of_inertia)) / G)
+    fastest = min(turn_s, solver.period)
+    resolution = float(np.spacing(max(abs(start_s), abs(end_s))))
+    if not resolution <= _RESOLVED_FRACTION_OF_A_TURN * fastest:
+        raise InputError(
+            f"{where}: the body turns in {fastest:.3g} s, too fast for TT seconds over "
+            f"this span (they resolve {resolution:.3g} s at {end_s:g} s, and a thousandth "
+            f"of a turn is needed): give a slower rate or a shorter span"
+        )
+    if not math.isfinite(solver.kinetic_energy):
+        raise InputError(f"{where}: the kinetic energy is beyond the float range")
 
 
 def propagate(scenario: Scenario) -> Trajectory:
-    """The exact motion of ``scenario`` over [epoch, stop], through its events."""
+    """The exact motion of ``scenario`` over [epoch, stop], through its events.
+
+    Raises :class:`InputError` naming the state (``initial_state`` or ``events[i]``)
+    whose motion the solver refuses, or that turns too fast for TT seconds (floats)
+    to follow over the span.
+    """
     initial = scenario.initial_state
     axes = scenario.spacecraft.principal_axes
     if initial.angular_momentum is not None:
@@ -62,15 +99,19 @@ def propagate(scenario: Scenario) -> Trajectory:
         m0 = axes.tensor @ initial.angular_velocity
     state = State(initial.attitude, m0, axes)
     starts: list[tuple[float, State, Event | None, State | None]] = [(0.0, state, None, None)]
-    solver = _solver(state, 0.0)
+    ends = [offset for offset, _ in scenario.events] + [scenario.stop_s]
+    solver = _solver(state, 0.0, "initial_state")
+    _check_resolved(solver, 0.0, ends[0], "initial_state")
     solvers = [solver]
-    for offset, event in scenario.events:
+    indices = getattr(scenario, "event_indices", range(len(scenario.events)))
+    for (offset, event), index, end in zip(scenario.events, indices, ends[1:], strict=True):
+        where = f"events[{index}] ({event.kind} at {scenario.format_epoch(offset)})"
         before = State(solver.attitude(offset), solver.angular_momentum(offset), state.inertia)
         state = event.apply(before)
-        solver = _solver(state, offset)
+        solver = _solver(state, offset, f"the state after {where}")
+        _check_resolved(solver, offset, end, f"the state after {where}")
         solvers.append(solver)
         starts.append((offset, state, event, before))
-    ends = [start for start, *_ in starts[1:]] + [scenario.stop_s]
     segments = [
         Segment(start, end, solver, state, event, before)
         for (start, state, event, before), end, solver in zip(starts, ends, solvers, strict=True)

@@ -17,8 +17,17 @@ LAYERS = [
     ["timescales", "spacecraft", "events", "scenario"],  # spacecraft, scenario and events
     ["trajectory", "motion_analysis"],  # trajectory
     ["ephemeris", "orbit", "eclipse", "pointing", "intervals"],  # pointing (skyfield)
-    ["exports", "aem", "plots", "report_page", "report"],  # reports and exports
-    ["scenario_file", "cli"],  # command line
+    [  # reports and exports
+        "exports",
+        "aem",
+        "plots",
+        "report_page",
+        "output_budget",
+        "run_plan",
+        "output_folder",
+        "report",
+    ],
+    ["scenario_file", "cli", "__main__"],  # command line
 ]
 
 

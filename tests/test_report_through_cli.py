@@ -52,7 +52,9 @@ def report(tmp_path_factory):
 
 
 def test_every_file_is_written_and_linked(report):
-    names = {p.name for p in report.iterdir()}
+    names = {p.name for p in report.iterdir()} - {"attitude-manifest.json"}
+    manifest = json.loads((report / "attitude-manifest.json").read_text())
+    assert set(manifest["files"]) == names  # the folder is marked as attitude's
     assert names == {
         "timeseries.csv",
         "intervals.csv",

@@ -100,7 +100,7 @@ BAD = {
     ),
     "bad epoch": (
         _replace('epoch = "2027-03-01T12:00:00"', 'epoch = "2027-13-45T12:00:00"'),
-        r"bad\.toml: scenario\.epoch: not an ISO 8601 epoch .*: '2027-13-45T12:00:00'",
+        r"bad\.toml: scenario\.epoch: not an ISO 8601 epoch: '2027-13-45T12:00:00' \(bad month\)",
     ),
     "bad time scale": (
         _replace('name = "valid"', 'name = "valid"\ntime_scale = "gps"'),
@@ -116,7 +116,7 @@ BAD = {
             "principal_moments = [10.0, 20.0, 25.0]",
             "inertia_tensor = [[10.0, 1.0, 0.0], [0.0, 20.0, 0.0], [0.0, 0.0, 25.0]]",
         ),
-        r"bad\.toml: spacecraft: inertia: tensor is not symmetric",
+        r"bad\.toml: spacecraft\.inertia_tensor: tensor is not symmetric",
     ),
     "negative step": (
         _replace("step = 1.0", "step = -1.0"),

@@ -1,0 +1,277 @@
+"""`attitude check` refuses whatever `attitude run` refuses, with the same one line.
+
+Both go through one path up to the sampling (attitude.run_plan).  Each file below
+was accepted by `check` and refused by `run` after computing, or crashed `run` with a
+traceback: a bad TLE, an epoch outside the ephemeris (with the margins the pointing
+adds), a far TLE epoch, wrong types, absurd magnitudes, a grid that cannot fit in
+memory.  Each now gives exit 2 and the same message from both, naming the file and
+the key, before anything is written.
+"""
+
+import json
+import re
+
+import pytest
+
+from attitude.cli import main
+
+BASE = """
+[scenario]
+name = "base"
+epoch = "2027-06-21T00:00:00"
+
+[spacecraft]
+name = "sat"
+principal_moments = [10.0, 20.0, 25.0]
+
+[initial_state]
+quaternion = [1.0, 0.0, 0.0, 0.0]
+angular_velocity = [0.01, 0.2, 0.01]
+
+[[events]]
+type = "angular_impulse"
+offset = 5.0
+impulse = [0.1, 0.0, 0.0]
+
+[output]
+duration = 10.0
+step = 1.0
+"""
+
+LINE1 = "1 59001U 27042A   27171.50000000  .00000120  00000-0  18000-4 0  9999"
+LINE2 = "2 59001  98.2100 175.3000 0012000  95.0000 265.2000 14.57123456    14"
+
+POINTING = """
+[pointing]
+tle = ["{line1}", "{line2}"]
+
+[[pointing.body_vectors]]
+name = "tracker"
+vector = [0.0, 0.0, 1.0]
+sun_exclusion_half_angle = {{ value = 30, unit = "deg" }}
+"""
+
+
+EARTH_CENTRE = '\n[pointing]\n[[pointing.body_vectors]]\nname = "x"\nvector = [1.0, 0.0, 0.0]\n'
+
+
+def _checksum(line: str) -> str:
+    """A TLE line with its checksum recomputed (digits, and 1 for each minus sign)."""
+    body = line[:68]
+    total = sum(int(c) for c in body if c.isdigit()) + body.count("-")
+    return body + str(total % 10)
+
+
+def _with_tle(line1: str = LINE1, line2: str = LINE2, text: str = BASE) -> str:
+    return text + POINTING.format(line1=line1, line2=line2)
+
+
+def _replace(old: str, new: str, text: str = BASE) -> str:
+    assert old in text, old
+    return text.replace(old, new, 1)
+
+
+def _epoch(epoch: str, duration: float = 10.0) -> str:
+    text = _replace('epoch = "2027-06-21T00:00:00"', f'epoch = "{epoch}"\ntime_scale = "tdb"')
+    return _replace("duration = 10.0", f"duration = {duration!r}", text)
+
+
+BAD = {
+    # The TLE: every error names the file and pointing.tle.
+    "TLE checksum": (_with_tle(LINE1[:68] + "0"), r"pointing\.tle: line1: checksum"),
+    "TLE short line": (_with_tle(LINE1, LINE2[:60]), r"pointing\.tle: line2 must have 69"),
+    "TLE lines swapped": (_with_tle(LINE2, LINE1), r"pointing\.tle: line1 must start with '1 '"),
+    "TLE non-numeric field": (
+        _with_tle(LINE1, _checksum(LINE2[:52] + "14.5712x456" + LINE2[63:])),
+        r"pointing\.tle: line2",
+    ),
+    "TLE eccentricity near 1": (
+        _with_tle(LINE1, _checksum(LINE2[:26] + "9999999" + LINE2[33:])),
+        r"pointing\.tle: .*SGP4",
+    ),
+    "TLE not ASCII": (_with_tle(LINE1[:20] + "é" + LINE1[21:]), r"pointing\.tle: line1 must be"),
+    "TLE epoch decades away": (
+        _with_tle(text=_replace("2027-06-21T00:00:00", "2047-06-21T00:00:00")),
+        r"pointing\.tle: the span reaches \d+ days from the TLE's epoch",
+    ),
+    # The Sun ephemeris, DE421: 1899-07-29 to 2053-10-09 TDB.
+    "epoch 1850": (
+        _with_tle(text=_epoch("1850-01-01T00:00:00")),
+        r"output: the span .* outside the span of the DE421 ephemeris",
+    ),
+    "epoch 2060": (
+        _with_tle(text=_epoch("2060-01-01T00:00:00")),
+        r"output: the span .* outside the span of the DE421 ephemeris",
+    ),
+    "span across 2053-10-09": (
+        _with_tle(text=_epoch("2053-10-08T12:00:00", 2 * 86400.0)),
+        r"output: the span .* outside the span of the DE421 ephemeris",
+    ),
+    # The epoch and the end are inside; the interpolation's nodes 10 min beyond are not.
+    "ephemeris start within the margin": (
+        _epoch("1899-07-29T00:15:00") + EARTH_CENTRE,
+        r"output: the span with its 600 s margins",
+    ),
+    "ephemeris end within the margin": (
+        _epoch("2053-10-08T23:59:00", 50.0) + EARTH_CENTRE,
+        r"output: the span with its 600 s margins",
+    ),
+    "year 10000": (
+        _replace('epoch = "2027-06-21T00:00:00"', 'epoch = "9999-12-31T23:59:55"'),
+        r"output\.duration: epochs must lie in the years 0001-9999",
+    ),
+    # Types: TOML booleans and strings are not numbers.
+    "boolean moment": (
+        _replace("[10.0, 20.0, 25.0]", "[true, 20.0, 25.0]"),
+        r"spacecraft\.principal_moments: expected 3 numbers, got \[True, 20\.0, 25\.0\]",
+    ),
+    "string duration": (
+        _replace("duration = 10.0", 'duration = "20"'),
+        r"output\.duration: expected a number, got '20'",
+    ),
+    "string vector": (
+        _replace("angular_velocity = [0.01, 0.2, 0.01]", 'angular_velocity = ["1", "2", "3"]'),
+        r"initial_state\.angular_velocity: expected 3 numbers, got \['1', '2', '3'\]",
+    ),
+    # Magnitudes.
+    "step 5e-324": (
+        _replace("step = 1.0", "step = 5e-324"),
+        r"output\.step: 4\.94066e-324 s is below what TT seconds resolve",
+    ),
+    "7 TiB of output epochs": (
+        _replace("step = 1.0", "step = 1e-3", _replace("duration = 10.0", "duration = 1e9")),
+        r"output: 1000000000002 samples would need about .* of memory",
+    ),
+    "1e8 output epochs": (
+        _replace("step = 1.0", "step = 1e-2", _replace("duration = 10.0", "duration = 1e6")),
+        r"output: 100000001 samples would need about .* of memory",
+    ),
+    "1e200 rad/s": (
+        _replace("[0.01, 0.2, 0.01]", "[1e200, 1e200, 0]"),
+        r"initial_state: the body turns in .* too fast for TT seconds",
+    ),
+    "1e200 rad/s after an event": (
+        _replace("impulse = [0.1, 0.0, 0.0]", "impulse = [1e201, 0.0, 0.0]"),
+        r"the state after events\[0\] \(angular_impulse at .*\): the body turns in",
+    ),
+}
+
+BIG = "1" + "0" * 400  # 10**400, a valid TOML integer
+BIG_KEYS = {
+    "duration": ("duration = 10.0", f"duration = {BIG}"),
+    "step": ("step = 1.0", f"step = {BIG}"),
+    "offset": ("offset = 5.0", f"offset = {BIG}"),
+    "principal_moments": ("[10.0, 20.0, 25.0]", f"[{BIG}, 20.0, 25.0]"),
+    "angular_velocity": ("[0.01, 0.2, 0.01]", f"[0.01, {BIG}, 0.01]"),
+    "impulse": ("[0.1, 0.0, 0.0]", f"[0.1, 0.0, -{BIG}]"),
+    "quaternion": ("[1.0, 0.0, 0.0, 0.0]", f"[{BIG}, 0.0, 0.0, 0.0]"),
+}
+for _key, (_old, _new) in BIG_KEYS.items():
+    BAD[f"10**400 as {_key}"] = (
+        _replace(_old, _new),
+        rf"[\w.\[\]]*\b{_key}: a number is beyond the float range",
+    )
+
+
+def _lines(capsys) -> list[str]:
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    return err.splitlines()
+
+
+@pytest.mark.parametrize("case", list(BAD))
+def test_check_and_run_refuse_with_the_same_line(case, tmp_path, capsys):
+    text, message = BAD[case]
+    path = tmp_path / "bad.toml"
+    path.write_text(text, encoding="utf-8")
+    assert main(["check", str(path)]) == 2
+    checked = _lines(capsys)
+    assert len(checked) == 1, checked
+    assert re.search(rf"^attitude: error: bad\.toml: {message}", checked[0]), checked[0]
+    assert checked[0].count("bad.toml") == 1  # the file named once, not `x: x: key`
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "--quiet"]) == 2
+    assert _lines(capsys) == checked
+    assert not out.exists() and [p.name for p in tmp_path.iterdir()] == ["bad.toml"]
+
+
+@pytest.mark.parametrize(
+    ("data", "message"),
+    [
+        (b"\x00\x01\x02\xff\xfe binary \x89PNG", r"bad\.toml: not a TOML file: .* not UTF-8"),
+        ("[scenario]\nname = 'x'\n".encode("utf-16"), r"bad\.toml: not a TOML file: .*UTF-16"),
+        (b"a = " + b"[" * 100_000 + b"]" * 100_000, r"bad\.toml: not valid TOML"),
+        (b"# " + b"x" * (2 << 20), r"bad\.toml: larger than 1024 KiB"),
+    ],
+    ids=["binary", "UTF-16", "nested 100000 deep", "2 MiB"],
+)
+def test_files_that_are_not_scenarios_are_refused_in_one_line(tmp_path, capsys, data, message):
+    path = tmp_path / "bad.toml"
+    path.write_bytes(data)
+    for argv in (["check", str(path)], ["run", str(path), "--out", str(tmp_path / "o")]):
+        assert main(argv) == 2
+        lines = _lines(capsys)
+        assert len(lines) == 1 and re.search(message, lines[0]), lines
+
+
+def test_year_0001_runs_and_is_written_with_four_digits(tmp_path, capsys):
+    path = tmp_path / "old.toml"
+    path.write_text(_replace('epoch = "2027-06-21T00:00:00"', 'epoch = "0001-03-01T12:00:00"'))
+    assert main(["check", str(path)]) == 0
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    aem = (tmp_path / "out" / "attitude.aem").read_text()
+    assert "START_TIME = 0001-03-01T12:00:00.000000000" in aem
+    csv = (tmp_path / "out" / "timeseries.csv").read_text()
+    assert "\n0001-03-01T12:00:01.000000000," in csv
+
+
+def test_a_precision_finer_than_time_resolves_is_clamped_and_said(tmp_path, capsys):
+    """interval_precision = 1e-13 s used to hang: the bisection cannot get below an ulp."""
+    text = _with_tle().replace("[pointing]\n", "[pointing]\ninterval_precision = 1e-13\n")
+    path = tmp_path / "fine.toml"
+    path.write_text(_replace("duration = 10.0", "duration = 600.0", text))
+    assert main(["check", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"note .*interval_precision 1e-13 s is finer than TT seconds resolve", out)
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and "attitude: note: fine.toml: pointing." in err
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["pointing"]["interval_precision_s"] == pytest.approx(2 * 1.1368683772161603e-13)
+
+
+def test_a_far_tle_epoch_is_said(tmp_path, capsys):
+    path = tmp_path / "far.toml"
+    path.write_text(_with_tle(text=_replace("2027-06-21T00:00:00", "2027-09-21T00:00:00")))
+    assert main(["check", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"note +pointing\.tle: the span reaches 9\d days from the TLE's epoch", out)
+
+
+def test_check_states_the_samples_and_the_sizes(tmp_path, capsys):
+    path = tmp_path / "ok.toml"
+    path.write_text(_with_tle(text=_replace("duration = 10.0", "duration = 3600.0")))
+    assert main(["check", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"outputs +3601 samples; writes about [\d.]+ MB \(timeseries\.csv", out)
+    assert "holds about" in out
+    assert "Sun exclusion half angle 30 deg" in out  # angles echoed in degrees
+
+
+def test_check_with_out_refuses_what_run_would(tmp_path, capsys):
+    path = tmp_path / "ok.toml"
+    path.write_text(BASE)
+    assert main(["check", str(path), "--out", str(tmp_path)]) == 2
+    assert "did not write" in capsys.readouterr().err
+    assert main(["check", str(path), "--out", str(tmp_path / "new")]) == 0
+    assert not (tmp_path / "new").exists()  # check creates nothing
+
+
+def test_every_run_error_names_the_file_and_the_key(tmp_path, capsys):
+    """Errors raised after loading (the TLE, the solver, the budget) used to lack both."""
+    for case in ("TLE lines swapped", "1e200 rad/s", "1e8 output epochs", "epoch 2060"):
+        path = tmp_path / "bad.toml"
+        path.write_text(BAD[case][0], encoding="utf-8")
+        assert main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 2
+        line = capsys.readouterr().err
+        assert re.match(r"attitude: error: bad\.toml: (pointing\.tle|initial_state|output): ", line)
