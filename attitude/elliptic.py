@@ -6,6 +6,20 @@ Everything here takes the *complementary parameter* ``mc = 1 − m`` ([OLBC10] �
 matter there.  The solver computes ``mc`` from the physics without cancellation
 (Leroy, "The elliptic modulus") and hands it to these kernels unchanged.
 
+How small mc may be.  The general kernels below depend on mc through K (through
+ln mc as mc → 0: K = ln(4/√mc) + O(mc ln mc), [OLBC10] 19.12.1) and through the AGM of
+1 and √mc; both keep full accuracy for any float mc, down to the subnormals (checked
+against mpmath at mc from 1e-100 to 1e-320: a few ulps, plus eps·|u|·|f'| for large
+|u|).  What fails first is mc itself: a subnormal float carries fewer than 53
+significant bits (1e-320 has 11), and K moves by half the relative error of mc, so a
+subnormal mc that is a rounded physical ratio gives K, hence the period, to only a
+few digits; and a ratio below 5e-324 rounds to zero, the separatrix, whose motion is
+not periodic at all.  So below ``NEAR_ONE_MC`` (2^-128 ≈ 2.9e-39) the kernels take
+ln mc instead, which the solver computes from its exact integers for any mc however
+small, and use the expansions about m = 1: there the neglected terms are O(√mc)
+relative, below 2^-66 (derivation in ``reduced_sn_cn_dn_near_one`` and
+``pi_minus_f_near_one``).
+
 Why our own kernels: ``scipy.special.ellipj`` takes ``m`` and, for ``m ≥ 1 − 1e-9``,
 switches to an approximation that is only valid in the first quarter period (values
 of 1e47 and NaN further out; scipy issue #8480), and its error grows with ``u``
@@ -22,20 +36,26 @@ References
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import special
 
 __all__ = [
+    "NEAR_ONE_MC",
     "complete_first_kind",
+    "complete_first_kind_near_one",
     "elliptic_f",
     "elliptic_pi",
     "elliptic_pi_complete",
     "jacobi_amplitude",
     "jacobi_sn_cn_dn",
     "pi_minus_f",
+    "pi_minus_f_near_one",
     "reduce_argument",
     "reduced_sn_cn_dn",
+    "reduced_sn_cn_dn_near_one",
 ]
 
 # Bulirsch's convergence threshold on the arithmetic-geometric mean: the method's
@@ -44,6 +64,10 @@ _AGM_TOLERANCE = 2.0**-27
 # Below this |u| the Taylor series to u⁵ is exact to rounding (the next term is
 # O(u⁶) ≈ 1e-24), and it avoids the overflow of Bulirsch's cot recurrence at tiny u.
 _SERIES_THRESHOLD = 1.0e-4
+# Below this complementary parameter the kernels work from ln mc and the expansions
+# about m = 1, whose neglected terms are O(√mc) = O(2^-64) relative (module docstring).
+NEAR_ONE_MC = 2.0**-128
+_LN4 = math.log(4.0)
 
 
 def _as_mc(mc: ArrayLike) -> NDArray[np.float64]:
@@ -298,3 +322,95 @@ def elliptic_pi_complete(n: ArrayLike, mc: ArrayLike) -> NDArray[np.float64]:
     n = _check_n(n)
     mc = _as_mc(mc)
     return special.elliprf(0.0, mc, 1.0) + (n / 3.0) * special.elliprj(0.0, mc, 1.0, 1.0 - n)
+
+
+# ----------------------------------------------------------------- m within 2^-128 of 1
+
+
+def complete_first_kind_near_one(log_mc: ArrayLike) -> NDArray[np.float64]:
+    """K from ln mc, for mc < ``NEAR_ONE_MC``: K = ln 4 − ½ ln mc.
+
+    [OLBC10] 19.12.1: K = ln(4/k') + O(k'² ln k') with k' = √mc; the neglected term is
+    below 2^-128·100 there.  ``log_mc = −∞`` (the separatrix) gives K = ∞.
+    """
+    return _LN4 - 0.5 * np.asarray(log_mc, dtype=np.float64)
+
+
+def _exp_or_zero(x: NDArray[np.float64]) -> NDArray[np.float64]:
+    with np.errstate(under="ignore"):
+        return np.exp(x)
+
+
+def reduced_sn_cn_dn_near_one(
+    r: ArrayLike, log_mc: ArrayLike, K: ArrayLike
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """sn, cn, dn of a reduced argument ``|r| ≤ K`` for mc < ``NEAR_ONE_MC``, from ln mc.
+
+    With k' = √mc and K = ln(4/k') (``complete_first_kind_near_one``):
+
+    - |r| ≤ K/2: sn = tanh r, cn = dn = sech r.  [OLBC10] 22.10.8–10 give the first
+      corrections, (k'²/4)(sinh r cosh r − r) times sech² r, −tanh r sech r and
+      +tanh r sech r: relative to the leading terms they are below k'²/4 for sn and
+      (k'²/4) sinh² r ≤ (k'²/4) e^K/4 = k'/4 for cn and dn.
+    - K/2 < |r| ≤ K: the quarter-period shift z = r ∓ K, |z| < K/2 ([OLBC10] Table
+      22.4.3): sn = ±cd z, cn = ∓k' sd z, dn = k' nd z, whose leading terms are ±1,
+      ∓k' sinh z and k' cosh z, with the same O(k') relative corrections.
+
+    So every value is exact to a relative 2^-66 when mc < 2^-128.  The products
+    k' sinh z and k' cosh z are formed as exponentials of ln k' ± |z|, so that a k'
+    below the float range (mc < 5e-324 has no float, ln mc always has one) still
+    gives the components that are representable; those below ~1e-308 round to 0.
+    ``log_mc = −∞`` (K = ∞) gives the separatrix functions tanh, sech, sech.
+    """
+    r, log_mc, K = np.broadcast_arrays(
+        np.asarray(r, dtype=np.float64),
+        np.asarray(log_mc, dtype=np.float64),
+        np.asarray(K, dtype=np.float64),
+    )
+    far = np.abs(r) > 0.5 * K
+    σ = np.copysign(1.0, r)
+    z = np.where(far, r - σ * K, r)
+    a = np.abs(z)
+    e = _exp_or_zero(-a)
+    sech = 2.0 * e / (1.0 + e * e)  # no overflow of cosh for large |z|
+    log_kc = 0.5 * log_mc
+    grow = _exp_or_zero(log_kc + a)  # k' e^|z| (≤ 2 √k' since |z| ≤ K/2)
+    decay = _exp_or_zero(log_kc - a)  # k' e^-|z|
+    k_sinh = np.copysign(0.5 * (grow - decay), z)  # k' sinh z
+    k_cosh = 0.5 * (grow + decay)  # k' cosh z
+    sn = np.where(far, σ, np.tanh(z))
+    cn = np.where(far, -σ * k_sinh, sech)
+    dn = np.where(far, k_cosh, sech)
+    return sn, cn, dn
+
+
+def pi_minus_f_near_one(
+    j: ArrayLike, r: ArrayLike, sn: ArrayLike, n: ArrayLike, K: ArrayLike
+) -> NDArray[np.float64]:
+    """Π(am u, n|m) − u for u = 2jK + r, |r| ≤ K, n < 0 and mc < ``NEAR_ONE_MC``.
+
+    ``sn`` is sn r.  Derivation (the project's own; [OLBC10] 19.2.7 for Π): with
+    s = sin θ, c = cos θ and Δ = √(c² + mc s²),
+
+        Π(φ, n) − F(φ) = ∫₀^φ n s² dθ / ((1 − n s²) Δ)
+                       = n/(1 − n) · [F(φ) − ∫₀^φ c² dθ / ((1 − n s²) Δ)],
+
+    since n s²/(1 − n s²) = n/(1 − n) − n c²/((1 − n)(1 − n s²)).  For |φ| ≤ π/2,
+    c²/Δ differs from |c| by at most mc/Δ, whose integral is mc F(φ) ≤ mc K; and
+    ∫₀^φ c dθ/(1 − n s²) = A(sin φ) with A(x) = arctan(√−n x)/√−n.  On a Jacobi
+    amplitude F(am r) = r, so Π(am r) − r = n/(1 − n) (r − A(sn r)) + O(mc K), and by
+    the quasi-periodicity ([OLBC10] 19.2.10 for F and Π) each half period adds the
+    complete value n/(1 − n) (K − A(1)).  The error is below mc K ≈ 2^-121.
+    """
+    j = np.asarray(j, dtype=np.float64)
+    n = np.asarray(n, dtype=np.float64)
+    a = np.sqrt(-n)
+
+    def A(x):
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(a > 0.0, np.arctan(a * x) / a, x)
+
+    incomplete = np.asarray(r) - A(np.asarray(sn, dtype=np.float64))
+    if np.all(j == 0.0):
+        return (n / (1.0 - n)) * incomplete
+    return (n / (1.0 - n)) * (incomplete + 2.0 * j * (np.asarray(K) - A(1.0)))
