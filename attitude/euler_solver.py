@@ -22,7 +22,9 @@ Bjh            √(±Ij Δh / Ijh), amplitudes of the components of m
 λ1, λ2, λ3     |λ| in cases (ii), (iii), (i)
 ν              the phase: u(t0) = −ν
 mc             1 − k², complementary parameter of the Jacobi functions ([Leroy]
-               "The elliptic modulus"); k⁻² replaces k² in case (ii)
+               "The elliptic modulus"); k⁻² replaces k² in case (ii).  Below 2^-128
+               (a state within ~1e-19 G of the separatrix) the kernels take ln mc,
+               exact from the integers of _ExactΔ however small mc is: see _Parameter
 K              K(mc), quarter period of the Jacobi functions in u
 n              characteristic of the elliptic integral of the third kind Π(φ, n|m)
 ψ              angle of the rotation about e1 (case i) or e3 (case ii) that completes
@@ -57,7 +59,16 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from attitude.elliptic import complete_first_kind, pi_minus_f, reduce_argument, reduced_sn_cn_dn
+from attitude.elliptic import (
+    NEAR_ONE_MC,
+    complete_first_kind,
+    complete_first_kind_near_one,
+    pi_minus_f,
+    pi_minus_f_near_one,
+    reduce_argument,
+    reduced_sn_cn_dn,
+    reduced_sn_cn_dn_near_one,
+)
 from attitude.errors import InputError
 from attitude.inertia import principal_axes
 from attitude.quantities import as_si_array, as_si_scalar, as_vector3
@@ -67,9 +78,6 @@ __all__ = ["EulerSolver"]
 
 # Evaluations over many times run in slices of this many samples (see _in_chunks).
 _CHUNK = 16384
-# The kernels keep full accuracy down to this complementary parameter (tested to
-# 1e-300); below, a state is closer to the separatrix than double precision can follow.
-_SMALLEST_MC = 1e-300
 
 
 def _rate(G: float, numerator: float, I1: float, I2: float, I3: float) -> float:
@@ -79,12 +87,84 @@ def _rate(G: float, numerator: float, I1: float, I2: float, I3: float) -> float:
     return (G / I3) * math.sqrt(numerator / I3 / ((I1 / I3) * (I2 / I3)))
 
 
+class _Parameter:
+    """The parameter m of the Jacobi functions of a state: mc = 1 − m, ln mc and K.
+
+    For mc ≥ ``NEAR_ONE_MC`` the kernels take mc; below, where mc may be subnormal or
+    below the float range while ln mc (from the exact integers) is always accurate,
+    they take ln mc and use the expansions about m = 1 (see attitude/elliptic.py).
+    """
+
+    def __init__(self, mc: float, log_mc: float) -> None:
+        self.mc = mc
+        self.log_mc = log_mc
+        self.near_one = mc < NEAR_ONE_MC
+        if self.near_one:
+            self.K = float(complete_first_kind_near_one(log_mc))
+        else:
+            self.K = float(complete_first_kind(mc))
+        self.kc = math.exp(0.5 * log_mc)  # k' = √mc (0 when below the float range)
+
+    def reduced_sn_cn_dn(self, r: NDArray[np.float64]):
+        if self.near_one:
+            return reduced_sn_cn_dn_near_one(r, self.log_mc, self.K)
+        return reduced_sn_cn_dn(r, self.mc, self.K)
+
+    def pi_minus_f(self, f: _Jacobi, n: float) -> NDArray[np.float64]:
+        """Π(am u, n) − u."""
+        if self.near_one:
+            return pi_minus_f_near_one(f.j, f.r, f.sn_r, n, self.K)
+        return pi_minus_f(f.j, f.sn_r, f.cn_r, f.dn_r, n, self.mc)
+
+    def phase(
+        self,
+        G: float,
+        sn: tuple[float, float],
+        cn: tuple[float, float],
+        dn: tuple[float, float],
+    ) -> float:
+        """ν, from sn ν, cn ν and dn ν each given as (component of m0, its amplitude B).
+
+        [Leroy] "Phase and initial value": ν = F(am ν).  Away from m = 1 this is
+        ``_elliptic_phase`` of (sn ν, cn ν).  Near m = 1 the components may differ by
+        more than the float range (a state 1e-200 G from the intermediate axis with
+        G = 1e124), so ν is found from their logarithms: sinh ν = sn/cn where
+        dn ν ≥ √k' (|ν| ≤ K/2, sn = tanh, cn = sech), and otherwise, with the quarter
+        shift ν = ±(K − z) of ``reduced_sn_cn_dn_near_one``, sinh z = |cn ν|/k'.
+        cn ν < 0 means |ν| > K: then ν = ±2K − ν', with ν' the phase of −cn ν
+        (cn(2K − x) = −cn x, sn and dn unchanged, [OLBC10] 22.4.3).
+        """
+        (m_s, B_s), (m_c, B_c), (m_d, B_d) = sn, cn, dn
+        if not self.near_one:
+            # sin φ : cos φ = m_s/B_s : m_c/B_c, scaled by B_s B_c/G² to stay O(1).
+            s, c = _unit_vector_phase((m_s / G) * (B_c / G), (m_c / G) * (B_s / G))
+            return _elliptic_phase(s, c, self.mc, self.K)
+        σ = -1.0 if m_s < 0.0 else 1.0
+        log_c = _log_abs(m_c) - math.log(B_c)
+        if m_c != 0.0 and _log_abs(m_d) - math.log(B_d) >= 0.25 * self.log_mc:
+            ν = σ * _asinh_of_exp(_log_abs(m_s) - math.log(B_s) - log_c)
+        else:
+            ν = σ * (self.K - _asinh_of_exp(log_c - 0.5 * self.log_mc))
+        return σ * 2.0 * self.K - ν if m_c < 0.0 else ν
+
+
+def _log_abs(x: float) -> float:
+    return math.log(abs(x)) if x != 0.0 else -math.inf
+
+
+def _asinh_of_exp(L: float) -> float:
+    """asinh(e^L) without overflow: L + ln 2 + O(e^-2L) for large L."""
+    if L > 20.0:
+        return L + math.log(2.0)
+    return math.asinh(math.exp(L))
+
+
 class _Jacobi:
     """sn, cn, dn of u = 2jK + r, with those of the reduced r (|r| ≤ K) kept for Π."""
 
-    def __init__(self, u: NDArray[np.float64], mc: float, K: float) -> None:
-        self.j, r = reduce_argument(u, K)
-        self.sn_r, self.cn_r, self.dn_r = reduced_sn_cn_dn(r, mc, K)
+    def __init__(self, u: NDArray[np.float64], parameter: _Parameter) -> None:
+        self.j, self.r = reduce_argument(u, parameter.K)
+        self.sn_r, self.cn_r, self.dn_r = parameter.reduced_sn_cn_dn(self.r)
         sign = 1.0 - 2.0 * np.mod(self.j, 2.0)  # (−1)^j: sn, cn change sign every 2K
         self.sn = sign * self.sn_r
         self.cn = sign * self.cn_r
@@ -138,17 +218,16 @@ class _FormulaI:
         """λ3 = G √(δ3 I12 / (I1 I2 I3)), the magnitude of λ."""
         return _rate(G, δ3 * (I1 - I2), I1, I2, I3)
 
-    def __init__(self, I1, I2, I3, m0, G, δ1, δ3, mc) -> None:
+    def __init__(self, I1, I2, I3, m0, G, δ1, δ3, parameter) -> None:
         I12, I13, I21, I31, I32 = I1 - I2, I1 - I3, I2 - I1, I3 - I1, I3 - I2
         self.B13 = G * math.sqrt(I1 * δ3 / I13)
         self.B21 = G * math.sqrt(I2 * δ1 / I21)
         self.B31 = G * math.sqrt(I3 * δ1 / I31)
-        self.mc = mc  # Δ2 I31 / (Δ3 I21), from the exact Δj (see _ExactΔ)
-        self.K = float(complete_first_kind(self.mc))
+        self.parameter = parameter  # mc = Δ2 I31 / (Δ3 I21), from the exact Δj
+        self.mc, self.K = parameter.mc, parameter.K
         self.λ = -self.rate(G, I1, I2, I3, δ1, δ3)  # the corrected sign: λ = −σ λ3
-        # m0 = (B13 dn ν, B21 sn ν, B31 cn ν); all factors scaled by G to stay O(1).
-        s, c = _unit_vector_phase((m0[1] / G) * (self.B31 / G), (m0[2] / G) * (self.B21 / G))
-        self.ν = _elliptic_phase(s, c, self.mc, self.K)
+        # m0 = (B13 dn ν, B21 sn ν, B31 cn ν).
+        self.ν = parameter.phase(G, (m0[1], self.B21), (m0[2], self.B31), (m0[0], self.B13))
         # ψ(t) = (G/I1) t + C Π(am u, n) − arctg(κ sc u)   [Leroy] "Integrals", case (i)
         self.C = (G / self.λ) * (I13 / I1 / I3)  # grouped to stay in the float range
         self.n = (I1 / I3) * (I32 / I12)
@@ -159,11 +238,11 @@ class _FormulaI:
 
     def evaluate(self, τ: NDArray[np.float64], with_ψ: bool):
         u = self.λ * τ - self.ν
-        f = _Jacobi(u, self.mc, self.K)
+        f = _Jacobi(u, self.parameter)
         m = np.stack([self.B13 * f.dn, -self.B21 * f.sn, self.B31 * f.cn], axis=-1)
         if not with_ψ:
             return m, None
-        Π_minus_F = pi_minus_f(f.j, f.sn_r, f.cn_r, f.dn_r, self.n, self.mc)
+        Π_minus_F = self.parameter.pi_minus_f(f, self.n)
         ψ = self.ψ_rate * τ + self.C * Π_minus_F - f.arctan_of_scaled_sc(self.κ)
         return m, ψ
 
@@ -183,17 +262,16 @@ class _FormulaII:
         """λ1 = G √(δ1 I32 / (I1 I2 I3)), the magnitude of λ."""
         return _rate(G, δ1 * (I3 - I2), I1, I2, I3)
 
-    def __init__(self, I1, I2, I3, m0, G, δ1, δ3, mc) -> None:
+    def __init__(self, I1, I2, I3, m0, G, δ1, δ3, parameter) -> None:
         I13, I21, I23, I31, I32 = I1 - I3, I2 - I1, I2 - I3, I3 - I1, I3 - I2
         self.B13 = G * math.sqrt(I1 * δ3 / I13)
         self.B23 = G * math.sqrt(I2 * δ3 / I23)
         self.B31 = G * math.sqrt(I3 * δ1 / I31)
-        self.mc = mc  # 1 − k⁻² = Δ2 I31 / (Δ1 I32), from the exact Δj (see _ExactΔ)
-        self.K = float(complete_first_kind(self.mc))
+        self.parameter = parameter  # mc = 1 − k⁻² = Δ2 I31 / (Δ1 I32), from the exact Δj
+        self.mc, self.K = parameter.mc, parameter.K
         self.λ = -self.rate(G, I1, I2, I3, δ1, δ3)  # the corrected sign: λ = −σ λ1
-        # m0 = (B13 cn ν, B23 sn ν, B31 dn ν); all factors scaled by G to stay O(1).
-        s, c = _unit_vector_phase((m0[1] / G) * (self.B13 / G), (m0[0] / G) * (self.B23 / G))
-        self.ν = _elliptic_phase(s, c, self.mc, self.K)
+        # m0 = (B13 cn ν, B23 sn ν, B31 dn ν).
+        self.ν = parameter.phase(G, (m0[1], self.B23), (m0[0], self.B13), (m0[2], self.B31))
         # ψ(t) = (G/I3) t + C Π(am u, n) + arctg(κ sc u)   [Leroy] "Integrals", case (ii)
         self.C = (G / self.λ) * (I31 / I1 / I3)  # grouped to stay in the float range
         self.n = (I3 / I1) * (I21 / I23)
@@ -203,11 +281,11 @@ class _FormulaII:
 
     def evaluate(self, τ: NDArray[np.float64], with_ψ: bool):
         u = self.λ * τ - self.ν
-        f = _Jacobi(u, self.mc, self.K)
+        f = _Jacobi(u, self.parameter)
         m = np.stack([self.B13 * f.cn, -self.B23 * f.sn, self.B31 * f.dn], axis=-1)
         if not with_ψ:
             return m, None
-        Π_minus_F = pi_minus_f(f.j, f.sn_r, f.cn_r, f.dn_r, self.n, self.mc)
+        Π_minus_F = self.parameter.pi_minus_f(f, self.n)
         ψ = self.ψ_rate * τ + self.C * Π_minus_F + f.arctan_of_scaled_sc(self.κ)
         return m, ψ
 
@@ -223,7 +301,7 @@ class _FormulaIII:
     mc = 0.0
     period = math.inf
 
-    def __init__(self, I1, I2, I3, m0, G, δ1, δ3, mc) -> None:
+    def __init__(self, I1, I2, I3, m0, G, δ1, δ3, parameter) -> None:
         I13, I31 = I1 - I3, I3 - I1
         self.G = G
         self.B13 = G * math.sqrt(I1 * δ3 / I13)
@@ -232,7 +310,7 @@ class _FormulaIII:
         # th(−ν) = m02/G and sech(−ν) = √(m01² + m03²)/G, so sinh(−ν) is their ratio:
         # no cancellation even when m02 is within an ulp of ±G.  A spin exactly about
         # e2 gives ν = ∓∞ and, through IEEE infinities, m(t) = (0, ±G, 0) at all t.
-        with np.errstate(divide="ignore"):
+        with np.errstate(divide="ignore", over="ignore"):
             self.ν = -float(np.arcsinh(np.float64(m0[1]) / math.hypot(m0[0], m0[2])))
         # P(t) maps m onto e1 if B13 < B31, else onto e3 ([Leroy] "Case (iii)"), so that
         # the coefficient (B − G)/B' of the arc tangent has a non-zero denominator.
@@ -268,7 +346,7 @@ class _Steady:
     mc = math.nan
     period = math.inf
 
-    def __init__(self, I1, I2, I3, m0, G, δ1, δ3, mc) -> None:
+    def __init__(self, I1, I2, I3, m0, G, δ1, δ3, parameter) -> None:
         self.m0 = np.array(m0)
         x = self.m0 / G
         self.ψ_rate = G * float(np.sum(x * x / np.array([I1, I2, I3])))  # 2T/G
@@ -355,11 +433,20 @@ class _ExactΔ:
     def mc(self, case: str) -> float:
         """mc = Δ2 I31/(Δ3 I21) in case (i), Δ2 I31/(Δ1 I32) in case (ii) ([Leroy]
         "The elliptic modulus"), correctly rounded, in [0, 1]."""
+        numerator, denominator = self._mc_ratio(case)
+        return numerator / denominator
+
+    def log_mc(self, case: str) -> float:
+        """ln mc, accurate however small mc is (Python's log takes integers of any size)."""
+        numerator, denominator = self._mc_ratio(case)
+        return math.log(numerator) - math.log(denominator)
+
+    def _mc_ratio(self, case: str) -> tuple[int, int]:
         J1, J2, J3 = self.J
         D1, D2, D3 = self.D
         if case == "i":
-            return (D2 * (J3 - J1)) / (D3 * (J2 - J1))
-        return (D2 * (J3 - J1)) / (D1 * (J3 - J2))
+            return -D2 * (J3 - J1), -D3 * (J2 - J1)
+        return D2 * (J3 - J1), D1 * (J3 - J2)
 
 
 def _preferred_axes(moments: NDArray[np.float64]) -> tuple[NDArray[np.intp], NDArray[np.float64]]:
@@ -423,7 +510,7 @@ class EulerSolver:
         m = signs * m_principal[order]
         G = math.hypot(*m)  # math.hypot scales: no overflow or underflow of the squares
         self._G = G
-        mc = math.nan
+        parameter = None
         if not math.isfinite(G / I1):
             raise InputError(
                 f"angular_momentum {m_body.tolist()} with moments {axes.moments.tolist()}: the "
@@ -438,20 +525,15 @@ class EulerSolver:
             if I1 == I3:
                 formula = _Steady  # the sphere
             elif exact.sign_Δ2 < 0:
-                formula, mc = _FormulaI, exact.mc("i")
+                formula, case = _FormulaI, "i"
             elif exact.sign_Δ2 > 0:
-                formula, mc = _FormulaII, exact.mc("ii")
+                formula, case = _FormulaII, "ii"
             else:
                 formula = _FormulaIII
-            if formula in (_FormulaI, _FormulaII) and formula.rate(G, I1, I2, I3, δ1, δ3) == 0.0:
-                formula = _Steady  # λ underflows: see _Steady
-            if formula in (_FormulaI, _FormulaII) and mc < _SMALLEST_MC:
-                raise InputError(
-                    f"angular_momentum {m_body.tolist()}: the state is not on the separatrix "
-                    f"but so close to it that the complementary parameter of its motion, "
-                    f"mc = {mc:.3g}, is below {_SMALLEST_MC:g}: double precision cannot follow "
-                    "its period.  Put it exactly on the separatrix, or further from it"
-                )
+            if formula in (_FormulaI, _FormulaII):
+                parameter = _Parameter(exact.mc(case), exact.log_mc(case))
+                if formula.rate(G, I1, I2, I3, δ1, δ3) == 0.0:
+                    formula = _Steady  # λ underflows: see _Steady
         # 2T = Σ mj²/Ij = G² (x1²/I1 + x2²/I2 + x3²/I3); Python floats: an energy
         # beyond the float range is inf, without a numpy warning.
         x = m / G if G > 0.0 else m
@@ -470,7 +552,7 @@ class EulerSolver:
             flips[[1, 2]] = -1.0
         signs = signs * flips
         m = flips * m
-        self._formula = formula(I1, I2, I3, m, G, δ1, δ3, mc)
+        self._formula = formula(I1, I2, I3, m, G, δ1, δ3, parameter)
 
         # S: user body → preferred principal axes: a signed permutation with det +1
         # after the body → principal rotation.  Row vectors go back to the body as
@@ -516,6 +598,28 @@ class EulerSolver:
 
     def _τ(self, t: Any) -> NDArray[np.float64]:
         return as_si_array(t, "time", "t") - self._t0
+
+    def _evaluate(self, chunk, t: Any, width: int, τ: NDArray[np.float64] | None = None):
+        """``chunk`` over the times ``t`` in slices, refusing a time too far from t0.
+
+        Far enough from t0 (|t − t0| beyond ~1.8e308 divided by the motion's fastest
+        angular rate) an angle λ(t − t0) or ψ(t) leaves the float range and the
+        result would be NaN: that time gets an InputError that names it instead.
+        """
+        if τ is None:
+            τ = self._τ(t)
+        with np.errstate(over="ignore", invalid="ignore"):
+            out = self._in_chunks(chunk, τ, width)
+        if not np.isfinite(out).all():
+            bad = np.flatnonzero(~np.isfinite(out).reshape(-1, width).all(axis=-1))[0]
+            t_bad = np.ravel(as_si_array(t, "time", "t"))[bad] if np.ndim(t) else t
+            rate = max(abs(getattr(self._formula, "λ", 0.0)), self._G / self._I_preferred[0])
+            raise InputError(
+                f"t = {float(t_bad)!r} s is too far from t0 = {self._t0!r} s for this motion: "
+                f"its angles, at rates up to {rate:.3g} rad/s, times t - t0 exceed the float "
+                "range (1.8e308)"
+            )
+        return out
 
     def _to_body(self, v_preferred: NDArray[np.float64]) -> NDArray[np.float64]:
         return np.dot(v_preferred, self._S_matrix)
@@ -575,11 +679,11 @@ class EulerSolver:
 
     def angular_momentum(self, t: ArrayLike) -> NDArray[np.float64]:
         """Body-frame angular momentum at ``t`` (N m s), shape ``np.shape(t) + (3,)``."""
-        return self._in_chunks(self._momentum_chunk, self._τ(t), 3)
+        return self._evaluate(self._momentum_chunk, t, 3)
 
     def angular_velocity(self, t: ArrayLike) -> NDArray[np.float64]:
         """Body-frame angular velocity at ``t`` (rad/s), shape ``np.shape(t) + (3,)``."""
-        return self._in_chunks(self._velocity_chunk, self._τ(t), 3)
+        return self._evaluate(self._velocity_chunk, t, 3)
 
     def attitude(self, t: ArrayLike) -> Rotation:
         """Rotation taking body coordinates to inertial coordinates at ``t``.
@@ -591,7 +695,7 @@ class EulerSolver:
             raise InputError(
                 f"t must be a scalar or a 1-D array for attitude(), got shape {τ.shape}"
             )
-        return Rotation.from_quat(self._quaternions_scalar_last(τ))
+        return Rotation.from_quat(self._quaternions_scalar_last(t, τ))
 
     def attitude_quaternion(self, t: ArrayLike, scalar_first: bool = True) -> NDArray[np.float64]:
         """The attitude at ``t`` as unit quaternions, body → inertial, shape ``np.shape(t) + (4,)``.
@@ -600,14 +704,14 @@ class EulerSolver:
         without building a ``Rotation``: for writing files and for callers that
         assemble many segments.
         """
-        q = self._quaternions_scalar_last(self._τ(t))
+        q = self._quaternions_scalar_last(t, self._τ(t))
         q /= np.linalg.norm(q, axis=-1, keepdims=True)
         return q[..., [3, 0, 1, 2]] if scalar_first else q
 
-    def _quaternions_scalar_last(self, τ: NDArray[np.float64]) -> NDArray[np.float64]:
+    def _quaternions_scalar_last(self, t: Any, τ: NDArray[np.float64]) -> NDArray[np.float64]:
         if self._formula.axis is None:  # at rest
             return np.broadcast_to(self._initial_attitude.as_quat(), (*τ.shape, 4)).copy()
-        return self._in_chunks(self._quaternion_chunk, τ, 4)
+        return self._evaluate(self._quaternion_chunk, t, 4, τ)
 
     def spin_axis_cone(self) -> tuple[NDArray[np.float64], float, float] | None:
         """The body axis about which m circulates, and the cone it describes about m.
@@ -625,20 +729,18 @@ class EulerSolver:
         B = f.B13 if f.name == "i" else f.B31
         axis = self._to_body(np.eye(3)[f.axis])
         G = self._G
-        return axis, math.acos(min(1.0, B / G)), math.acos(min(1.0, B * math.sqrt(f.mc) / G))
+        return axis, math.acos(min(1.0, B / G)), math.acos(min(1.0, B * f.parameter.kc / G))
 
-    def flip_times(self, t_start: float, t_end: float) -> NDArray[np.float64]:
-        """Times in [t_start, t_end] at which the body flips (the Джанибеков effect).
+    def _flip_phases(self, t_start: Any, t_end: Any) -> tuple[float, float] | None:
+        """The phases u at t_start and t_end (ascending), or None if the body never flips.
 
         A flip is a sign change of the momentum component along the intermediate
         principal axis while the body turns over: m2 ∝ sn(u) vanishes at u = 2jK in
-        cases (i) and (ii), so the flips are the exact times t = t0 + (2jK + ν)/λ,
-        every period/2; on the separatrix there is one, at u = 0.
-
+        cases (i) and (ii), every period/2; on the separatrix there is one, at u = 0.
         The body turns over only if the intermediate axis swings from near +m to
         near −m: we count flips when the amplitude of m2 exceeds G/√2 (that axis
         comes within 45° of the angular momentum).  Below, m2 changes sign too, but
-        as part of a nutation about the spin axis, not as a flip.  Empty also for a
+        as part of a nutation about the spin axis, not as a flip.  None also for a
         body without a distinct intermediate axis (I1 = I2 or I2 = I3).
         """
         t_start = as_si_scalar(t_start, "time", "t_start")
@@ -646,15 +748,70 @@ class EulerSolver:
         f = self._formula
         I1, I2, I3 = self._I_preferred
         if not (I1 < I2 < I3) or f.name not in ("i", "ii", "iii") or f.λ == 0.0:
-            return np.empty(0)
-        u_a, u_b = sorted((f.λ * (t_start - self._t0) - f.ν, f.λ * (t_end - self._t0) - f.ν))
+            return None
+        if not math.isfinite(f.ν):  # a steady spin about the intermediate axis
+            return None
+        if f.name != "iii" and (f.B21 if f.name == "i" else f.B23) <= self._G * math.sqrt(0.5):
+            return None
+        phases = []
+        for name, t in (("t_start", t_start), ("t_end", t_end)):
+            u = f.λ * (t - self._t0) - f.ν
+            if not math.isfinite(u):
+                raise InputError(
+                    f"{name} = {t!r} s is too far from t0 = {self._t0!r} s: the phase of the "
+                    f"motion, {f.λ:.3g} rad/s times {name} - t0, exceeds the float range"
+                )
+            phases.append(u)
+        u_a, u_b = sorted(phases)
+        return u_a, u_b
+
+    def flip_count(self, t_start: float, t_end: float) -> int:
+        """The number of flips in [t_start, t_end], in closed form (no array is built).
+
+        The count of j with 2jK in [u(t_start), u(t_end)] (``flip_times`` says what a
+        flip is): floor(u_b/2K) − ceil(u_a/2K) + 1, exact for the float phases u;
+        0 or 1 on the separatrix.  A flip within rounding of t_start or t_end (a few
+        ulps of λ(t − t0)) may be counted on either side.
+        """
+        phases = self._flip_phases(t_start, t_end)
+        if phases is None:
+            return 0
+        u_a, u_b = phases
+        f = self._formula
         if f.name == "iii":
-            zeros_u = np.array([0.0]) if u_a <= 0.0 <= u_b else np.empty(0)
+            return int(u_a <= 0.0 <= u_b)
+        return max(0, math.floor(u_b / (2.0 * f.K)) - math.ceil(u_a / (2.0 * f.K)) + 1)
+
+    def flip_times(
+        self, t_start: float, t_end: float, limit: int = 10_000_000
+    ) -> NDArray[np.float64]:
+        """Times in [t_start, t_end] at which the body flips (the Джанибеков effect).
+
+        The exact times t = t0 + (2jK + ν)/λ, every period/2, at which the momentum
+        component along the intermediate axis changes sign while the body turns over
+        (see ``_flip_phases``); on the separatrix there is one, at u = 0.  Empty if
+        the body never turns over.
+
+        A span with more than ``limit`` flips (80 MB of float64 at the default) is
+        refused with an InputError naming the count: ``flip_count`` gives the count
+        alone, at no cost, for any span.
+        """
+        count = self.flip_count(t_start, t_end)
+        if count > limit:
+            count_text = str(count) if count < 10**12 else f"{float(count):.4g}"
+            raise InputError(
+                f"flip_times({t_start!r}, {t_end!r}): the body flips {count_text} times in "
+                f"this span ({count * 8 / 2**30:.3g} GiB of float64), beyond limit={limit}; "
+                "ask for a shorter span, or flip_count() for the number alone"
+            )
+        if count == 0:
+            return np.empty(0)
+        u_a, _ = self._flip_phases(t_start, t_end)
+        f = self._formula
+        if f.name == "iii":
+            zeros_u = np.array([0.0])
         else:
-            if (f.B21 if f.name == "i" else f.B23) <= self._G * math.sqrt(0.5):
-                return np.empty(0)
-            j = np.arange(math.ceil(u_a / (2 * f.K)), math.floor(u_b / (2 * f.K)) + 1)
-            zeros_u = 2.0 * j * f.K
+            zeros_u = 2.0 * f.K * (float(math.ceil(u_a / (2.0 * f.K))) + np.arange(count))
         return np.sort(self._t0 + (zeros_u + f.ν) / f.λ)
 
     # ----------------------------------------------------------------- properties
