@@ -5,9 +5,11 @@ A float64 integrator cannot be the authority near the separatrix (DOP853 at rtol
 day) and mpmath's Taylor integrator would need ~11 h for a day.  So the reference is
 a *second* closed form, from a different derivation than the package's solver
 (Celledoni et al. with Leroy's corrections, preferred axes, Carlson kernels in
-float64): A. Jadczyk's formulas in
-``shared/references/jadczyk-attitude-matrix-and-quaternion-formulas.md``, evaluated
-with mpmath's ``ellipfun``, ``ellipk``, ``ellipf`` and ``ellippi`` at 40 digits.
+float64): A. Jadczyk's formulas (blog posts of March 2017 on the free rigid body,
+http://arkadiusz-jadczyk.eu/blog/category/elliptic-functions/: "Attitude matrix and
+quaternion path for m>1" and "The final answer for the Universe in which m<1"),
+evaluated with mpmath's ``ellipfun``, ``ellipk``, ``ellipf`` and ``ellippi`` at 40
+digits.
 
 Jadczyk's setting: sorted moments I1 < I2 < I3, a unit angular momentum |L| = 1 and
 d = 2T/|L|².  We scale the problem to it: L = m/G, I'j = Ij/I2 and the dimensionless

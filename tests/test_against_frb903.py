@@ -1,15 +1,19 @@
 """EulerSolver against ACM TOMS Algorithm 903 (FRB, Celledoni and Zanna, 2010).
 
-The example quoted in shared/references/jadczyk-attitude-matrix-and-quaternion-formulas.md
-("Example Four"): I = (1, 1.012686988782515, 3.306237422473038),
+E. Celledoni and A. Zanna, "Algorithm 903: FRB — Fortran routines for the exact
+computation of free rigid body motions", ACM Trans. Math. Softw. 37(2), 2010.  Its
+"Example Four", as run and printed by A. Jadczyk ("The final answer for the Universe
+in which m<1", 6 March 2017, http://arkadiusz-jadczyk.eu/blog/2017/03/06/, and
+"Attitude matrix for m<1", http://arkadiusz-jadczyk.eu/blog/2017/03/attitude-matrix-m1/):
+I = (1, 1.012686988782515, 3.306237422473038),
 m0 = (−0.544332842491675, 0.729131780907662, −0.414811526666455), identity attitude
 at t = 0, state at t = 10.
 
-Convention mapping (checked in shared/references/README.md against a rebuild of the
-Fortran): FRB's quaternion is scalar first and represents the body → space rotation
-(dq/dt = ½ q ⊗ (0, ω)): it is our ``attitude(t).as_quat(scalar_first=True)`` up to
-the sign of the whole quaternion.  The matrix printed in the reference is the
-transpose, Rᵀ, of our ``attitude(t).as_matrix()``.
+Convention mapping (checked against a rebuild of the Fortran): FRB's quaternion is
+scalar first and represents the body → space rotation (dq/dt = ½ q ⊗ (0, ω)): it is
+our ``attitude(t).as_quat(scalar_first=True)`` up to the sign of the whole
+quaternion.  The matrix printed in the reference is the transpose, Rᵀ, of our
+``attitude(t).as_matrix()``.
 
 The Fortran was run with its quadrature option (NP = 5), not its exact elliptic
 integral, so its printed digits are good to about 1e-9 only: we reproduce them to
