@@ -160,6 +160,7 @@ class Elliptic:
         self.C = (G / w(self.λ != 0.0, self.λ, 1.0)) * (w(case_ii, I31, I13) / I1 / I3)
         self.ψ_rate = w(case_ii, G / I1, G / I3)
         self.ν = self._phase(m1, m2, m3, G, xp)
+        self.Π_minus_K = self.parameter.complete_pi_minus_k(self.n, xp)
 
     @property
     def period(self) -> Any:
@@ -221,7 +222,7 @@ class Elliptic:
         a, b, c = self.A_s * sn, self.A_c * cn, self.A_d * dn
         if not with_ψ:
             return a, b, c, None
-        Π_minus_F = self.parameter.pi_minus_f(j, r, sn_r, cn_r, dn_r, self.n, xp)
+        Π_minus_F = self.parameter.pi_minus_f(j, r, sn_r, cn_r, dn_r, self.n, self.Π_minus_K, xp)
         ψ = (
             self.ψ_rate * τ
             + self.C * Π_minus_F
@@ -471,10 +472,10 @@ class ManyStates:
         m1, m2, m3 = m.T
         G = norm(m1, m2, m3, np)
         self.G = G
-        case = np.full(N, "rest", dtype=object)
+        case = np.full(N, _CODE["rest"], dtype=np.int8)
         sphere = (G > 0.0) & (I1 == I3)
         general = (G > 0.0) & ~sphere
-        case[sphere] = "steady"
+        case[sphere] = _CODE["steady"]
         g = np.flatnonzero(general)
         mc = np.full(N, np.nan)
         log_mc = np.full(N, np.nan)
@@ -482,61 +483,64 @@ class ManyStates:
         δ3 = np.zeros(N)
         if g.size:
             inv = invariants(I1[g], I2[g], I3[g], m1[g], m2[g], m3[g], np)
-            case[g] = np.where(inv.sign < 0.0, "i", np.where(inv.sign > 0.0, "ii", "iii"))
+            case[g] = np.where(
+                inv.sign < 0.0, _CODE["i"], np.where(inv.sign > 0.0, _CODE["ii"], _CODE["iii"])
+            )
             mc[g], log_mc[g], δ1[g], δ3[g] = inv.mc, inv.log_mc, inv.δ1, inv.δ3
-        flip1 = (m1 < 0.0) & ((case == "i") | (case == "iii"))
-        flip3 = (m3 < 0.0) & ((case == "ii") | (case == "iii") | (case == "steady"))
+        elliptic = (case == _CODE["i"]) | (case == _CODE["ii"])
+        flip1 = (m1 < 0.0) & ((case == _CODE["i"]) | (case == _CODE["iii"]))
+        flip3 = (m3 < 0.0) & ((case == _CODE["ii"]) | (case == _CODE["iii"]))
+        flip3 |= (m3 < 0.0) & (case == _CODE["steady"])
         flips = np.stack(preferred_flips(flip1, flip3, np), axis=-1)
         m = flips * m
-        m1, m2, m3 = m.T
         self.groups: list[tuple[np.ndarray, CaseFormula]] = []
-        # Elliptic, in the two regimes of the kernels; a rate that underflows is steady.
+
+        def constants(k):
+            inv_k = Invariants(None, δ1[k], δ3[k], mc[k], log_mc[k])
+            return (I1[k], I2[k], I3[k], m[k, 0], m[k, 1], m[k, 2], G[k], inv_k)
+
         with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+            # Elliptic, in the two regimes of the kernels; a rate that underflows is steady.
             for near_one in (False, True):
-                k = np.flatnonzero(
-                    ((case == "i") | (case == "ii")) & ((mc < NEAR_ONE_MC) == near_one)
-                )
+                k = np.flatnonzero(elliptic & ((mc < NEAR_ONE_MC) == near_one))
                 if not k.size:
                     continue
-                inv_k = Invariants(None, δ1[k], δ3[k], mc[k], log_mc[k])
-                args = (I1[k], I2[k], I3[k], m1[k], m2[k], m3[k], G[k], inv_k)
-                formula = Elliptic(*args, case[k] == "ii", near_one, np)
+                formula = Elliptic(*constants(k), case[k] == _CODE["ii"], near_one, np)
                 still = formula.λ != 0.0
                 if not np.all(still):
                     lost = k[~still]
-                    case[lost] = "steady"
-                    more = np.where(m3[lost] < 0.0, -1.0, 1.0)
-                    flips[lost, 1] *= more
-                    flips[lost, 2] *= more
-                    m[lost, 1] *= more
-                    m[lost, 2] *= more
+                    case[lost] = _CODE["steady"]
+                    sign3 = np.where(m[lost, 2] < 0.0, -1.0, 1.0)  # Steady's flip of m3
+                    more = np.stack([np.ones_like(sign3), sign3, sign3], axis=-1)
+                    flips[lost] *= more
+                    m[lost] *= more
                     k = k[still]
-                    inv_k = Invariants(None, δ1[k], δ3[k], mc[k], log_mc[k])
-                    args = (I1[k], I2[k], I3[k], m[k, 0], m[k, 1], m[k, 2], G[k], inv_k)
-                    formula = Elliptic(*args, case[k] == "ii", near_one, np)
+                    if k.size:
+                        formula = Elliptic(*constants(k), case[k] == _CODE["ii"], near_one, np)
                 if k.size:
                     self.groups.append((k, formula))
-            m1, m2, m3 = m.T
-            k = np.flatnonzero(case == "iii")
+            k = np.flatnonzero(case == _CODE["iii"])
             if k.size:
-                inv_k = Invariants(None, δ1[k], δ3[k], mc[k], log_mc[k])
-                formula = Separatrix(I1[k], I2[k], I3[k], m1[k], m2[k], m3[k], G[k], inv_k, np)
-                case[k[formula.onto_e1]] = "iii-e1"
+                formula = Separatrix(*constants(k), np)
+                case[k[formula.onto_e1]] = _CODE["iii-e1"]
                 self.groups.append((k, formula))
-            for name, make in (
-                ("steady", lambda k: Steady(I1[k], I2[k], I3[k], m1[k], m2[k], m3[k], G[k], np)),
-                ("rest", lambda k: Rest()),
-            ):
-                k = np.flatnonzero(case == name)
-                if k.size:
-                    self.groups.append((k, make(k)))
-        self.case = case
+            k = np.flatnonzero(case == _CODE["steady"])
+            if k.size:
+                self.groups.append((k, Steady(*constants(k)[:7], np)))
+            k = np.flatnonzero(case == _CODE["rest"])
+            if k.size:
+                self.groups.append((k, Rest()))
         # P[k] = r_sign[k] f[r_index[k]] s[r_index[k]] principal[order[r_index[k]]].
-        r_index = np.array([RELABEL[c][0] for c in case]).reshape(N, 3)
-        r_sign = np.array([RELABEL[c][1] for c in case], dtype=float).reshape(N, 3)
+        r_index = _RELABEL_INDEX[case]
         self.index = np.take_along_axis(order, r_index, axis=1)
         self.sign = (
-            r_sign
+            _RELABEL_SIGN[case]
             * np.take_along_axis(flips, r_index, axis=1)
             * np.take_along_axis(sorted_signs, r_index, axis=1)
         )
+
+
+# The relabelling of each case as arrays indexed by a small integer code, for batches.
+_CODE = {name: code for code, name in enumerate(RELABEL)}
+_RELABEL_INDEX = np.array([RELABEL[name][0] for name in RELABEL])
+_RELABEL_SIGN = np.array([RELABEL[name][1] for name in RELABEL], dtype=float)

@@ -441,14 +441,16 @@ def pi_minus_f_near_one(j: Any, r: Any, sn: Any, n: Any, K: Any, xp: Any = np) -
     the quasi-periodicity ([OLBC10] 19.2.10 for F and Π) each half period adds the
     complete value n/(1 − n) (K − A(1)).  The error is below mc K ≈ 2^-121.
     """
+    A_sn, A_1 = _arctan_integral(sn, n, xp), _arctan_integral(1.0, n, xp)
+    return (n / (1.0 - n)) * ((r - A_sn) + 2.0 * j * (K - A_1))
+
+
+def _arctan_integral(x: Any, n: Any, xp: Any) -> Any:
+    """A(x) = ∫₀^x ds/(1 − n s²) = arctan(√−n x)/√−n for n ≤ 0 (x in the limit n → 0)."""
     a = xp.sqrt(-n)
     positive = a > 0.0
-    a_safe = xp.where(positive, a, 1.0)  # A(x) = x in the limit n → 0
-
-    def A(x):
-        return xp.where(positive, xp.arctan(a_safe * x) / a_safe, x)
-
-    return (n / (1.0 - n)) * ((r - A(sn)) + 2.0 * j * (K - A(1.0)))
+    a_safe = xp.where(positive, a, 1.0)
+    return xp.where(positive, xp.arctan(a_safe * x) / a_safe, x)
 
 
 # ----------------------------------------------------------------- the solver's interface
@@ -498,17 +500,29 @@ class JacobiParameter:
         sign = _parity_sign(j, xp)
         return sign * sn_r, sign * cn_r, dn_r
 
-    def pi_minus_f(self, j: Any, r: Any, sn: Any, cn: Any, dn: Any, n: Any, xp: Any) -> Any:
-        """Π(am u, n) − u from the reduced functions (``pi_minus_f`` or its near-one form)."""
+    def complete_pi_minus_k(self, n: Any, xp: Any) -> Any:
+        """Π(n|m) − K(m): what Π(am u, n) − u gains over each half period 2K.
+
+        (n/3) R_J(0, mc, 1, 1 − n) ([OLBC10] 19.25.2), or n/(1 − n) (K − A(1)) near
+        m = 1 (``pi_minus_f_near_one``).  A constant of the state: computed once.
+        """
         if self.near_one:
-            return pi_minus_f_near_one(j, r, sn, n, self.K, xp)
-        if xp is FLOAT:  # pi_minus_f without its numpy tests (a numpy call costs ~1 µs)
+            return (n / (1.0 - n)) * (self.K - _arctan_integral(1.0, n, xp))
+        value = (n / 3.0) * special.elliprj(0.0, self.mc, 1.0, 1.0 - n)
+        return float(value) if xp is FLOAT else value
+
+    def pi_minus_f(
+        self, j: Any, r: Any, sn: Any, cn: Any, dn: Any, n: Any, complete: Any, xp: Any
+    ) -> Any:
+        """Π(am u, n) − u for u = 2jK + r, from the reduced functions and
+        ``complete = complete_pi_minus_k(n)``: ``pi_minus_f`` or its near-one form."""
+        if self.near_one:
+            incomplete = (n / (1.0 - n)) * (r - _arctan_integral(sn, n, xp))
+        else:
             c2, s2 = cn * cn, sn * sn
-            value = sn * s2 * float(special.elliprj(c2, dn * dn, 1.0, c2 + (1.0 - n) * s2))
-            if j != 0.0:
-                value += 2.0 * j * float(special.elliprj(0.0, self.mc, 1.0, 1.0 - n))
-            return (n / 3.0) * value
-        return pi_minus_f(j, sn, cn, dn, n, self.mc)
+            r_j = special.elliprj(c2, dn * dn, 1.0, c2 + (1.0 - n) * s2)
+            incomplete = (n / 3.0) * sn * s2 * (float(r_j) if xp is FLOAT else r_j)
+        return incomplete + 2.0 * j * complete
 
     def f_of_sin_cos(self, s: Any, c: Any, xp: Any) -> Any:
         """F(φ|m) for sin φ = s, cos φ = c, φ ∈ (−π, π] (mc ≥ ``NEAR_ONE_MC``).
