@@ -432,7 +432,22 @@ class EulerSolver:
 
     @property
     def kinetic_energy(self) -> float:
-        """T = ½ Σ mj²/Ij, J (conserved)."""
+        """T = ½ Σ mj²/Ij, J (conserved).
+
+        Raises an InputError, naming its size, for a state whose energy is beyond the
+        float range (|m| above ~1e154 N m s on unit moments), whose motion is computed.
+        """
+        if not math.isfinite(self._kinetic_energy):
+            I1, I2, I3 = self._state.I
+            m1, m2, m3 = self._state.preferred
+            G = self._G
+            x2_over_I = (m1 / G) ** 2 / I1 + (m2 / G) ** 2 / I2 + (m3 / G) ** 2 / I3
+            log10_T = 2.0 * math.log10(G) + math.log10(0.5 * x2_over_I)
+            raise InputError(
+                f"the kinetic energy of angular_momentum {self._initial_angular_momentum.tolist()}"
+                f" with moments {self._axes.moments.tolist()}, about 1e{log10_T:.0f} J, is "
+                "beyond the float range"
+            )
         return self._kinetic_energy
 
     @property

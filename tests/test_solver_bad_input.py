@@ -155,3 +155,11 @@ def test_states_next_to_the_separatrix_are_accepted(inertia, m0):
     solver = EulerSolver(inertia, m0)
     assert solver.formula == "i" and 0.0 < solver.mc < 1e-300
     assert np.isfinite(solver.period)
+
+
+def test_an_energy_beyond_the_float_range_is_named_not_inf():
+    """|m| = 1.4e200 on unit moments: the motion is computed, T (~1e400 J) is refused."""
+    solver = EulerSolver(GOOD_I, [1e200, 1e200, 0.0])
+    assert np.all(np.isfinite(solver.angular_momentum([0.0, 1e-200])))
+    with pytest.raises(InputError, match=r"kinetic energy .* about 1e400 J, is beyond the float"):
+        solver.kinetic_energy  # noqa: B018
