@@ -11,9 +11,9 @@ PACKAGE = Path(__file__).parents[1] / "attitude"
 
 # In order; a module may import modules of its own layer or of earlier ones.
 LAYERS = [
-    ["version", "errors", "quantities", "quaternions", "vectors"],  # shared base
+    ["version", "errors", "quantities", "quaternions", "vectors", "float_math"],  # shared base
     ["elliptic"],  # elliptic kernels
-    ["inertia", "euler_solver"],  # the Euler solver
+    ["inertia", "invariants", "closed_form", "euler_solver", "free_flow"],  # the Euler solver
     ["timescales", "spacecraft", "events", "scenario"],  # spacecraft, scenario and events
     ["trajectory", "motion_analysis"],  # trajectory
     ["ephemeris", "orbit", "eclipse", "pointing", "intervals"],  # pointing (skyfield)
