@@ -13,7 +13,7 @@ PACKAGE = Path(__file__).parents[1] / "attitude"
 LAYERS = [
     ["version", "errors", "quantities", "quaternions", "vectors"],  # shared base
     ["elliptic"],  # elliptic kernels
-    ["inertia", "euler_solver"],  # the Euler solver
+    ["inertia", "euler_solver", "free_flow"],  # the Euler solver and its free-flow map
     ["timescales", "spacecraft", "events", "scenario"],  # spacecraft, scenario and events
     ["trajectory", "motion_analysis"],  # trajectory
     ["ephemeris", "orbit", "eclipse", "pointing", "intervals"],  # pointing (skyfield)
