@@ -4,6 +4,8 @@ The layers, each importing only the ones above it in this list (README "Layout")
 
 - ``attitude.elliptic``: Jacobi functions and elliptic integrals in mc = 1 − m
 - ``attitude.euler_solver``: ``EulerSolver``, the closed-form torque-free rigid body
+- ``attitude.torques``, ``splitting``, ``torqued_solver``: ``TorquedSolver``, torques
+  (gravity gradient, constant torques, user torques) by splitting with the exact free flow
 - ``attitude.spacecraft``, ``events``, ``scenario``, ``timescales``: the scenario layer
 - ``attitude.trajectory``, ``motion_analysis``: the propagated motion
 - ``attitude.ephemeris``, ``orbit``, ``eclipse``, ``pointing``, ``intervals``: pointing
@@ -28,6 +30,12 @@ from attitude.euler_solver import EulerSolver
 from attitude.version import __version__
 
 _LAZY = {
+    "TorquedSolver": "attitude.torqued_solver",
+    "propagate_batch": "attitude.torqued_solver",
+    "departure_time": "attitude.torqued_solver",
+    "GravityGradient": "attitude.torques",
+    "ConstantTorque": "attitude.torques",
+    "UserTorque": "attitude.torques",
     "Spacecraft": "attitude.spacecraft",
     "InitialState": "attitude.scenario",
     "Scenario": "attitude.scenario",
