@@ -211,7 +211,8 @@ class StepChoice:
     error (rad) over [t0, t0 + span]: the largest angle between the runs at ``step``
     and ``2·step``, over ``checks`` times spread over the span, divided by 2^p − 1
     (Richardson, p the classical order; conservative when the error falls faster, as
-    for the near-integrable methods).  ``tried``: (step, estimate) of every pair run.
+    for the near-integrable methods).  ``tried``: (step, estimate) of every pair run;
+    the step adopted is within a factor 1.25 of the largest that passed.
     """
 
     step: float
@@ -294,7 +295,7 @@ class TorquedSolver:
     :class:`~attitude.torques.ConstantTorque`, :class:`~attitude.torques.UserTorque`
     (a bare callable ``torque(t, attitude, angular_velocity)`` is taken as the last).
 
-    The method: ``order`` 2 (Strang), 4 (default: ABA(10,6,4) of Blanes et al. 2013,
+    The method: ``order`` 2 (Strang), 4 (the default: ABA(10,6,4) of Blanes et al. 2013,
     whose error is O(εh¹⁰ + ε²h⁶ + ε³h⁴) for a torque ε times smaller than the free
     dynamics), or 6 (SRKN₁₁ᵇ of Blanes & Moan 2002, best when the torque is not
     small, e.g. a gravity-gradient-stabilized body; needs torques independent of ω);
@@ -317,7 +318,7 @@ class TorquedSolver:
         t0: float = 0.0,
         torques: Any = (),
         step: float | None = None,
-        order: int | None = 4,
+        order: int | None = None,
         *,
         method: str | None = None,
         tolerance: float | None = None,
@@ -326,7 +327,7 @@ class TorquedSolver:
         self._free = EulerSolver(inertia, angular_momentum, attitude, t0)  # validates all three
         self._t0 = self._free.t0
         self._torques = as_torque_list(torques)
-        self.method = composition(None if method is not None else order, method)
+        self.method = composition(4 if order is None and method is None else order, method)
         if self.method.needs_rkn and any(t.depends_on_angular_velocity for t in self._torques):
             raise InputError(
                 f"method {self.method.name!r} (order {self.method.order}) needs torques that do "
@@ -382,40 +383,46 @@ class TorquedSolver:
             raise InputError(f"span must be positive (s), got {span}")
         p = self.method.order
         checks = self._t0 + span * np.linspace(1.0 / 32.0, 1.0, 32)
-        h = min(span, self._initial_step())
-        coarse = self._new_propagation(h)
-        q_coarse = coarse.states(checks)[1]
+
+        def estimate(step: float) -> tuple[float, _Propagation]:
+            """Richardson estimate of the error of the run at ``step`` (from 2 step)."""
+            fine = self._new_propagation(step)
+            coarse = self._new_propagation(2.0 * step)
+            difference = np.max(_angles(coarse.states(checks)[1], fine.states(checks)[1]))
+            return float(difference) / (2.0**p - 1.0), fine
+
+        # Search on the adopted step s, within a factor 1.25 of the largest that passes:
+        # the error model C s^p to move, bisection (in log s) once bracketed.
+        step = min(0.5 * span, 0.5 * self._initial_step())
+        good: tuple[float, float, _Propagation] | None = None
+        bad = math.inf
         tried = []
-        best = None
-        for _ in range(12):
-            fine = self._new_propagation(0.5 * h)
-            q_fine = fine.states(checks)[1]
-            difference = float(np.max(_angles(q_coarse, q_fine)))
-            estimate = difference / (2.0**p - 1.0)
-            tried.append((0.5 * h, estimate))
-            if estimate <= tolerance:
-                best = (fine, 0.5 * h, estimate)
-                if estimate > tolerance / 100.0 or h >= span:
-                    break
-            # Error model C h^p: the coarse step that would give 0.5 tolerance on its
-            # half, bounded to a factor 8 either way; after a success only larger steps.
-            factor = (0.5 * tolerance / max(estimate, 1e-300)) ** (1.0 / p)
-            factor = min(4.0, max(0.125, factor))
-            if best is not None and factor <= 1.0:
-                break
-            if factor == 0.5 or (0.45 < factor < 0.55):
-                coarse, q_coarse, h = fine, q_fine, 0.5 * h
+        for _ in range(10):
+            error, propagation = estimate(step)
+            tried.append((step, error))
+            if error <= tolerance:
+                if good is None or step > good[0]:
+                    good = (step, error, propagation)
             else:
-                h = min(span, h * factor)
-                coarse = self._new_propagation(h)
-                q_coarse = coarse.states(checks)[1]
-        if best is None:
+                bad = min(bad, step)
+            factor = (0.5 * tolerance / max(error, 1e-300)) ** (1.0 / p)
+            if good is not None and math.isfinite(bad):
+                if bad / good[0] < 1.25:
+                    break
+                step = math.sqrt(good[0] * bad)
+            elif good is not None:
+                if factor < 1.25 or step >= 0.5 * span:
+                    break
+                step = min(0.5 * span, step * min(4.0, factor))
+            else:
+                step *= min(0.8, max(0.125, factor))
+        if good is None:
             raise InputError(
                 f"tolerance {tolerance:g} rad over {span:g} s not reached: the estimate was "
                 f"{tried[-1][1]:.3g} rad at a step of {tried[-1][0]:.3g} s"
             )
-        propagation, step, estimate = best
-        self.step_choice = StepChoice(step, estimate, tolerance, span, tuple(tried), len(checks))
+        step, error, propagation = good
+        self.step_choice = StepChoice(step, error, tolerance, span, tuple(tried), len(checks))
         return propagation
 
     def _initial_step(self) -> float:
@@ -531,7 +538,7 @@ def propagate_batch(
     times: ArrayLike = (),
     torques: Any = (),
     step: float = 5.0,
-    order: int | None = 4,
+    order: int | None = None,
     *,
     method: str | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -572,7 +579,7 @@ def propagate_batch(
     if not step > 0.0:
         raise InputError(f"step must be positive (s), got {step}")
     torques = as_torque_list(torques)
-    chosen = composition(None if method is not None else order, method)
+    chosen = composition(4 if order is None and method is None else order, method)
     frame = PrincipalFrame(tuple(moments[..., i] for i in range(3)))
     engine = _Engine(chosen, torques, frame, moments)
     breakpoints = np.array(sorted({b for t in torques for b in t.breakpoints if b > t0}))
