@@ -55,6 +55,8 @@ _DENSE_CHUNK = 8192
 # A step may exceed the nominal one by this fraction rather than leave a sliver
 # before a breakpoint.
 _SLIVER = 1e-6
+# More steps than this in one request (hours of computing) is refused as a mistake.
+_MAX_STEPS = 1e8
 
 
 # ----------------------------------------------------------------- the step engine
@@ -240,6 +242,12 @@ class _Propagation:
 
     def extend_to(self, t_max: float) -> None:
         e = self.engine
+        if (t_max - self.t_end) / self.step > _MAX_STEPS:
+            raise InputError(
+                f"t = {t_max:g} s is {(t_max - self.t_end) / self.step:.3g} steps of "
+                f"{self.step:g} s ahead: more than {_MAX_STEPS:g} steps; use a larger step "
+                "or a shorter span"
+            )
         while self.t_end < t_max:
             starts, sizes = _grid_steps(
                 self.t_end, t_max, self.step, self.breakpoints, _CHUNK_STEPS
@@ -356,11 +364,11 @@ class TorquedSolver:
             sorted({b for t in self._torques for b in t.breakpoints if b > self._t0})
         )
         self.step_choice: StepChoice | None = None
-        if tolerance is not None:
+        if tolerance is not None and self._torques:
             if step is not None:
                 raise InputError("give either step or tolerance, not both")
             self._propagation = self._choose_step(tolerance, span)
-        else:
+        else:  # (a tolerance without torques: the exact solver needs no step)
             step = 5.0 if step is None else as_si_scalar(step, "time", "step")
             if not step > 0.0:
                 raise InputError(f"step must be positive (s), got {step}")

@@ -192,3 +192,10 @@ def test_batch_input_is_checked():
         propagate_batch([[1.0, 2.0, 3.0]] * 2, [M0] * 3, None, 0.0, [1.0], [gg])
     with pytest.raises(InputError, match="increasing"):
         propagate_batch(INERTIA, [M0], None, 0.0, [5.0, 1.0], [gg])
+
+
+def test_a_huge_span_is_refused_not_hung():
+    solver = TorquedSolver(INERTIA, M0, torques=[GravityGradient(circular)], step=1.0)
+    with pytest.raises(InputError, match="steps"):
+        solver.attitude(1e12)
+    assert np.all(np.isfinite(solver.attitude_quaternion(3.0)))  # still usable after
