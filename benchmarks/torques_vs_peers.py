@@ -36,8 +36,6 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
-import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,8 +44,10 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
+from benchmarks.__main__ import _LoadSampler, _machine
 from benchmarks.peer_basilisk import availability as basilisk_availability
 from benchmarks.peer_basilisk import mrp_to_quaternion, quaternion_to_mrp
+from benchmarks.peer_scipy import euler_rhs
 from benchmarks.reference import quaternion_angle
 
 HERE = Path(__file__).parent
@@ -100,56 +100,6 @@ def position(t):
     return RADIUS * np.stack([np.cos(N * t), np.sin(N * t), np.zeros_like(t)], axis=-1)
 
 
-# ----------------------------------------------------------------- the machine and the load
-
-
-def _machine() -> dict:
-    from importlib.metadata import PackageNotFoundError, version
-
-    cpu = ""
-    try:
-        cpu = next(
-            line.split(":", 1)[1].strip()
-            for line in Path("/proc/cpuinfo").read_text().splitlines()
-            if line.startswith("model name")
-        )
-    except (OSError, StopIteration):
-        pass
-    versions = {}
-    for package in ("numpy", "scipy", "bsk"):
-        try:
-            versions[package] = version(package)
-        except PackageNotFoundError:
-            versions[package] = None
-    return {"cpu": cpu, "cores": os.cpu_count(), "versions": versions}
-
-
-class _Load:
-    """The 1-minute load average every 10 s while the benchmark runs."""
-
-    def __init__(self) -> None:
-        self.samples: list[float] = []
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._loop, daemon=True)
-
-    def _loop(self) -> None:
-        while not self._stop.is_set():
-            self.samples.append(os.getloadavg()[0])
-            self._stop.wait(10.0)
-
-    def __enter__(self):
-        self._thread.start()
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self._stop.set()
-        self._thread.join()
-
-    def summary(self) -> dict:
-        s = self.samples or [os.getloadavg()[0]]
-        return {"min": min(s), "mean": sum(s) / len(s), "max": max(s)}
-
-
 def _timed(function, *args):
     """(result, best wall time): a warm-up, then the best of up to 5 runs under 1 s."""
     function(*args)
@@ -171,12 +121,12 @@ def _timed(function, *args):
 
 
 def _rhs(t, y, inertia):
-    """Euler's equations with the gravity-gradient torque, and the kinematics (q scalar first)."""
-    m, (w, x, yy, z) = y[:3], y[3:]
-    ω = m / inertia
+    """The torque-free right-hand side of the scipy peer, plus the gravity-gradient torque."""
+    derivative = euler_rhs(t, y, 1.0 / inertia)
+    w, x, yy, z = y[3:]
     r = position(t)
     radius = math.sqrt(r @ r)
-    # r̂ in body axes: Rᵀ r̂, R the body → inertial matrix of q.
+    # r̂ in body axes: Rᵀ r̂, R the body → inertial matrix of q (scalar first).
     R = np.array(
         [
             [1 - 2 * (yy * yy + z * z), 2 * (x * yy - w * z), 2 * (x * z + w * yy)],
@@ -185,17 +135,8 @@ def _rhs(t, y, inertia):
         ]
     )
     u = R.T @ (r / radius)
-    τ = 3 * MU / radius**3 * np.cross(u, inertia * u)
-    dm = np.cross(m, ω) + τ
-    dq = 0.5 * np.array(
-        [
-            -x * ω[0] - yy * ω[1] - z * ω[2],
-            w * ω[0] + yy * ω[2] - z * ω[1],
-            w * ω[1] + z * ω[0] - x * ω[2],
-            w * ω[2] + x * ω[1] - yy * ω[0],
-        ]
-    )
-    return np.concatenate([dm, dq])
+    derivative[:3] += 3 * MU / radius**3 * np.cross(u, inertia * u)
+    return derivative
 
 
 def dop853(problem: Problem, times, rtol: float, q0=Q0, omega0=None, inertia=None):
@@ -302,9 +243,18 @@ def jacobi(inertia, q, ω, r):
 
 
 def _cheapest(ladder: list[dict], error: float) -> dict | None:
-    """The cheapest ladder run at least as accurate as ``error`` (ladder from large steps)."""
-    passing = [row for row in ladder if row["error"] <= error]
-    return min(passing, key=lambda row: row["wall_s"]) if passing else None
+    """The largest ladder step that, with every smaller step, is within ``error``.
+
+    Not merely the cheapest passing run: the error is not monotonic in the step
+    (resonances), and a user choosing any step up to the one quoted must get the error
+    quoted.
+    """
+    chosen = None
+    for row in sorted(ladder, key=lambda row: row["step"]):
+        if row["error"] > error:
+            break
+        chosen = row
+    return chosen
 
 
 def _errors(q, q_ref) -> dict:
@@ -518,8 +468,9 @@ def _markdown(report: dict) -> str:
     m = report["machine"]
     load = report["load"]
     lines.append(
-        f"Machine: {m['cpu']}, {m['cores']} cores; numpy {m['versions']['numpy']}, scipy "
-        f"{m['versions']['scipy']}, bsk {m['versions']['bsk']}. Load average during the run: "
+        f"Machine: {m['cpu']}, {m['cores']} cores, {m['memory']}; numpy "
+        f"{m['versions']['numpy']}, scipy {m['versions']['scipy']}, bsk {m['versions']['bsk']}. "
+        "Load average during the run: "
         f"min {load['min']:.2f}, mean {load['mean']:.2f}, max {load['max']:.2f}. "
         f"Free flow: {report['free_flow']}."
     )
@@ -608,7 +559,7 @@ def main(argv=None) -> dict:
         "free_flow": "provisional (one EulerSolver per state)" if provisional else "vectorized",
     }
     started = time.perf_counter()
-    with _Load() as load:
+    with _LoadSampler() as load:
         report["single"] = []
         for problem in (TUMBLER, SPINNER):
             log(f"{problem.name}:")
