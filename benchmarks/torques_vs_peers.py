@@ -403,16 +403,26 @@ def long_run(days: float, step: float, have_basilisk: str | None, log) -> dict:
     marks = np.array([d for d in (1, 3, 10, 30, 100) if d <= days] or [days], dtype=float) * 86400.0
     samples = np.linspace(0.0, span, int(days * 24) + 1)  # hourly, for the Jacobi integral
     path = DATA / f"reference_torqued_tumbler_{days:g}d.npz"
-    if path.exists():
-        stored = np.load(path)
+    meta = json.dumps(
+        {
+            "inertia": TUMBLER.inertia,
+            "omega0": TUMBLER.omega0,
+            "q0": Q0,
+            "mu": MU,
+            "radius": RADIUS,
+            "rtol": 1e-13,
+        }
+    )
+    stored = np.load(path) if path.exists() else None
+    if stored is not None and np.array_equal(stored["t"], marks) and str(stored["meta"]) == meta:
         q_ref = stored["q"]
         log(f"  reference: cached {path.name}")
     else:
-        log(f"  reference: DOP853 rtol 1e-13 over {days:g} days (minutes) ...")
+        log(f"  reference: DOP853 rtol 1e-13 over {days:g} days (about half an hour) ...")
         q_ref, _ = dop853(TUMBLER, np.concatenate([[0.0], marks]), 1e-13)
         q_ref = q_ref[1:]
         DATA.mkdir(exist_ok=True)
-        np.savez_compressed(path, t=marks, q=q_ref)
+        np.savez_compressed(path, t=marks, q=q_ref, meta=meta)
     inertia = np.asarray(TUMBLER.inertia)
     begin = time.perf_counter()
     solver = TorquedSolver(
