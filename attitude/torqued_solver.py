@@ -97,7 +97,15 @@ class _Engine:
         if isinstance(m[0], float):
             m_new, q_new = advance(self.moments, np.array(m), np.array(q), dt)
             return tuple(m_new.tolist()), tuple(q_new.tolist())
-        m_new, q_new = advance(self.moments, np.stack(m, axis=-1), np.stack(q, axis=-1), dt)
+        m_array = np.stack(np.broadcast_arrays(*m), axis=-1)
+        n = m_array.shape[0]
+        # Every argument at its full (N, ...) shape: the free flow need not broadcast.
+        m_new, q_new = advance(
+            np.broadcast_to(self.moments, (n, 3)),
+            m_array,
+            np.stack(np.broadcast_arrays(*q), axis=-1),
+            np.broadcast_to(np.asarray(dt, dtype=np.float64), (n,)),
+        )
         return tuple(m_new.T), tuple(q_new.T)
 
     def torque(self, data, m, q):
