@@ -4,6 +4,8 @@ The layers, each importing only the ones above it in this list (README "Layout")
 
 - ``attitude.elliptic``: Jacobi functions and elliptic integrals in mc = 1 − m
 - ``attitude.euler_solver``: ``EulerSolver``, the closed-form torque-free rigid body
+- ``attitude.torques``, ``splitting``, ``torqued_solver``: ``TorquedSolver``, torques
+  (gravity gradient, constant torques, user torques) by splitting with the exact free flow
 - ``attitude.spacecraft``, ``events``, ``scenario``, ``timescales``: the scenario layer
 - ``attitude.trajectory``, ``motion_analysis``: the propagated motion
 - ``attitude.ephemeris``, ``orbit``, ``eclipse``, ``pointing``, ``intervals``: pointing
@@ -38,10 +40,18 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.scenario import InitialState, Scenario
     from attitude.scenario_file import load_scenario
     from attitude.spacecraft import Spacecraft
+    from attitude.torqued_solver import TorquedSolver, departure_time, propagate_batch
+    from attitude.torques import ConstantTorque, GravityGradient, UserTorque
     from attitude.trajectory import Trajectory, propagate
 
 _LAZY = {
     "EulerSolver": "attitude.euler_solver",
+    "TorquedSolver": "attitude.torqued_solver",
+    "propagate_batch": "attitude.torqued_solver",
+    "departure_time": "attitude.torqued_solver",
+    "GravityGradient": "attitude.torques",
+    "ConstantTorque": "attitude.torques",
+    "UserTorque": "attitude.torques",
     "Spacecraft": "attitude.spacecraft",
     "InitialState": "attitude.scenario",
     "Scenario": "attitude.scenario",
@@ -67,7 +77,9 @@ __all__ = [
     "AttitudeError",
     "AttitudeReset",
     "BodyVector",
+    "ConstantTorque",
     "EulerSolver",
+    "GravityGradient",
     "InertiaChange",
     "InertiaWarning",
     "InitialState",
@@ -76,13 +88,17 @@ __all__ = [
     "Scenario",
     "Spacecraft",
     "TleOrbit",
+    "TorquedSolver",
     "Trajectory",
+    "UserTorque",
     "__version__",
     "analyze",
     "compute_pointing",
+    "departure_time",
     "load_scenario",
     "produce",
     "propagate",
+    "propagate_batch",
     "write_aem",
 ]
 

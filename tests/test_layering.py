@@ -14,6 +14,7 @@ LAYERS = [
     ["version", "errors", "quantities", "quaternions", "vectors", "float_math"],  # shared base
     ["elliptic"],  # elliptic kernels
     ["inertia", "invariants", "closed_form", "euler_solver", "free_flow"],  # the Euler solver
+    ["torques", "splitting", "torqued_solver"],  # torques and splitting
     ["timescales", "spacecraft", "events", "scenario"],  # spacecraft, scenario and events
     ["trajectory", "motion_analysis"],  # trajectory
     ["ephemeris", "orbit", "eclipse", "pointing", "intervals"],  # pointing (skyfield)
