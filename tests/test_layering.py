@@ -14,7 +14,7 @@ LAYERS = [
     ["version", "errors", "quantities", "quaternions", "vectors"],  # shared base
     ["elliptic"],  # elliptic kernels
     ["inertia", "euler_solver"],  # the Euler solver
-    ["timescales", "spacecraft", "events", "scenario"],  # spacecraft, scenario and events
+    ["timescales", "epoch_texts", "spacecraft", "events", "scenario"],  # scenario and events
     ["trajectory", "motion_analysis"],  # trajectory
     ["ephemeris", "orbit", "eclipse", "pointing", "intervals"],  # pointing (skyfield)
     [  # reports and exports
