@@ -20,6 +20,7 @@ LAYERS = [
     [  # reports and exports
         "exports",
         "aem",
+        "aem_sampling",
         "plots",
         "report_page",
         "output_budget",
