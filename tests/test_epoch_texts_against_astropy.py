@@ -6,7 +6,8 @@ the leap seconds of 2015-06-30 and 2016-12-31 (UTC's 23:59:60), in every scale, 
 the years 0001 and 9999, and before 1972 (where UTC drifted from TAI), the texts are
 equal character for character.  At random instants they are equal except where the
 exact instant lies within 0.03 ns of half a nanosecond: astropy's two-part Julian
-dates carry 0.005 to 0.02 ns of rounding (more in TDB and TCB, converted twice), and the two round that tie differently.
+dates carry 0.005 to 0.02 ns of rounding (more in TDB and TCB, converted twice), and
+the two round that tie differently.
 """
 
 from fractions import Fraction

@@ -19,10 +19,13 @@ LAYERS = [
     ["ephemeris", "orbit", "eclipse", "pointing", "intervals"],  # pointing (skyfield)
     [  # reports and exports
         "exports",
+        "timeseries_parquet",
         "aem",
         "aem_sampling",
         "plots",
+        "report_figures",
         "report_page",
+        "output_formats",
         "output_budget",
         "run_plan",
         "output_folder",
