@@ -13,6 +13,11 @@ shares the machine).  Peak RSS is each child's own (``os.wait4``).
     python -m benchmarks.report_one_day --days 30 --repeat 1  # the 30-day case (slow)
     python -m benchmarks.report_one_day --days 30 --no-peer   # this tree only
     python -m benchmarks.report_one_day --formats parquet,aem # passed to this tree's run
+    python -m benchmarks.report_one_day --days 30 --no-pointing  # the trajectory alone
+    python -m benchmarks.report_one_day --days 30 --no-peer --blocked-orbit
+
+A peer that refuses the run (main before streaming refuses 30 days with pointing: its
+memory estimate is 19.5 GB) is reported as refused, with its message.
 
 Targets (issue 9): one day in ≤ 45% of the peer's time; peak RSS ≤ 600 MB at 30 days.
 Results go to stdout and to benchmarks/results/report_<days>d.json.
@@ -37,10 +42,11 @@ RESULTS = Path(__file__).parent / "results"
 PEER_COMMIT = "52ad360"
 
 
-def scenario_text(days: float) -> str:
+def scenario_text(days: float, pointing: bool = True) -> str:
     text = (ROOT / "scenarios" / "spinner_thruster_pulse.toml").read_text()
     text = re.sub(r"(?m)^duration = .*$", f"duration = {days * 86400.0!r}", text)
-    return re.sub(r"(?m)^step = .*$", "step = 1.0", text)
+    text = re.sub(r"(?m)^step = .*$", "step = 1.0", text)
+    return text if pointing else text.split("[pointing]")[0]
 
 
 def export_peer(commit: str, folder: Path) -> Path:
@@ -52,10 +58,12 @@ def export_peer(commit: str, folder: Path) -> Path:
     return folder
 
 
-def run_once(tree: Path, scenario: Path, out: Path, extra: list[str]) -> dict:
+def run_once(
+    tree: Path, scenario: Path, out: Path, extra: list[str], module: str = "attitude.cli"
+) -> dict:
     """One ``attitude run`` of ``tree``'s package: wall time, peak RSS, stages, sizes."""
-    environment = dict(os.environ, PYTHONPATH=str(tree))
-    command = [sys.executable, "-m", "attitude.cli", "run", str(scenario), "--out", str(out)]
+    environment = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tree), str(ROOT)]))
+    command = [sys.executable, "-m", module, "run", str(scenario), "--out", str(out)]
     start = time.perf_counter()
     process = subprocess.Popen(
         command + extra, cwd=tree, env=environment, stderr=subprocess.PIPE, text=True
@@ -85,14 +93,21 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--peer-commit", default=PEER_COMMIT)
     parser.add_argument("--no-peer", action="store_true")
     parser.add_argument("--formats", help="--formats for this tree's runs")
+    parser.add_argument("--no-pointing", action="store_true", help="without [pointing]")
+    parser.add_argument(
+        "--blocked-orbit",
+        action="store_true",
+        help="this tree with the TLE orbit sampled in blocks (benchmarks/blocked_orbit_run.py)",
+    )
     args = parser.parse_args(argv)
     extra = ["--formats", args.formats] if args.formats else []
     load_before = os.getloadavg()
     runs: dict[str, list[dict]] = {"this": [], "peer": []}
+    refused: dict[str, str] = {}
     with tempfile.TemporaryDirectory() as folder:
         folder = Path(folder)
         scenario = folder / "scenario.toml"
-        scenario.write_text(scenario_text(args.days))
+        scenario.write_text(scenario_text(args.days, not args.no_pointing))
         trees = {"this": ROOT}
         if not args.no_peer:
             peer = folder / "peer"
@@ -100,8 +115,20 @@ def main(argv: list[str] | None = None) -> dict:
             trees["peer"] = export_peer(args.peer_commit, peer)
         for repeat in range(args.repeat):
             for name, tree in trees.items():
+                if name in refused:
+                    continue
                 out = folder / f"out-{name}-{repeat}"
-                runs[name].append(run_once(tree, scenario, out, extra if name == "this" else []))
+                try:
+                    module = "attitude.cli"
+                    if name == "this" and args.blocked_orbit:
+                        module = "benchmarks.blocked_orbit_run"
+                    runs[name].append(
+                        run_once(tree, scenario, out, extra if name == "this" else [], module)
+                    )
+                except RuntimeError as exc:
+                    refused[name] = str(exc)
+                    print(f"{name:4s} refused: {exc}", flush=True)
+                    continue
                 print(
                     f"{name:4s} run {repeat + 1}: {runs[name][-1]['wall_s']:7.1f} s wall, "
                     f"{runs[name][-1]['peak_rss_mb']:7.0f} MB peak RSS",
@@ -114,12 +141,15 @@ def main(argv: list[str] | None = None) -> dict:
 
     report = {
         "case": f"spinner_thruster_pulse.toml over {args.days:g} days at 1 s "
-        f"({int(args.days * 86400) + 1} epochs), TLE orbit, 3 body vectors",
+        f"({int(args.days * 86400) + 1} epochs)"
+        + (", no pointing" if args.no_pointing else ", TLE orbit, 3 body vectors"),
+        "refused": refused,
         "machine": f"{platform.machine()}, {os.cpu_count()} cores, {platform.system()} "
         f"{platform.release()}, Python {platform.python_version()}",
         "load_average_1min": {"before": load_before[0], "after": load_after[0]},
         "peer_commit": None if args.no_peer else args.peer_commit,
         "formats": args.formats or "default",
+        "blocked_orbit": args.blocked_orbit,
         "runs": runs,
         "median_wall_s": {name: median(name, "wall_s") for name in runs},
         "median_cpu_s": {name: median(name, "cpu_s") for name in runs},
@@ -132,7 +162,10 @@ def main(argv: list[str] | None = None) -> dict:
         report["cpu_ratio_this_to_peer"] = median("this", "cpu_s") / median("peer", "cpu_s")
     report["wall_s_per_day"] = median("this", "wall_s") / args.days
     RESULTS.mkdir(exist_ok=True)
-    path = RESULTS / f"report_{args.days:g}d.json"
+    suffix = ("_no_pointing" if args.no_pointing else "") + (
+        "_blocked_orbit" if args.blocked_orbit else ""
+    )
+    path = RESULTS / f"report_{args.days:g}d{suffix}.json"
     path.write_text(json.dumps(report, indent=2) + "\n")
     print(f"case: {report['case']}; load {load_before[0]:.2f} -> {load_after[0]:.2f}")
     for name in runs:
