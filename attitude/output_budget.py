@@ -13,11 +13,12 @@ rotation, over the whole span, and an interval per turn) is bounded too: a searc
 more than :data:`MAX_SEARCH_GRID_POINTS` samples (hours of computing, and an
 intervals file of a line or more per turn) is refused with the sizes.
 
-The figures are measured (``benchmarks/report_outputs.py``, on the 2-core
-development machine, with a margin of about 1.3): peak RSS of a streamed run with
-pointing 250–330 MB whatever the span; per sample, 20 bytes of CSV per
-shortest-round-trip number plus 30 for the epoch, 12 bytes of Parquet per column
-(zstd), 190 bytes per AEM record.
+The figures are measured (``benchmarks/report_one_day.py`` and
+``report_outputs.py``, docs/benchmarks.md, on the 2-core development machine, with
+margins of 1.3 to 1.5): peak RSS 195–215 MB for one day or 30 at 1 s (the time series;
+with a TLE the orbit's nodes and the intervals add to it); 651 bytes a row of CSV for
+41 columns (15 a shortest round-trip number, 30 the epoch), 6.2 bytes a column of
+Parquet (zstd), 187 bytes an AEM record.
 """
 
 from __future__ import annotations
@@ -50,7 +51,7 @@ _MEMORY_PER_CHUNK_SAMPLE_PER_VECTOR = 500
 # of the Parquet file (zstd; the text and tt_ns included); a record of the AEM.
 _CSV_TIME_BYTES = 31
 _CSV_BYTES_PER_COLUMN = 20
-_PARQUET_BYTES_PER_COLUMN = 12
+_PARQUET_BYTES_PER_COLUMN = 8
 _AEM_BYTES_PER_RECORD = 190
 _PLOT_BYTES = 250_000
 _SUMMARY_BYTES = 50_000

@@ -568,7 +568,9 @@ def _build(
                     following = float(output_grid(scenario, first + chunk, first + chunk + 1)[0])
                 pointing = source_of_pointing.stream(τ, following)
             stream.add(τ, samples, pointing)
-            if time.perf_counter() - shown > _PROGRESS_EVERY_S and first + chunk < count:
+            # After the first chunk (a stream has started), then every few seconds.
+            late = first == 0 or time.perf_counter() - shown > _PROGRESS_EVERY_S
+            if late and first + chunk < count:
                 shown = time.perf_counter()
                 progress(f"  {100.0 * (first + chunk) / count:.0f}% ({first + chunk} epochs)")
     files = list(stream.files)

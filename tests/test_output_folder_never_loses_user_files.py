@@ -279,7 +279,7 @@ def _run_until(folder: Path, scenario: Path, out: Path, stage: str) -> subproces
     [
         (signal.SIGINT, 130, "sampling"),
         (signal.SIGTERM, 143, "sampling"),
-        (signal.SIGINT, 130, "% ("),  # in the middle of the stream: a chunk is written
+        (signal.SIGINT, 130, "% ("),  # in the middle of the stream: a chunk was written
         (signal.SIGTERM, 143, "writing attitude.aem"),
         (signal.SIGINT, 130, "plotting"),
     ],
@@ -287,8 +287,8 @@ def _run_until(folder: Path, scenario: Path, out: Path, stage: str) -> subproces
 )
 def test_a_signal_stops_the_run_with_one_line_and_no_leftovers(user_folder, number, code, stage):
     folder, _ = user_folder
-    # Long enough that the stream reports its progress (every 2 s) before it ends.
-    scenario = _scenario(folder, duration=600000.0, name="long.toml")
+    # Long enough for several chunks (the stream reports after its first).
+    scenario = _scenario(folder, duration=150000.0, name="long.toml")
     out = folder / "out"
     # A previous run of ours, which must survive the interrupted one untouched.
     assert main(["run", str(folder / "scenario.toml"), "--out", str(out), "--quiet"]) == 0
