@@ -202,7 +202,8 @@ def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str
                     ],
                 )
             )
-    parts.append("<h2>Plots</h2>")
+    if images:
+        parts.append("<h2>Plots</h2>")
     for caption, name in images.items():
         parts.append(
             f"<figure><img src='{escape(name)}' alt='{escape(caption)}'>"
@@ -211,6 +212,14 @@ def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str
     parts.append("<h2>Files</h2><ul>")
     parts += [f"<li><a href='{escape(f)}'>{escape(f)}</a></li>" for f in files]
     parts.append("</ul>")
+    aem = summary.get("outputs", {}).get("aem")
+    if aem:
+        parts.append(
+            f"<p class='note'>attitude.aem: {aem['records']} records, sampled so that "
+            "LAGRANGE interpolation as declared (degree 7, each quaternion component over the "
+            "8 records centred on the interval, normalized) stays within "
+            f"{aem['tolerance_rad']:g} rad of the exact attitude.</p>"
+        )
     parts.append(
         "<p class='note'>Frames: body = spacecraft body axes; ICRF axes for inertial vectors. "
         "Quaternions are scalar first and rotate body coordinates into ICRF "

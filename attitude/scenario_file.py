@@ -26,8 +26,10 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from attitude.aem_sampling import check_tolerance
 from attitude.errors import InertiaWarning, InputError
 from attitude.events import AngularImpulse, AttitudeReset, InertiaChange
+from attitude.output_formats import DEFAULT_FORMATS, OutputChoice, parse_formats
 from attitude.pointing import BodyVector, PointingSpec
 from attitude.quantities import convert_unit
 from attitude.scenario import InitialState, Scenario
@@ -56,6 +58,7 @@ class ScenarioFile:
     path: Path
     scenario: Scenario
     pointing: PointingSpec = field(default_factory=PointingSpec)
+    outputs: OutputChoice = field(default_factory=OutputChoice)
 
 
 class _Table:
@@ -404,7 +407,7 @@ def load_scenario(path: str | Path) -> ScenarioFile:
     events = _events(root, scale)
 
     output = root.table("output")
-    output.allow("start", "stop", "duration", "step")
+    output.allow("start", "stop", "duration", "step", "formats", "aem_tolerance")
     if output.has("stop") == output.has("duration"):
         output.fail("give exactly one of stop (ISO 8601) and duration (seconds)")
     stop = output.epoch("stop", scale, required=False)
@@ -426,7 +429,26 @@ def load_scenario(path: str | Path) -> ScenarioFile:
     except InputError as exc:
         end = "stop" if stop is not None else "duration"
         raise ScenarioFileError(f"{path.name}: {_scenario_key(str(exc), end)}") from None
-    return ScenarioFile(path, scenario, _pointing(root))
+    return ScenarioFile(path, scenario, _pointing(root), _outputs(output))
+
+
+def _outputs(output: _Table) -> OutputChoice:
+    """``formats`` (a list of names) and ``aem_tolerance`` (an angle, with its unit)."""
+    formats = output.raw("formats", required=False, default=list(DEFAULT_FORMATS))
+    if not isinstance(formats, list):
+        output.fail(f"expected a list of format names, got {_short(formats)}", "formats")
+    try:
+        formats = parse_formats(formats, "formats")
+    except InputError as exc:
+        output.fail(str(exc).removeprefix("formats: "), "formats")
+    tolerance = output.quantity("aem_tolerance", "angle", (), required=False)
+    if tolerance is None:
+        return OutputChoice(formats)
+    try:
+        check_tolerance(tolerance, "aem_tolerance")
+    except InputError as exc:
+        output.fail(str(exc).removeprefix("aem_tolerance: "), "aem_tolerance")
+    return OutputChoice(formats, tolerance)
 
 
 def _scenario_key(message: str, end: str) -> str:

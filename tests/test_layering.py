@@ -15,14 +15,18 @@ LAYERS = [
     ["elliptic"],  # elliptic kernels
     ["inertia", "invariants", "closed_form", "euler_solver", "free_flow"],  # the Euler solver
     ["torques", "splitting", "torqued_solver"],  # torques and splitting
-    ["timescales", "spacecraft", "events", "scenario"],  # spacecraft, scenario and events
+    ["timescales", "epoch_texts", "spacecraft", "events", "scenario"],  # scenario and events
     ["trajectory", "motion_analysis"],  # trajectory
     ["ephemeris", "orbit", "eclipse", "pointing", "intervals"],  # pointing (skyfield)
     [  # reports and exports
         "exports",
+        "timeseries_parquet",
         "aem",
+        "aem_sampling",
         "plots",
+        "report_figures",
         "report_page",
+        "output_formats",
         "output_budget",
         "run_plan",
         "output_folder",
