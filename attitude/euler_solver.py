@@ -96,6 +96,8 @@ class EulerSolver:
     t0
         Epoch of the initial state, seconds (the solver's own time origin).
 
+    Notes
+    -----
     The attitude at t is ``Q(t) = R ∘ Y(ψ(t) − ψ(t0)) ∘ P(t) ∘ S`` (module docstring),
     built so that ``Q(t0)`` is the given attitude and nothing is singular anywhere
     on the sphere of momenta.  All evaluations accept a scalar or an array of times
