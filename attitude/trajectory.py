@@ -197,7 +197,10 @@ class Trajectory:
         )
 
     def attitude(self, times: Any) -> Rotation:
-        """Rotation body → inertial (ICRF axes): one for a scalar time, a stack for 1-D."""
+        """Rotation body → inertial (ICRF axes): one for a scalar time, a stack for 1-D.
+
+        Its ``as_quat()`` is scalar last (scipy's default); ``attitude_quaternion``
+        gives the same rotation scalar first (docs/conventions.md)."""
         return Rotation.from_quat(self.attitude_quaternion(times, scalar_first=False))
 
     def angular_momentum(self, times: Any) -> NDArray[np.float64]:
