@@ -131,6 +131,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "BODY_FRAME",
+    "QUATERNION_COMMENT",
     "REFERENCE_FRAMES",
     "TIME_SYSTEMS",
     "AemSegment",
@@ -141,6 +142,13 @@ __all__ = [
 AEM_VERSION = "2.0"
 ATTITUDE_TYPE = "QUATERNION/ANGVEL"
 BODY_FRAME = "SC_BODY_1"
+# Every message says how to read its quaternions (docs/conventions.md): AEM v2 has no
+# QUATERNION_TYPE keyword (annex J), the order is fixed scalar last.
+QUATERNION_COMMENT = (
+    "quaternion Q1 Q2 Q3 QC: scalar last (QC = cos(angle/2)), from REF_FRAME_A to "
+    "REF_FRAME_B as in annex F: the rotation taking body coordinates into REF_FRAME_A "
+    "coordinates"
+)
 # Our inertial axes are the ICRS axes.  The GCRS axes are the same axes; only the origin
 # differs, and an attitude does not depend on the origin.  Other frames (EME2000, ...)
 # would need a rotation, so they are refused rather than mislabelled.
@@ -311,7 +319,7 @@ class AemWriter:
             f"TIME_SYSTEM = {self.time_system}",
         ]
         lines = [f"CCSDS_AEM_VERS = {AEM_VERSION}"]
-        lines += _comment_lines(_checked_comments("comments", comments))
+        lines += _comment_lines([*_checked_comments("comments", comments), QUATERNION_COMMENT])
         lines.append(f"CREATION_DATE = {_creation_date(creation_date)}")
         lines.append(f"ORIGINATOR = {_text_value('originator', originator)}")
         _check_line_lengths(lines + self._frames)

@@ -83,6 +83,7 @@ class CaseFormula(Protocol):
 
     name: str
     period: Any
+    mc: Any  # the complementary parameter 1 − m (0 on the separatrix, NaN if none)
 
     def momentum(self, τ: Any, xp: Any) -> tuple[Any, Any, Any]: ...
 

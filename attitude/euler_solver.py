@@ -42,7 +42,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from attitude.closed_form import CaseFormula, Elliptic, OneState, p_quaternion, y_times_p
+from attitude.closed_form import (
+    CaseFormula,
+    Elliptic,
+    OneState,
+    Separatrix,
+    p_quaternion,
+    y_times_p,
+)
 from attitude.errors import InputError
 from attitude.float_math import FLOAT
 from attitude.inertia import PrincipalAxes, principal_axes
@@ -89,6 +96,8 @@ class EulerSolver:
     t0
         Epoch of the initial state, seconds (the solver's own time origin).
 
+    Notes
+    -----
     The attitude at t is ``Q(t) = R ∘ Y(ψ(t) − ψ(t0)) ∘ P(t) ∘ S`` (module docstring),
     built so that ``Q(t0)`` is the given attitude and nothing is singular anywhere
     on the sphere of momenta.  All evaluations accept a scalar or an array of times
@@ -130,7 +139,8 @@ class EulerSolver:
         Refuses a state whose angular velocity |m|/I1 is beyond the float range.
         """
         m_principal = m_body if axes.is_diagonal else axes.body_to_principal.apply(m_body)
-        moments = tuple(float(v) for v in axes.moments)
+        I1, I2, I3 = axes.moments
+        moments = (float(I1), float(I2), float(I3))
         momentum = tuple(float(v) for v in m_principal)
         G = math.hypot(*momentum)  # math.hypot scales: no overflow of the squares
         if not math.isfinite(G / min(moments)):
@@ -310,12 +320,12 @@ class EulerSolver:
         t_end = as_si_scalar(t_end, "time", "t_end")
         f = self._formula
         I1, I2, I3 = self._state.I
-        if not (I1 < I2 < I3) or f.name not in ("i", "ii", "iii") or f.λ == 0.0:
+        if not (I1 < I2 < I3) or not isinstance(f, Elliptic | Separatrix) or f.λ == 0.0:
             return None
         if not math.isfinite(f.ν):  # a steady spin about the intermediate axis
             return None
         # The amplitude of m2 is |A_s| = B21 (case i) or B23 (case ii).
-        if f.name != "iii" and abs(f.A_s) <= self._G * math.sqrt(0.5):
+        if isinstance(f, Elliptic) and abs(f.A_s) <= self._G * math.sqrt(0.5):
             return None
         phases = []
         for name, t in (("t_start", t_start), ("t_end", t_end)):
@@ -342,7 +352,7 @@ class EulerSolver:
             return 0
         u_a, u_b = phases
         f = self._formula
-        if f.name == "iii":
+        if not isinstance(f, Elliptic):  # the separatrix (phases are None otherwise)
             return int(u_a <= 0.0 <= u_b)
         return max(0, math.floor(u_b / (2.0 * f.K)) - math.ceil(u_a / (2.0 * f.K)) + 1)
 
@@ -368,14 +378,17 @@ class EulerSolver:
                 f"this span ({count * 8 / 2**30:.3g} GiB of float64), beyond limit={limit}; "
                 "ask for a shorter span, or flip_count() for the number alone"
             )
-        if count == 0:
+        phases = self._flip_phases(t_start, t_end)
+        if count == 0 or phases is None:
             return np.empty(0)
-        u_a, _ = self._flip_phases(t_start, t_end)
+        u_a, _ = phases
         f = self._formula
-        if f.name == "iii":
+        if isinstance(f, Separatrix):
             zeros_u = np.array([0.0])
-        else:
+        elif isinstance(f, Elliptic):
             zeros_u = 2.0 * f.K * (float(math.ceil(u_a / (2.0 * f.K))) + np.arange(count))
+        else:  # pragma: no cover (phases are None for the other cases)
+            return np.empty(0)
         return np.sort(self._t0 + (zeros_u + f.ν) / f.λ)
 
     # ----------------------------------------------------------------- properties

@@ -49,7 +49,7 @@ class State:
     @property
     def angular_velocity(self) -> NDArray[np.float64]:
         """Body angular velocity, rad/s: I⁻¹ m."""
-        return np.linalg.solve(self.inertia.tensor, self.angular_momentum)
+        return np.asarray(np.linalg.solve(self.inertia.tensor, self.angular_momentum), np.float64)
 
     @property
     def kinetic_energy(self) -> float:

@@ -261,8 +261,8 @@ def _advance_many(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray, first: 
     q_new = np.stack(_hamilton(tuple(q.T), (step[:, 0], *v.T)), axis=-1)
     finite = np.isfinite(q_new).all(axis=1) & np.isfinite(m_new).all(axis=1)
     if not finite.all():
-        k = int(np.flatnonzero(~finite)[0])
-        raise InputError(_too_far(float(τ[k]), f"[{first + k}]"))
+        bad = int(np.flatnonzero(~finite)[0])
+        raise InputError(_too_far(float(τ[bad]), f"[{first + bad}]"))
     return m_new, q_new / np.linalg.norm(q_new, axis=1, keepdims=True)
 
 

@@ -15,6 +15,7 @@ state.  Every figure stays readable at any span:
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -221,7 +222,10 @@ def _shade(axes, spans_s: Sequence[tuple[float, float]], unit_s: float, low, hig
     axes.fill_between(x, low, high, where=inside, color="0.88", zorder=0, linewidth=0, label=label)
 
 
-def _zoom_panel(axes, zoom: Zoom, colors: dict[str, str], ylabel: str, scale=None) -> None:
+def _zoom_panel(axes, zoom: Zoom, colors: dict[str, str], ylabel: str, scale=None) -> float:
+    """The zoom's series on ``axes``; returns its time unit (s), which a caller's own
+    marks on the panel must use: the axis shows the time since the epoch, so the unit
+    follows the zoom's distance from the epoch as well as its span."""
     span = float(zoom.seconds[-1] - zoom.seconds[0]) if zoom.seconds.size > 1 else 0.0
     unit_s, label = time_unit(max(span, float(np.max(np.abs(zoom.seconds[[0, -1]])))))
     scale = scale or {}
@@ -240,6 +244,7 @@ def _zoom_panel(axes, zoom: Zoom, colors: dict[str, str], ylabel: str, scale=Non
     axes.set_ylabel(ylabel)
     axes.set_title(zoom.title)
     axes.grid(alpha=0.3)
+    return unit_s
 
 
 def plot_angular_velocity(
@@ -271,6 +276,30 @@ def plot_angular_velocity(
     return _save(figure, path)
 
 
+def _sun_angle_guides(
+    axes,
+    limits_deg: dict[str, float | None],
+    colors: dict[str, str],
+    shaded_s: Sequence[tuple[float, float]],
+    unit_s: float,
+) -> None:
+    """What a Sun-angle panel is read against: each vector's exclusion limit (dashed, in
+    its colour), the eclipses shaded, and the full 0-180° range."""
+    for name, limit in limits_deg.items():
+        if limit is not None:
+            axes.axhline(
+                limit,
+                color=colors.get(name, "k"),
+                linestyle="--",
+                linewidth=1.0,
+                label=f"{name} exclusion ({limit:g}°)",
+            )
+    _shade(axes, shaded_s, unit_s, 0.0, 180.0, "eclipse")
+    axes.set_ylim(0.0, 180.0)
+    axes.set_yticks(np.arange(0, 181, 30))
+    axes.grid(alpha=0.3)
+
+
 def plot_sun_angles(
     path: Path,
     envelope: Envelope,
@@ -281,38 +310,20 @@ def plot_sun_angles(
 ) -> str:
     """Sun angle of each body vector (deg), with its exclusion limit (dashed), the
     eclipses shaded, and an optional zoom panel."""
-    rows = 2 if zoom is not None else 1
-    figure, panels = _panels(rows, 3.6)
+    figure, panels = _panels(2 if zoom is not None else 1, 3.6)
     colors = {name: f"C{i}" for i, name in enumerate(envelope.names)}
-
-    def decorate(axes, shaded, unit_s):
-        for name, limit in limits_deg.items():
-            if limit is not None:
-                axes.axhline(
-                    limit,
-                    color=colors.get(name, "k"),
-                    linestyle="--",
-                    linewidth=1.0,
-                    label=f"{name} exclusion ({limit:g}°)",
-                )
-        _shade(axes, shaded, unit_s, 0.0, 180.0, "eclipse")
-        axes.set_ylim(0.0, 180.0)
-        axes.set_yticks(np.arange(0, 181, 30))
-        axes.grid(alpha=0.3)
-
     top = panels[0]
     unit_s, label = time_unit(envelope.stop_s - envelope.start_s)
     _draw_envelope(top, envelope, unit_s, colors)
-    decorate(top, shadow_s, unit_s)
+    _sun_angle_guides(top, limits_deg, colors, shadow_s, unit_s)
     top.set_xlim(envelope.start_s / unit_s, envelope.stop_s / unit_s)
     top.set_xlabel(label)
     top.set_ylabel("angle from the Sun (deg)")
     top.set_title(title or "Sun angle on the body vectors (band: range in each pixel column)")
     top.legend(loc="upper right", fontsize="small", ncols=2)
     if zoom is not None:
-        _zoom_panel(panels[1], zoom, colors, "angle from the Sun (deg)")
-        zoom_unit, _ = time_unit(float(np.ptp(zoom.seconds)))
-        decorate(panels[1], zoom.shaded_s, zoom_unit)
+        zoom_unit_s = _zoom_panel(panels[1], zoom, colors, "angle from the Sun (deg)")
+        _sun_angle_guides(panels[1], limits_deg, colors, zoom.shaded_s, zoom_unit_s)
     return _save(figure, path)
 
 
@@ -369,6 +380,96 @@ def plot_eclipse(
     return _save(figure, path)
 
 
+def _momentum_directions(
+    paths: Sequence[tuple[int, NDArray[np.float64]]],
+) -> list[tuple[int, NDArray[np.float64]]]:
+    """Each segment's unit momentum directions, where there is momentum (none at rest).
+    Scaled by the largest component first, so that no square overflows (|h| of 1e160
+    is a valid state)."""
+    directions = []
+    for k, h_body in paths:
+        scale = np.max(np.abs(h_body), axis=1, keepdims=True)
+        moving = scale[:, 0] > 0.0
+        if np.any(moving):
+            d = h_body[moving] / scale[moving]
+            directions.append((k, d / np.linalg.norm(d, axis=1, keepdims=True)))
+    return directions
+
+
+@dataclass(frozen=True)
+class _MeanView:
+    """The azimuthal equidistant view from the mean direction of the momentum: a unit
+    vector d is drawn at (θ cos φ, θ sin φ), θ its angle (deg) from ``mean`` and φ its
+    azimuth about it (from ``e1`` towards ``e2``); ``radius_deg``: the largest θ."""
+
+    mean: NDArray[np.float64]
+    e1: NDArray[np.float64]
+    e2: NDArray[np.float64]
+    radius_deg: float
+
+    @classmethod
+    def of(cls, directions: list[tuple[int, NDArray[np.float64]]]) -> _MeanView:
+        every = np.concatenate([d for _, d in directions])
+        mean = np.mean(every, axis=0)
+        # A motion symmetric about the origin (a flip) has no mean: view from its start.
+        mean = mean / np.linalg.norm(mean) if np.linalg.norm(mean) > 1e-6 else every[0]
+        e1, e2 = basis_across(mean)
+        radius = float(np.degrees(np.max(np.arccos(np.clip(every @ mean, -1.0, 1.0)))))
+        return cls(mean, e1, e2, radius)
+
+    def xy(self, d: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        angle = np.degrees(np.arccos(np.clip(d @ self.mean, -1.0, 1.0)))
+        azimuth = np.arctan2(d @ self.e2, d @ self.e1)
+        return angle * np.cos(azimuth), angle * np.sin(azimuth)
+
+
+def _unit_sphere(sphere) -> None:
+    u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 37), np.linspace(0, np.pi, 19))
+    sphere.plot_wireframe(
+        np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v), color="0.85", linewidth=0.5
+    )
+
+
+def _draw_on_sphere(sphere, directions: list[tuple[int, NDArray[np.float64]]]) -> None:
+    """The paths on the unit sphere, with the body axes, each path's start marked."""
+    for k, d in directions:
+        color = f"C{int(k) % 10}"
+        sphere.plot(d[:, 0], d[:, 1], d[:, 2], linewidth=1.2, color=color)
+        sphere.scatter(*d[0], s=12, color=color)
+    for i, name in enumerate("xyz"):
+        tip = np.eye(3)[i] * 1.15
+        sphere.plot([0, tip[0]], [0, tip[1]], [0, tip[2]], color="k", linewidth=0.8)
+        sphere.text(*tip, f"body {name}")
+    sphere.set_box_aspect((1, 1, 1))
+    sphere.set_axis_off()
+    sphere.set_title("on the unit sphere")
+
+
+def _draw_from_mean(flat, directions: list[tuple[int, NDArray[np.float64]]]) -> None:
+    """The paths seen from their mean direction, so that a small nutation cone is as
+    readable as a flip; the body axes that fall within the view, for orientation."""
+    view = _MeanView.of(directions)
+    for k, d in directions:
+        color = f"C{int(k) % 10}"
+        x, y = view.xy(d)
+        flat.plot(x, y, linewidth=1.0, color=color, label=f"segment {int(k)}")
+        flat.plot(x[0], y[0], "o", color=color, markersize=4)
+    for i, name in enumerate("xyz"):
+        [x], [y] = view.xy(np.eye(3)[i : i + 1])
+        if math.hypot(x, y) <= 1.2 * view.radius_deg + 0.5:
+            flat.plot(x, y, "k+", markersize=9)
+            flat.annotate(
+                f"body {name}", (x, y), textcoords="offset points", xytext=(4, 4), fontsize="small"
+            )
+    flat.set_aspect("equal", adjustable="datalim")
+    flat.set_xlabel("angle from the mean direction (deg)")
+    flat.set_ylabel("angle from the mean direction (deg)")
+    flat.grid(alpha=0.3)
+    flat.set_title("seen from the mean direction")
+    if len(directions) > 1:
+        flat.legend(loc="best", fontsize="small")
+
+
 def plot_polhode(
     path: Path, paths: Sequence[tuple[int, NDArray[np.float64]]], title: str = ""
 ) -> str:
@@ -383,73 +484,14 @@ def plot_polhode(
     figure.subplots_adjust(left=0.02, right=0.97, bottom=0.1, top=0.88, wspace=0.15)
     sphere = figure.add_subplot(1, 2, 1, projection="3d")
     flat = figure.add_subplot(1, 2, 2)
-    u, v = np.meshgrid(np.linspace(0, 2 * np.pi, 37), np.linspace(0, np.pi, 19))
-    sphere.plot_wireframe(
-        np.cos(u) * np.sin(v), np.sin(u) * np.sin(v), np.cos(v), color="0.85", linewidth=0.5
-    )
-    directions = []
-    for k, h_body in paths:
-        # Directions only where there is momentum (none at rest), scaled first so that no
-        # square overflows (|h| of 1e160 is a valid state).
-        scale = np.max(np.abs(h_body), axis=1, keepdims=True)
-        moving = scale[:, 0] > 0.0
-        if np.any(moving):
-            d = h_body[moving] / scale[moving]
-            directions.append((k, d / np.linalg.norm(d, axis=1, keepdims=True)))
     figure.suptitle(title or "Angular momentum direction in body axes (polhode)")
+    _unit_sphere(sphere)
+    directions = _momentum_directions(paths)
     if not directions:
         flat.text(0.5, 0.5, "at rest: no angular momentum", ha="center", va="center")
         flat.set_axis_off()
         sphere.set_axis_off()
         return _save(figure, path)
-    every = np.concatenate([d for _, d in directions])
-    mean = np.mean(every, axis=0)
-    mean = mean / np.linalg.norm(mean) if np.linalg.norm(mean) > 1e-6 else every[0]
-    e1, e2 = basis_across(mean)
-    radius = float(np.degrees(np.max(np.arccos(np.clip(every @ mean, -1.0, 1.0)))))
-    for k, d in directions:
-        color = f"C{int(k) % 10}"
-        sphere.plot(d[:, 0], d[:, 1], d[:, 2], linewidth=1.2, color=color)
-        sphere.scatter(*d[0], s=12, color=color)
-        angle = np.degrees(np.arccos(np.clip(d @ mean, -1.0, 1.0)))
-        azimuth = np.arctan2(d @ e2, d @ e1)
-        flat.plot(
-            angle * np.cos(azimuth),
-            angle * np.sin(azimuth),
-            linewidth=1.0,
-            color=color,
-            label=f"segment {int(k)}",
-        )
-        flat.plot(
-            angle[0] * np.cos(azimuth[0]),
-            angle[0] * np.sin(azimuth[0]),
-            "o",
-            color=color,
-            markersize=4,
-        )
-    for i, name in enumerate("xyz"):
-        tip = np.eye(3)[i] * 1.15
-        sphere.plot([0, tip[0]], [0, tip[1]], [0, tip[2]], color="k", linewidth=0.8)
-        sphere.text(*tip, f"body {name}")
-        axis_angle = np.degrees(np.arccos(np.clip(np.eye(3)[i] @ mean, -1.0, 1.0)))
-        if axis_angle <= 1.2 * radius + 0.5:  # the body axes within the view, for orientation
-            az = np.arctan2(np.eye(3)[i] @ e2, np.eye(3)[i] @ e1)
-            flat.plot(axis_angle * np.cos(az), axis_angle * np.sin(az), "k+", markersize=9)
-            flat.annotate(
-                f"body {name}",
-                (axis_angle * np.cos(az), axis_angle * np.sin(az)),
-                textcoords="offset points",
-                xytext=(4, 4),
-                fontsize="small",
-            )
-    sphere.set_box_aspect((1, 1, 1))
-    sphere.set_axis_off()
-    sphere.set_title("on the unit sphere")
-    flat.set_aspect("equal", adjustable="datalim")
-    flat.set_xlabel("angle from the mean direction (deg)")
-    flat.set_ylabel("angle from the mean direction (deg)")
-    flat.grid(alpha=0.3)
-    flat.set_title("seen from the mean direction")
-    if len(directions) > 1:
-        flat.legend(loc="best", fontsize="small")
+    _draw_on_sphere(sphere, directions)
+    _draw_from_mean(flat, directions)
     return _save(figure, path)

@@ -25,7 +25,7 @@ Time rules (what a user can rely on):
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -44,6 +44,9 @@ from attitude.timescales import (
     time_from_tt_seconds,
     tt_seconds,
 )
+
+if TYPE_CHECKING:  # astropy loads only when a Time is made
+    from astropy.time import Time
 
 __all__ = ["InitialState", "Scenario"]
 
@@ -219,7 +222,7 @@ class Scenario:
         """The astropy scale of the epoch, used for every epoch written out."""
         return self.epoch.scale
 
-    def times(self, seconds: Any):
+    def times(self, seconds: Any) -> Time:
         """``Time`` (in the scenario's scale) of TT ``seconds`` after the epoch."""
         t = time_from_tt_seconds(self.epoch, seconds)
         with offline_time():
@@ -246,7 +249,7 @@ class Scenario:
     def output_seconds(self) -> NDArray[np.float64]:
         """The output grid: start, start + step, ..., and stop (TT s since the epoch)."""
         count = int(np.floor((self.stop_s - self.start_s) / self.step_s * (1 + 1e-12))) + 1
-        grid = self.start_s + self.step_s * np.arange(count)
+        grid = self.start_s + self.step_s * np.arange(count, dtype=np.float64)
         if self.stop_s - grid[-1] > 1e-9 * self.step_s:
             grid = np.append(grid, self.stop_s)
         return grid

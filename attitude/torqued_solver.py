@@ -44,7 +44,7 @@ from attitude.free_flow import advance
 from attitude.inertia import principal_axes
 from attitude.quantities import as_si_array, as_si_scalar, as_vector3
 from attitude.splitting import Composition, composition
-from attitude.torques import PrincipalFrame, Torque, as_torque_list
+from attitude.torques import GravityGradient, PrincipalFrame, Torque, as_torque_list
 
 __all__ = ["StepChoice", "TorquedSolver", "departure_time", "propagate_batch"]
 
@@ -246,7 +246,7 @@ class _Propagation:
         self._pending = [np.array([0.0])]
         self._state = (tuple(m0), tuple(q0), 0.0)
         self.t_end = t0
-        self._arrays = None
+        self._arrays: tuple[NDArray[np.float64], ...] | None = None
 
     def extend_to(self, t_max: float) -> None:
         e = self.engine
@@ -443,13 +443,12 @@ class TorquedSolver:
 
     def _initial_step(self) -> float:
         """A quarter of the spin period, at most a twentieth of any orbit period."""
-        ω = np.linalg.norm(np.asarray(self._m0) / self._moments)
+        ω = float(np.linalg.norm(np.asarray(self._m0) / self._moments))
         candidates = [2.0 * math.pi / ω / 4.0] if ω > 0.0 else []
         for torque in self._torques:
-            mu = getattr(torque, "mu", None)
-            if mu is not None:
+            if isinstance(torque, GravityGradient):  # the one torque with an orbit period
                 radius = float(np.linalg.norm(torque.position(np.array([self._t0]))[0]))
-                candidates.append(2.0 * math.pi * math.sqrt(radius**3 / mu) / 20.0)
+                candidates.append(2.0 * math.pi * math.sqrt(radius**3 / torque.mu) / 20.0)
         return min(candidates) if candidates else 60.0
 
     # ----------------------------------------------------------------- evaluation

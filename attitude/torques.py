@@ -154,12 +154,14 @@ class GravityGradient(Torque):
     r), so a kick is a symplectic map and the splitting a Poisson integrator.
 
     ``position``: where the spacecraft is, in inertial axes (m), as
+
     - a callable t → position, t in seconds of the solver's time (an array), returning
       shape ``t.shape + (3,)``; or
     - an orbit object with a ``position(times)`` or ``position_velocity(times)``
       method taking ``astropy.time.Time`` (e.g. :class:`attitude.orbit.TleOrbit`);
       then ``epoch`` (an ``astropy.time.Time``, default the orbit's own ``epoch``) is
       the instant that the solver's t = 0 stands for.
+
     ``mu``: gravitational parameter μ of the central body, m³/s² (Earth: IERS 2010).
 
     Not modelled: the oblateness of the central body (J2 in the gradient, a relative

@@ -15,7 +15,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -26,6 +26,9 @@ from attitude.euler_solver import EulerSolver
 from attitude.events import Event, State
 from attitude.scenario import Scenario
 from attitude.timescales import SAME_INSTANT_S, tt_seconds
+
+if TYPE_CHECKING:  # astropy loads only when a Time is made
+    from astropy.time import Time
 
 __all__ = ["Segment", "Trajectory", "propagate"]
 
@@ -95,7 +98,8 @@ def propagate(scenario: Scenario) -> Trajectory:
     axes = scenario.spacecraft.principal_axes
     if initial.angular_momentum is not None:
         m0 = initial.angular_momentum
-    else:
+    else:  # InitialState holds exactly one of the two (checked when it is made)
+        assert initial.angular_velocity is not None
         m0 = axes.tensor @ initial.angular_velocity
     state = State(initial.attitude, m0, axes)
     starts: list[tuple[float, State, Event | None, State | None]] = [(0.0, state, None, None)]
@@ -135,7 +139,7 @@ class Trajectory:
         self._starts[0] = -np.inf
 
     @property
-    def epoch(self):
+    def epoch(self) -> Time:
         return self.scenario.epoch
 
     @property
@@ -193,7 +197,10 @@ class Trajectory:
         )
 
     def attitude(self, times: Any) -> Rotation:
-        """Rotation body → inertial (ICRF axes): one for a scalar time, a stack for 1-D."""
+        """Rotation body → inertial (ICRF axes): one for a scalar time, a stack for 1-D.
+
+        Its ``as_quat()`` is scalar last (scipy's default); ``attitude_quaternion``
+        gives the same rotation scalar first (docs/conventions.md)."""
         return Rotation.from_quat(self.attitude_quaternion(times, scalar_first=False))
 
     def angular_momentum(self, times: Any) -> NDArray[np.float64]:
@@ -219,11 +226,10 @@ class Trajectory:
 
     def flip_times(self) -> NDArray[np.float64]:
         """All Джанибеков flips over [epoch, stop], TT seconds since the epoch (closed form)."""
-        flips = [
+        per_segment = [
             segment.solver.flip_times(segment.start_s, segment.end_s) for segment in self.segments
         ]
-        flips = np.concatenate(flips) if flips else np.empty(0)
-        return np.unique(flips)
+        return np.unique(np.concatenate(per_segment) if per_segment else np.empty(0))
 
     def __repr__(self) -> str:
         return f"Trajectory({self.scenario.name!r}, {len(self.segments)} segments)"

@@ -332,47 +332,51 @@ def _find(report: dict, case: str, label_start: str) -> dict | None:
     return None
 
 
+def _speed_target(report: dict) -> dict | None:
+    """Case 1, one day: attitude against the fastest Basilisk setting that is as accurate,
+    or, when no setting run is, against the most accurate one (the target in a stronger
+    form: Basilisk pays that time and still misses the accuracy)."""
+    ours = _find(report, "dzhanibekov_1d", "attitude")
+    if not ours or ours["status"] != "ok":
+        return None
+    basilisk = [
+        r
+        for c in report["cases"]
+        if c["name"] == "dzhanibekov_1d"
+        for r in c["rows"]
+        if r["peer"] == "basilisk" and r["status"] == "ok"
+    ]
+    if not basilisk:
+        return None
+    reaching = [r for r in basilisk if r["worst_error_rad"] <= ours["worst_error_rad"]]
+    peer = (
+        min(reaching, key=lambda r: r["wall_s"])
+        if reaching
+        else min(basilisk, key=lambda r: r["worst_error_rad"])
+    )
+    ratio = peer["wall_s"] / ours["wall_s"]
+    if reaching:
+        detail = f"{peer['label']}: {ratio:.3g}x slower"
+    else:
+        detail = (
+            "in a stronger form: no Basilisk setting run reaches attitude's "
+            f"{ours['worst_error_rad']:.1e} rad; "
+            f"the most accurate one, {peer['label']} "
+            f"({peer['worst_error_rad']:.1e} rad, "
+            f"{peer['error_ratio']:.1e}x attitude's error), is {ratio:.3g}x slower"
+        )
+    return {
+        "target": "case 1, one day: attitude >= 100x faster than the Basilisk setting "
+        "that reaches the same worst-case accuracy",
+        "met": ratio >= 100,
+        "detail": detail,
+    }
+
+
 def _targets(report: dict) -> list[dict]:
     """The issue's figures, checked on this run's numbers."""
-    out = []
-    ours = _find(report, "dzhanibekov_1d", "attitude")
-    if ours and ours["status"] == "ok":
-        basilisk = [
-            r
-            for c in report["cases"]
-            if c["name"] == "dzhanibekov_1d"
-            for r in c["rows"]
-            if r["peer"] == "basilisk" and r["status"] == "ok"
-        ]
-        reaching = [r for r in basilisk if r["worst_error_rad"] <= ours["worst_error_rad"]]
-        if reaching:
-            fastest = min(reaching, key=lambda r: r["wall_s"])
-            ratio = fastest["wall_s"] / ours["wall_s"]
-            out.append(
-                {
-                    "target": "case 1, one day: attitude >= 100x faster than the Basilisk setting "
-                    "that reaches the same worst-case accuracy",
-                    "met": ratio >= 100,
-                    "detail": f"{fastest['label']}: {ratio:.3g}x slower",
-                }
-            )
-        elif basilisk:
-            best = min(basilisk, key=lambda r: r["worst_error_rad"])
-            ratio = best["wall_s"] / ours["wall_s"]
-            out.append(
-                {
-                    "target": "case 1, one day: attitude >= 100x faster than the Basilisk setting "
-                    "that reaches the same worst-case accuracy",
-                    "met": ratio >= 100,
-                    "detail": (
-                        "in a stronger form: no Basilisk setting run reaches attitude's "
-                        f"{ours['worst_error_rad']:.1e} rad; "
-                        f"the most accurate one, {best['label']} "
-                        f"({best['worst_error_rad']:.1e} rad, "
-                        f"{best['error_ratio']:.1e}x attitude's error), is {ratio:.3g}x slower"
-                    ),
-                }
-            )
+    speed = _speed_target(report)
+    out = [speed] if speed else []
     for case in ("dzhanibekov_1h", "dzhanibekov_1d"):
         rk4 = _find(report, case, "Basilisk RK4 0.1 s")
         if rk4 and rk4["status"] == "ok" and "error_ratio" in rk4:

@@ -25,7 +25,7 @@ from aem_read_back import parse, read_back
 from astropy.time import Time
 from scipy.spatial.transform import Rotation
 
-from attitude.aem import AemSegment, write_aem
+from attitude.aem import QUATERNION_COMMENT, AemSegment, write_aem
 from attitude.errors import InputError
 from attitude.timescales import offline_time, time_from_tt_seconds, tt_seconds
 
@@ -175,7 +175,7 @@ def test_90_degree_rotation_about_z(tmp_path):
     assert message.version == "2.0"
     assert message.header.creation_date == CREATED
     assert message.header.originator == "attitude"
-    assert message.header.comment == ["hand check"]
+    assert message.header.comment == ["hand check", QUATERNION_COMMENT]  # ours, always
     [parsed] = message.segments
     np.testing.assert_array_equal(
         parsed.data.attitude_states_numpy,

@@ -144,3 +144,30 @@ step = 10.0
     np.testing.assert_allclose(angle, 60.0, atol=1e-9)
     azimuth = np.unwrap(np.arctan2(drawn[:, 1], drawn[:, 0]))
     assert np.ptp(azimuth) == pytest.approx(2.0 * math.pi, rel=1e-9)  # the whole circle
+
+
+def test_the_zoom_shades_its_eclipse_on_its_own_time_axis(tmp_path, monkeypatch):
+    """A zoom 300 s long but 5000 s after the epoch is drawn in minutes (its axis shows
+    the time since the epoch); its eclipse, 5100-5200 s, must be shaded at 85-86.7 min
+    on that axis, inside the panel, not at 5100 "min"."""
+    figures = []
+    save = attitude.plots._save
+    monkeypatch.setattr(attitude.plots, "_save", lambda f, p: figures.append(f) or save(f, p))
+    envelope = Envelope(0.0, 10_000.0, ["panel"], columns=100, keep=0)
+    t = np.linspace(0.0, 10_000.0, 1001)
+    envelope.add(t, {"panel": 90.0 + 30.0 * np.sin(t / 500.0)})
+    seconds = np.linspace(5000.0, 5300.0, 301)
+    zoom = attitude.plots.Zoom(
+        seconds, {"panel": 90.0 + 0.0 * seconds}, "Zoom", shaded_s=[(5100.0, 5200.0)]
+    )
+    attitude.plots.plot_sun_angles(
+        tmp_path / "sun.png", envelope, {"panel": 30.0}, [(5100.0, 5200.0)], zoom
+    )
+    [figure] = figures
+    panel = figure.axes[1]
+    assert panel.get_xlabel() == "time since the epoch (min)"
+    [shade] = [c for c in panel.collections if c.get_label() == "eclipse"]
+    x = np.concatenate([path.vertices[:, 0] for path in shade.get_paths()])
+    np.testing.assert_allclose([x.min(), x.max()], [5100.0 / 60.0, 5200.0 / 60.0])
+    low, high = panel.get_xlim()
+    assert low <= x.min() and x.max() <= high
