@@ -39,7 +39,7 @@ from attitude.exports import (
 from attitude.output_budget import check_fits
 from attitude.output_folder import claim
 from attitude.plots import plot_angular_velocity, plot_eclipse, plot_polhode, plot_sun_angles
-from attitude.pointing import PointingSpec, compute_pointing
+from attitude.pointing import PointingSpec, pointing_analysis, pointing_samples
 from attitude.report_page import render_page
 from attitude.run_plan import RunPlan, plan_run
 from attitude.scenario import Scenario
@@ -222,14 +222,16 @@ def _build(
     progress(f"sampling {seconds.size} epochs over {scenario.stop_s:g} s")
     samples = sample(trajectory, seconds)
     columns = trajectory_columns(samples)
-    result = None
+    result = analysis = None
     if not pointing.is_empty:
         progress(
             f"pointing: {len(pointing.body_vectors)} body vectors, "
-            f"{'TLE orbit' if pointing.tle else 'Earth centre'}, intervals"
+            f"{'Earth centre' if pointing.orbit is None else pointing.orbit.describe()}"
         )
-        result = compute_pointing(trajectory, pointing, seconds)
+        result = pointing_samples(trajectory, pointing, seconds)
         columns += pointing_columns(result)
+        progress("pointing: intervals and extrema on the exact motion")
+        analysis = pointing_analysis(trajectory, pointing)
     scale = scenario.time_scale
     preamble = [
         f"attitude {__version__}: {scenario.name} ({source})",
@@ -254,11 +256,11 @@ def _build(
         },
     }
     files = ["timeseries.csv"]
-    if result is not None:
-        summary["pointing"] = pointing_summary(result, scenario.format_epoch)
+    if analysis is not None:
+        summary["pointing"] = pointing_summary(analysis, scenario.format_epoch)
         write_intervals_csv(
             tmp / "intervals.csv",
-            result,
+            analysis,
             scenario.iso,
             [*preamble[:3], f"interval ends refined to {pointing.interval_precision_s:g} s"],
         )

@@ -2,10 +2,12 @@
 
 ``plan_run(scenario, pointing)`` propagates the scenario (the exact solver segments,
 refused where the motion is faster than TT seconds can follow), analyses each
-segment (flips counted, not listed), checks the pointing (the TLE, SGP4 over the
-span, the Sun ephemeris with the interpolation's margins), counts the output samples
-and estimates the outputs' size against the memory available.  What it refuses, a
-run would have refused later, after computing; what it returns is what the run uses.
+segment (flips counted, not listed), checks the pointing (the orbit source over the
+span, the Sun and Moon ephemeris with the interpolation's margins), counts the output
+samples and estimates the outputs' size against the memory available.  It notes an
+output step that undersamples the motion (more than a tenth of its shortest period).
+What it refuses, a run would have refused later, after computing; what it returns is
+what the run uses.
 Errors are ``attitude.errors.InputError`` whose message starts with the scenario key.
 """
 
@@ -15,7 +17,12 @@ from dataclasses import dataclass, field
 
 from attitude.motion_analysis import SegmentMotion, analyze
 from attitude.output_budget import OutputBudget, check_fits, estimate
-from attitude.pointing import PointingSpec, check_pointing, search_grid_count
+from attitude.pointing import (
+    CHUNK_POINTS,
+    PointingSpec,
+    check_pointing,
+    undersampling_note,
+)
 from attitude.scenario import Scenario
 from attitude.trajectory import Trajectory, propagate
 
@@ -40,12 +47,14 @@ def plan_run(scenario: Scenario, pointing: PointingSpec | None = None) -> RunPla
     samples = scenario.output_count()
     trajectory = propagate(scenario)
     # The memory check comes before the analysis and the pointing checks, which do
-    # not depend on the output grid but can take a while on a long span.
-    grid = 0
-    if not pointing.is_empty:
-        grid = search_grid_count(trajectory, scenario.start_s, scenario.stop_s)
-    budget = estimate(samples, grid, len(pointing.body_vectors), pointing.tle is not None)
+    # not depend on the output grid but can take a while on a long span.  The
+    # pointing's search runs in chunks: its memory is one chunk's, whatever the span.
+    grid = 0 if pointing.is_empty else CHUNK_POINTS
+    budget = estimate(samples, grid, len(pointing.body_vectors), pointing.orbit is not None)
     check_fits(budget)
     motion = analyze(trajectory)
     notes = check_pointing(trajectory, pointing)
+    undersampled = undersampling_note(trajectory, motion)
+    if undersampled:
+        notes.append(undersampled)
     return RunPlan(scenario, pointing, trajectory, motion, budget, notes)

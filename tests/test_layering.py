@@ -16,7 +16,20 @@ LAYERS = [
     ["inertia", "euler_solver"],  # the Euler solver
     ["timescales", "spacecraft", "events", "scenario"],  # spacecraft, scenario and events
     ["trajectory", "motion_analysis"],  # trajectory
-    ["ephemeris", "orbit", "eclipse", "pointing", "intervals"],  # pointing (skyfield)
+    [  # pointing (skyfield)
+        "ephemeris",
+        "earth",
+        "frames",
+        "orbit",
+        "keplerian",
+        "ccsds_files",
+        "oem",
+        "aem_input",
+        "intervals",
+        "extrema",
+        "eclipse",
+        "pointing",
+    ],
     [  # reports and exports
         "exports",
         "aem",
