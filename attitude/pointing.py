@@ -25,10 +25,10 @@ interpolated again here.
 
 **How intervals and extrema are found.**  Each quantity is sampled on a search grid
 whose step comes from the motion and the geometry, not from the output step: 64
-samples per radian·2π of the fastest rate any direction here can turn at, the body's
-fastest rotation (G/I_min over the segments) plus the orbit's (the nadir's angular
-rate, the rate of the Earth's angular radius, the Moon's parallax), and at most 30 s
-on an orbit (600 s at the Earth's centre).  A condition's sign changes are then
+samples per 2π radians of the fastest rate any direction here can turn at, the body's
+fastest rotation (bounded by √(2T/I_min) over the segments) plus the orbit's (the
+nadir's angular rate, the rate of the Earth's angular radius, the Moon's parallax),
+and at most 30 s on an orbit (600 s at the Earth's centre).  A condition's sign changes are then
 bisected on the exact motion (:func:`attitude.intervals.find_intervals`) to
 ``interval_precision``; each grid minimum or maximum brackets an extremum, narrowed by
 golden-section search on the exact motion (:func:`attitude.extrema.least`) to 1 µs,
@@ -58,7 +58,6 @@ from attitude.orbit import Orbit, TleOrbit
 from attitude.quantities import as_si_scalar, as_vector3
 from attitude.timescales import SECONDS_PER_DAY, offline_time
 from attitude.trajectory import Trajectory
-from attitude.vectors import angle_between
 
 __all__ = [
     "CHUNK_POINTS",
@@ -233,23 +232,6 @@ class PointingSpec:
         """The TLE lines, when the orbit is a TLE."""
         return self.orbit.lines if isinstance(self.orbit, TleOrbit) else None
 
-    def describe(self) -> dict[str, Any]:
-        return {
-            "body_vectors": [
-                {
-                    "name": v.name,
-                    "vector_body": v.vector.tolist(),
-                    "kind": v.kind,
-                    "sun_exclusion_half_angle_deg": v.sun_exclusion_half_angle_deg,
-                    "moon_exclusion_half_angle_deg": v.moon_exclusion_half_angle_deg,
-                    "earth_limb_exclusion_angle_deg": v.earth_limb_exclusion_angle_deg,
-                }
-                for v in self.body_vectors
-            ],
-            "orbit": "Earth centre" if self.orbit is None else self.orbit.describe(),
-            "interval_precision_s": self.interval_precision_s,
-        }
-
 
 def describe_lines(spec: PointingSpec) -> list[str]:
     """What ``attitude check`` says of the pointing: the orbit, and each body vector with
@@ -331,7 +313,8 @@ class SearchGrid:
     """The search grid of :func:`pointing_analysis` and the rate bounds behind it.
 
     ``step_s``: the grid step; ``count``: its points over the span;
-    ``body_rate_rad_s``: the fastest body rotation (G/I_min); ``orbit_rate_rad_s``: the
+    ``body_rate_rad_s``: a bound on the body's rotation rate (√(2T/I_min));
+    ``orbit_rate_rad_s``: the
     fastest turn of the nadir (|r × v|/r²) plus the rate of the Earth's angular radius;
     ``orbit_speed_m_s``: the greatest orbital speed.
     """
@@ -362,9 +345,14 @@ class SearchGrid:
 
 
 def _body_rate(trajectory: Trajectory, start_s: float, stop_s: float) -> float:
-    """The fastest rotation of the body over [start_s, stop_s]: max G/I_min (rad/s)."""
+    """A bound on the body's rotation rate over [start_s, stop_s], rad/s: the largest
+    over the segments of √(2T/I_min), since |ω|² = Σ m_i²/I_i² ≤ (Σ m_i²/I_i)/I_min =
+    2T/I_min (tighter than G/I_min, which it never exceeds)."""
     rates = [
-        segment.solver.angular_momentum_norm / float(np.min(segment.solver.moments_of_inertia))
+        math.sqrt(
+            max(2.0 * segment.solver.kinetic_energy, 0.0)
+            / float(np.min(segment.solver.moments_of_inertia))
+        )
         for segment in trajectory.segments
         if segment.end_s >= start_s and segment.start_s <= stop_s
     ]
@@ -523,6 +511,7 @@ class Surroundings:
     earth_angular_radius_rad: NDArray[np.float64] | None = None
     limb_angular_radius_rad: NDArray[np.float64] | None = None
     shadow_angles: tuple[NDArray[np.float64], ...] | None = None
+    nadir: NDArray[np.float64] | None = None  # unit vector to the Earth's centre
 
 
 class SunMoonEarth:
@@ -587,6 +576,7 @@ class SunMoonEarth:
             b,
             b if height == 0.0 else angular_radius(r, height),
             (a, b, c),
+            -r / _norm(r)[:, None],
         )
 
 
@@ -649,20 +639,31 @@ def _moon_hidden(env: Surroundings) -> NDArray[np.float64] | None:
     centre): the Earth's angular radius minus the Moon's angle from nadir."""
     if env.position_m is None:
         return None
-    return env.earth_angular_radius_rad - angle_between(env.moon_direction, -env.position_m)
+    return env.earth_angular_radius_rad - _unit_angle(env.moon_direction, env.nadir)
+
+
+def _norm(v: NDArray[np.float64]) -> NDArray[np.float64]:
+    return np.sqrt(np.einsum("ij,ij->i", v, v))
+
+
+def _unit_angle(u: NDArray[np.float64], v: NDArray[np.float64]) -> NDArray[np.float64]:
+    """The angle between unit vectors (n, 3): 2 atan2(|u − v|, |u + v|), accurate at
+    every angle like atan2(|u × v|, u·v), and cheaper (W. Kahan, "How Futile are
+    Mindless Assessments of Roundoff in Floating-Point Computation?", 2006)."""
+    return 2.0 * np.arctan2(_norm(u - v), _norm(u + v))
 
 
 def _vector_angles(icrf: NDArray[np.float64], env: Surroundings) -> dict[str, NDArray]:
     """A body vector's angles (radians) and Sun incidence from its ICRF direction."""
     cos_sun = np.sum(icrf * env.sun_direction, axis=-1)
     angles = {
-        "sun_angle": angle_between(icrf, env.sun_direction),
+        "sun_angle": _unit_angle(icrf, env.sun_direction),
         "sun_cosine": cos_sun,
         "cos_incidence": np.maximum(cos_sun, 0.0) * env.sunlit_fraction,
-        "moon_angle": angle_between(icrf, env.moon_direction),
+        "moon_angle": _unit_angle(icrf, env.moon_direction),
     }
     if env.position_m is not None:
-        angles["nadir_angle"] = angle_between(icrf, -env.position_m)
+        angles["nadir_angle"] = _unit_angle(icrf, env.nadir)
         angles["earth_limb_angle"] = angles["nadir_angle"] - env.limb_angular_radius_rad
     return angles
 

@@ -441,7 +441,8 @@ def _keplerian(table: _Table, scale: str, epoch, name: str) -> KeplerianOrbit:
         "frame",
         "j2",
     )
-    at = table.epoch("epoch", scale, required=False) or epoch
+    at = table.epoch("epoch", scale, required=False)
+    at = epoch if at is None else at
     if table.has("mean_anomaly") == table.has("true_anomaly"):
         table.fail("give exactly one of mean_anomaly and true_anomaly")
     anomaly = "mean_anomaly" if table.has("mean_anomaly") else "true_anomaly"

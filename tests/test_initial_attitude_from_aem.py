@@ -121,3 +121,23 @@ def test_bad_files_are_refused_in_one_line(tmp_path, aem_text, edit, message):
 def test_an_epoch_outside_the_file_is_refused(tmp_path, aem_text):
     with pytest.raises(InputError, match=r"file\.aem: the scenario epoch 2027-06-21T00:03:20"):
         _read(tmp_path, aem_text, 200.0)
+
+
+def test_a_scenario_starts_from_the_aem(tmp_path, aem_text):
+    # [initial_state] aem = "spin.aem": the scenario's first attitude is the file's at its
+    # epoch (2027-06-21T00:00:13.37, between records), relative to the scenario file.
+    from attitude.scenario_file import load_scenario
+    from attitude.trajectory import propagate
+
+    (tmp_path / "spin.aem").write_text(aem_text)
+    (tmp_path / "start.toml").write_text(
+        '[scenario]\nname = "from an AEM"\nepoch = "2027-06-21T00:00:13.37"\n'
+        '[spacecraft]\nname = "spin"\nprincipal_moments = [10.0, 20.0, 30.0]\n'
+        '[initial_state]\naem = "spin.aem"\nangular_velocity = [0.05, 0.3, 0.02]\n'
+        "[output]\nduration = 10.0\n"
+    )
+    loaded = load_scenario(tmp_path / "start.toml")
+    first = propagate(loaded.scenario).attitude(np.array([0.0]))[0]
+    expected = _read(tmp_path, aem_text, 13.37)
+    assert (first.inv() * expected).magnitude() < 1e-15
+    assert (first.inv() * _exact(13.37)).magnitude() < 3e-4

@@ -182,11 +182,15 @@ def test_violation_ends_are_refined_to_the_stated_precision(on_orbit):
     angle = _angle(body_sun, np.array([1.0, 0.0, 0.0])).reshape(-1, 4)
     assert np.all(angle[:, 0] > half) and np.all(angle[:, 1] < half)
     assert np.all(angle[:, 2] < half) and np.all(angle[:, 3] > half)
-    # Flags on the output grid agree with the intervals.
-    inside = np.zeros(result.seconds.size, dtype=bool)
+    # Flags on the output grid agree with the intervals (away from their ends, which are
+    # known to the precision δ only).
+    t = result.seconds
+    inside = np.zeros(t.size, dtype=bool)
+    near_an_end = np.zeros(t.size, dtype=bool)
     for i in x.violations:
-        inside |= (result.seconds >= i.start_s) & (result.seconds <= i.end_s)
-    assert np.array_equal(inside, x.violated)
+        inside |= (t >= i.start_s) & (t <= i.end_s)
+        near_an_end |= (np.abs(t - i.start_s) <= δ) | (np.abs(t - i.end_s) <= δ)
+    assert np.array_equal(inside[~near_an_end], x.violated[~near_an_end])
 
 
 def test_no_violation_in_umbra(on_orbit):
