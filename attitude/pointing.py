@@ -28,13 +28,13 @@ whose step comes from the motion and the geometry, not from the output step: 64
 samples per 2π radians of the fastest rate any direction here can turn at, the body's
 fastest rotation (bounded by √(2T/I_min) over the segments) plus the orbit's (the
 nadir's angular rate, the rate of the Earth's angular radius, the Moon's parallax),
-and at most 30 s on an orbit (600 s at the Earth's centre).  A condition's sign changes are then
-bisected on the exact motion (:func:`attitude.intervals.find_intervals`) to
-``interval_precision``; each grid minimum or maximum brackets an extremum, narrowed by
-golden-section search on the exact motion (:func:`attitude.extrema.least`) to 1 µs,
-with brackets that cannot hold the answer dropped on the rate bound.
+and at most 30 s on an orbit (600 s at the Earth's centre).  A condition's sign
+changes are bisected on the exact motion (:func:`attitude.intervals.find_all_intervals`)
+to ``interval_precision``; each grid minimum or maximum brackets an extremum, narrowed
+by golden-section search on the exact motion (:func:`attitude.extrema.least_of_each`)
+to 1 µs, with brackets that cannot hold the answer dropped on the rate bound.
 ``tests/test_extrema_against_dense_sampling.py`` compares them with a sampling 100×
-denser than the search grid.
+denser than a 10 s output grid.
 """
 
 from __future__ import annotations
@@ -854,6 +854,144 @@ def _grid_points(
     return np.unique(np.concatenate([τ, inside])) if inside.size else τ
 
 
+class _Search:
+    """The intervals, extrema and averages of the analysis, accumulated chunk by chunk."""
+
+    def __init__(self, trajectory: Trajectory, spec: PointingSpec, grid: SearchGrid) -> None:
+        self.trajectory, self.spec, self.grid = trajectory, spec, grid
+        self.precision = interval_precision(spec, trajectory.scenario.stop_s)[0]
+        self.extremum_precision = max(_EXTREMUM_PRECISION_S, 4.0 * float(np.spacing(grid.stop_s)))
+        self.conditions = _conditions(spec)
+        self.found: dict[str, list[Interval]] = {name: [] for name in self.conditions}
+        # (vector, quantity) pairs, and the least and greatest of each found so far.
+        self.wanted = [
+            (v.name, quantity)
+            for v in spec.body_vectors
+            for quantity, needs_orbit in EXTREMA.items()
+            if spec.on_orbit or not needs_orbit
+        ]
+        self.lows: dict[tuple[str, str], Extremum | None] = dict.fromkeys(self.wanted)
+        self.highs: dict[tuple[str, str], Extremum | None] = dict.fromkeys(self.wanted)
+        self.sums = {"sunlit_fraction": 0.0} | {
+            f"{v.name}.cos_incidence": 0.0 for v in spec.body_vectors
+        }
+
+    def _rate(self, quantity: str) -> float:
+        """A bound on the quantity's rate of change (the incidence adds the lit fraction's)."""
+        if quantity == "cos_incidence":
+            return self.grid.angle_rate_bound + self.grid.fraction_rate_bound
+        return self.grid.angle_rate_bound
+
+    def _condition_values(self, values: dict[str, NDArray]) -> dict[str, NDArray]:
+        return {
+            name: scale * values[key] - offset
+            for name, (key, scale, offset) in self.conditions.items()
+        }
+
+    def _extremum_values(self, values: dict[str, NDArray]) -> dict[str, NDArray]:
+        """Each quantity to minimize ('.low') and its negative to minimize ('.high')."""
+        out = {}
+        for name, quantity in self.wanted:
+            key = f"{name}.{quantity}"
+            out[f"{key}.low"] = values[key]
+            out[f"{key}.high"] = -values[key]
+        return out
+
+    def chunk(self, τ: NDArray[np.float64]) -> None:
+        """Search the grid points τ (one chunk) and fold what they hold into the totals."""
+        quantities = _Quantities(self.trajectory, self.spec, float(τ[0]), float(τ[-1]))
+        values = quantities(τ)
+        self._intervals(quantities, τ, values)
+        self._extrema(quantities, τ, values)
+        widths = np.diff(τ)
+        for key in self.sums:  # the trapezoid rule on the search grid
+            self.sums[key] += float(np.sum(0.5 * (values[key][1:] + values[key][:-1]) * widths))
+
+    def _intervals(self, quantities: _Quantities, τ, values) -> None:
+        pieces = find_all_intervals(
+            lambda t: self._condition_values(quantities(t)),
+            τ,
+            self.precision,
+            self._condition_values(values),
+        )
+        for name in self.conditions:
+            join(self.found[name], pieces[name], float(τ[0]))
+
+    def _extrema(self, quantities: _Quantities, τ, values) -> None:
+        on_grid = self._extremum_values(values)
+        problems = {}
+        for name, quantity in self.wanted:
+            key = f"{name}.{quantity}"
+            low, high = self.lows[(name, quantity)], self.highs[(name, quantity)]
+            if quantity == "cos_incidence" and np.min(on_grid[f"{key}.low"]) <= 0.0:
+                # No light: 0 is the least incidence, placed from the intervals (result).
+                self.lows[(name, quantity)] = Extremum(float(τ[0]), 0.0)
+            else:
+                problems[f"{key}.low"] = Problem(on_grid[f"{key}.low"], self._rate(quantity), low)
+            problems[f"{key}.high"] = Problem(
+                on_grid[f"{key}.high"],
+                self._rate(quantity),
+                None if high is None else Extremum(high.time_s, -high.value),
+            )
+        if not problems:
+            return
+        best = least_of_each(
+            lambda t: self._extremum_values(quantities(t)),
+            τ,
+            problems,
+            _EXTREMUM_TOLERANCE,
+            self.extremum_precision,
+        )
+        for name, quantity in self.wanted:
+            key = f"{name}.{quantity}"
+            if f"{key}.low" in best:
+                self.lows[(name, quantity)] = best[f"{key}.low"]
+            high = best[f"{key}.high"]
+            self.highs[(name, quantity)] = Extremum(high.time_s, -high.value)
+
+    def result(self) -> PointingAnalysis:
+        """The analysis: the accumulated intervals (each condition less what hides it),
+        extrema and averages."""
+        grid, spec, found = self.grid, self.spec, self.found
+        span = max(grid.stop_s - grid.start_s, 1e-300)
+        umbra = found.get("umbra", [])
+        analysis = PointingAnalysis(
+            start_s=grid.start_s,
+            stop_s=grid.stop_s,
+            precision_s=self.precision,
+            on_orbit=spec.on_orbit,
+            orbit="Earth centre" if spec.orbit is None else spec.orbit.describe(),
+            grid=grid,
+            vectors=[],
+            shadow=found.get("shadow", []),
+            umbra=umbra,
+            moon_hidden=found.get("moon_hidden", []),
+            sunlit_fraction_mean=self.sums["sunlit_fraction"] / span,
+        )
+        for v in spec.body_vectors:
+            name = v.name
+            extrema = {
+                q: (self.lows[(name, q)], self.highs[(name, q)])
+                for n, q in self.wanted
+                if n == name
+            }
+            item = VectorAnalysis(
+                vector=v,
+                extrema=extrema,
+                sun_visible=difference(found[f"{name}.sun_visible"], umbra),
+                sun_exclusion=difference(found.get(f"{name}.sun_exclusion", []), umbra),
+                moon_exclusion=difference(
+                    found.get(f"{name}.moon_exclusion", []), analysis.moon_hidden
+                ),
+                earth_limb_exclusion=found.get(f"{name}.earth_limb_exclusion", []),
+                mean_cos_incidence=self.sums[f"{name}.cos_incidence"] / span,
+            )
+            low, high = extrema["cos_incidence"]
+            item.extrema["cos_incidence"] = (_first_dark(item, grid) or low, high)
+            analysis.vectors.append(item)
+        return analysis
+
+
 def pointing_analysis(
     trajectory: Trajectory,
     spec: PointingSpec,
@@ -868,122 +1006,15 @@ def pointing_analysis(
     intervals found.  Interval ends are refined to ``spec.interval_precision_s``,
     extrema to 1 µs.
     """
-    scenario = trajectory.scenario
     grid = search_grid(trajectory, spec, start_s, stop_s)
-    precision = interval_precision(spec, scenario.stop_s)[0]
-    extremum_precision = max(_EXTREMUM_PRECISION_S, 4.0 * float(np.spacing(grid.stop_s)))
-    conditions = _conditions(spec)
-    found: dict[str, list[Interval]] = {name: [] for name in conditions}
-    bounds = {
-        "cos_incidence": grid.angle_rate_bound + grid.fraction_rate_bound,
-    }
-    wanted = [
-        (v.name, quantity)
-        for v in spec.body_vectors
-        for quantity, needs_orbit in EXTREMA.items()
-        if spec.on_orbit or not needs_orbit
-    ]
-    lows: dict[tuple[str, str], Extremum | None] = dict.fromkeys(wanted)
-    highs: dict[tuple[str, str], Extremum | None] = dict.fromkeys(wanted)
-    sums = {"sunlit_fraction": 0.0} | {f"{v.name}.cos_incidence": 0.0 for v in spec.body_vectors}
-    events_s = np.array([t for t, _ in scenario.events], dtype=np.float64)
-
-    def condition_values(values: dict[str, NDArray[np.float64]]) -> dict[str, NDArray]:
-        return {
-            name: scale * values[key] - offset for name, (key, scale, offset) in conditions.items()
-        }
-
-    def extremum_values(values: dict[str, NDArray[np.float64]]) -> dict[str, NDArray]:
-        out = {}  # (a few of these are not asked for: computing them costs less than a test)
-        for name, quantity in wanted:
-            key = f"{name}.{quantity}"
-            out[f"{key}.low"] = values[key]
-            out[f"{key}.high"] = -values[key]
-        return out
-
+    search = _Search(trajectory, spec, grid)
+    events_s = np.array([t for t, _ in trajectory.scenario.events], dtype=np.float64)
     first = 0
     while first < grid.count - 1:
         last = min(first + CHUNK_POINTS, grid.count - 1)
-        τ = _grid_points(grid, first, last, events_s)
-        quantities = _Quantities(trajectory, spec, float(τ[0]), float(τ[-1]))
-        values = quantities(τ)
-        pieces = find_all_intervals(
-            lambda t, q=quantities: condition_values(q(t)),
-            τ,
-            precision,
-            condition_values(values),
-        )
-        for name in conditions:
-            join(found[name], pieces[name], float(τ[0]))
-        problems = {}
-        on_grid = extremum_values(values)
-        for name, quantity in wanted:
-            key = f"{name}.{quantity}"
-            rate = bounds.get(quantity, grid.angle_rate_bound)
-            low, high = lows[(name, quantity)], highs[(name, quantity)]
-            if quantity == "cos_incidence" and np.min(on_grid[f"{key}.low"]) <= 0.0:
-                # No light: 0 is the least incidence, placed from the intervals below.
-                lows[(name, quantity)] = Extremum(float(τ[0]), 0.0)
-            else:
-                problems[f"{key}.low"] = Problem(on_grid[f"{key}.low"], rate, low)
-            problems[f"{key}.high"] = Problem(
-                on_grid[f"{key}.high"],
-                rate,
-                None if high is None else Extremum(high.time_s, -high.value),
-            )
-        if problems:
-            best = least_of_each(
-                lambda t, q=quantities: extremum_values(q(t)),
-                τ,
-                problems,
-                _EXTREMUM_TOLERANCE,
-                extremum_precision,
-            )
-            for name, quantity in wanted:
-                key = f"{name}.{quantity}"
-                if f"{key}.low" in best:
-                    lows[(name, quantity)] = best[f"{key}.low"]
-                high = best[f"{key}.high"]
-                highs[(name, quantity)] = Extremum(high.time_s, -high.value)
-        widths = np.diff(τ)
-        for key in sums:  # the trapezoid rule on the search grid
-            sums[key] += float(np.sum(0.5 * (values[key][1:] + values[key][:-1]) * widths))
+        search.chunk(_grid_points(grid, first, last, events_s))
         first = last
-
-    span = max(grid.stop_s - grid.start_s, 1e-300)
-    umbra = found.get("umbra", [])
-    analysis = PointingAnalysis(
-        start_s=grid.start_s,
-        stop_s=grid.stop_s,
-        precision_s=precision,
-        on_orbit=spec.on_orbit,
-        orbit="Earth centre" if spec.orbit is None else spec.orbit.describe(),
-        grid=grid,
-        vectors=[],
-        shadow=found.get("shadow", []),
-        umbra=umbra,
-        moon_hidden=found.get("moon_hidden", []),
-        sunlit_fraction_mean=sums["sunlit_fraction"] / span,
-    )
-    for v in spec.body_vectors:
-        name = v.name
-        item = VectorAnalysis(
-            vector=v,
-            extrema={q: (lows[(name, q)], highs[(name, q)]) for n, q in wanted if n == name},
-            sun_visible=difference(found[f"{name}.sun_visible"], umbra),
-            sun_exclusion=difference(found.get(f"{name}.sun_exclusion", []), umbra),
-            moon_exclusion=difference(
-                found.get(f"{name}.moon_exclusion", []), analysis.moon_hidden
-            ),
-            earth_limb_exclusion=found.get(f"{name}.earth_limb_exclusion", []),
-            mean_cos_incidence=sums[f"{name}.cos_incidence"] / span,
-        )
-        item.extrema["cos_incidence"] = (
-            _first_dark(item, grid) or item.extrema["cos_incidence"][0],
-            item.extrema["cos_incidence"][1],
-        )
-        analysis.vectors.append(item)
-    return analysis
+    return search.result()
 
 
 def _first_dark(item: VectorAnalysis, grid: SearchGrid) -> Extremum | None:
