@@ -8,7 +8,8 @@ The layers, each importing only the ones above it in this list (README "Layout")
   (gravity gradient, constant torques, user torques) by splitting with the exact free flow
 - ``attitude.spacecraft``, ``events``, ``scenario``, ``timescales``: the scenario layer
 - ``attitude.trajectory``, ``motion_analysis``: the propagated motion
-- ``attitude.ephemeris``, ``orbit``, ``eclipse``, ``pointing``, ``intervals``: pointing
+- ``attitude.ephemeris``, ``earth``, ``frames``, ``orbit``, ``keplerian``, ``oem``,
+  ``aem_input``, ``intervals``, ``extrema``, ``eclipse``, ``pointing``: pointing
 - ``attitude.exports``, ``aem``, ``plots``, ``report_page``, ``report``: reports and exports
 - ``attitude.scenario_file``, ``cli``: scenario files and the command line
 
@@ -33,9 +34,11 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.aem import write_aem
     from attitude.euler_solver import EulerSolver
     from attitude.events import AngularImpulse, AttitudeReset, InertiaChange
+    from attitude.keplerian import KeplerianOrbit
     from attitude.motion_analysis import analyze
+    from attitude.oem import OemOrbit
     from attitude.orbit import TleOrbit
-    from attitude.pointing import BodyVector, PointingSpec, compute_pointing
+    from attitude.pointing import BodyVector, PointingSpec, pointing_analysis, pointing_samples
     from attitude.report import produce
     from attitude.scenario import InitialState, Scenario
     from attitude.scenario_file import load_scenario
@@ -63,8 +66,11 @@ _LAZY = {
     "analyze": "attitude.motion_analysis",
     "BodyVector": "attitude.pointing",
     "PointingSpec": "attitude.pointing",
-    "compute_pointing": "attitude.pointing",
+    "pointing_samples": "attitude.pointing",
+    "pointing_analysis": "attitude.pointing",
     "TleOrbit": "attitude.orbit",
+    "KeplerianOrbit": "attitude.keplerian",
+    "OemOrbit": "attitude.oem",
     "write_aem": "attitude.aem",
     "load_scenario": "attitude.scenario_file",
     "produce": "attitude.report",
@@ -84,6 +90,8 @@ __all__ = [
     "InertiaWarning",
     "InitialState",
     "InputError",
+    "KeplerianOrbit",
+    "OemOrbit",
     "PointingSpec",
     "Scenario",
     "Spacecraft",
@@ -93,9 +101,10 @@ __all__ = [
     "UserTorque",
     "__version__",
     "analyze",
-    "compute_pointing",
     "departure_time",
     "load_scenario",
+    "pointing_analysis",
+    "pointing_samples",
     "produce",
     "propagate",
     "propagate_batch",

@@ -169,19 +169,9 @@ def _describe(loaded, plan, out: Path | None = None) -> str:
         f"{f' ({event.label})' if event.label else ''}"
         for t, event in scenario.events
     ]
-    spec = loaded.pointing
-    if not spec.is_empty:
-        lines.append(
-            f"  pointing    {len(spec.body_vectors)} body vectors, orbit: "
-            f"{'TLE' if spec.tle else 'Earth centre'}, interval ends to "
-            f"{spec.interval_precision_s:g} s"
-        )
-        for vector in spec.body_vectors:
-            half = vector.sun_exclusion_half_angle_deg
-            lines.append(
-                f"    {vector.name}: {vector.kind}, {vector.vector.tolist()} (body)"
-                + ("" if half is None else f", Sun exclusion half angle {half:.12g} deg")
-            )
+    from attitude.pointing import describe_lines
+
+    lines += [f"  {line}" for line in describe_lines(loaded.pointing)]
     if plan.aem is not None:
         steps = [item.step_s for item in plan.aem.segments]
         lines.append(

@@ -2,12 +2,14 @@
 
 ``plan_run(scenario, pointing, outputs)`` propagates the scenario (the exact solver
 segments, refused where the motion is faster than TT seconds can follow), analyses
-each segment (flips counted, not listed), checks the pointing (the TLE, SGP4 over the
-span, the Sun ephemeris with the interpolation's margins), chooses the AEM's records
-for its tolerance, counts the output samples and estimates the outputs' sizes and the
-(constant) memory of the streamed run.  What it refuses, a run would have refused
-later, after computing; what it returns is what the run uses.  Errors are
-``attitude.errors.InputError`` whose message starts with the scenario key.
+each segment (flips counted, not listed), checks the pointing (the orbit source over
+the span, the Sun and Moon ephemeris with the interpolation's margins, the size of
+the exact search), chooses the AEM's records for its tolerance, counts the output
+samples and estimates the outputs' sizes and the (constant) memory of the streamed
+run.  It notes an output step that undersamples the motion (more than a tenth of its
+shortest period).  What it refuses, a run would have refused later, after computing;
+what it returns is what the run uses.  Errors are ``attitude.errors.InputError``
+whose message starts with the scenario key.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ from attitude.aem_sampling import AemPlan, plan_aem
 from attitude.motion_analysis import SegmentMotion, analyze
 from attitude.output_budget import OutputBudget, check_fits, estimate
 from attitude.output_formats import OutputChoice
-from attitude.pointing import PointingSpec, check_pointing, search_grid_count
+from attitude.pointing import PointingSpec, SearchGrid, check_pointing, undersampling_note
 from attitude.scenario import Scenario
 from attitude.timeseries_parquet import check_span
 from attitude.trajectory import Trajectory, propagate
@@ -38,6 +40,7 @@ class RunPlan:
     notes: list[str] = field(default_factory=list)
     outputs: OutputChoice = field(default_factory=OutputChoice)
     aem: AemPlan | None = None
+    search: SearchGrid | None = None  # the pointing's exact search (None without pointing)
 
 
 def plan_run(
@@ -50,18 +53,16 @@ def plan_run(
     if "parquet" in outputs:
         check_span(scenario.start_s, scenario.stop_s, "--formats parquet")
     trajectory = propagate(scenario)
-    # The search-size and memory checks come before the analysis and the pointing
-    # checks, which do not depend on the output grid but can take a while on a long span.
-    grid = 0
-    if not pointing.is_empty:
-        grid = search_grid_count(trajectory, scenario.start_s, scenario.stop_s)
-    on_orbit = pointing.tle is not None
-    budget = estimate(
-        samples, grid, len(pointing.body_vectors), on_orbit, outputs.formats, aem_records=0
-    )
+    # The size and memory checks come before the analysis and the pointing checks,
+    # which do not depend on the output grid but can take a while on a long span.
+    vectors, on_orbit = len(pointing.body_vectors), pointing.on_orbit
+    budget = estimate(samples, 0, vectors, on_orbit, outputs.formats, aem_records=0)
     check_fits(budget)
     motion = analyze(trajectory)
-    notes = check_pointing(trajectory, pointing)
+    notes, search = check_pointing(trajectory, pointing)
+    undersampled = undersampling_note(trajectory, motion)
+    if undersampled:
+        notes.append(undersampled)
     aem = None
     if "aem" in outputs:
         aem = plan_aem(
@@ -72,7 +73,12 @@ def plan_run(
             outputs.aem_tolerance_rad,
             outputs.tolerance_key,
         )
-        budget = estimate(
-            samples, grid, len(pointing.body_vectors), on_orbit, outputs.formats, aem.records
-        )
-    return RunPlan(scenario, pointing, trajectory, motion, budget, notes, outputs, aem)
+    budget = estimate(
+        samples,
+        0 if search is None else search.count,
+        vectors,
+        on_orbit,
+        outputs.formats,
+        0 if aem is None else aem.records,
+    )
+    return RunPlan(scenario, pointing, trajectory, motion, budget, notes, outputs, aem, search)

@@ -17,7 +17,20 @@ LAYERS = [
     ["torques", "splitting", "torqued_solver"],  # torques and splitting
     ["timescales", "epoch_texts", "spacecraft", "events", "scenario"],  # scenario and events
     ["trajectory", "motion_analysis"],  # trajectory
-    ["ephemeris", "orbit", "eclipse", "pointing", "intervals"],  # pointing (skyfield)
+    [  # pointing (skyfield)
+        "ephemeris",
+        "earth",
+        "frames",
+        "orbit",
+        "keplerian",
+        "ccsds_files",
+        "oem",
+        "aem_input",
+        "intervals",
+        "extrema",
+        "eclipse",
+        "pointing",
+    ],
     [  # reports and exports
         "exports",
         "timeseries_parquet",
