@@ -255,6 +255,8 @@ _MOTION_TEXT = {
     "separatrix": "separatrix: no period; m leaves the intermediate axis and returns to it "
     "asymptotically, so the body turns over at most once",
     "rest": "at rest: no motion",
+    "torqued": "under torques (propagated by splitting with the exact free flow): no "
+    "period, flips not located; the kinetic energy and momentum are those at its start",
 }
 
 

@@ -27,7 +27,9 @@ Segments without a period are stated as what they are (``SegmentMotion.motion``)
 - ``"separatrix"``: m on the separatrix (Δ2 = 0) but not at the intermediate axis:
   no period; m leaves the intermediate axis and returns to it asymptotically, so the
   body turns over at most once (at u = 0) and nothing repeats;
-- ``"rest"``: G = 0.
+- ``"rest"``: G = 0;
+- ``"torqued"``: a segment under torques (``attitude.torqued_segment``): no period and
+  no closed form; its energy and momentum are given at its start.
 Flips are counted from the closed form without listing them all: at most
 :data:`LISTED_FLIPS` flip times are kept (a day of a fast tumbler has millions).
 """
@@ -60,7 +62,7 @@ class SegmentMotion:
     start_s: float
     end_s: float
     formula: str
-    motion: str  # "periodic", "steady spin", "separatrix" or "rest"
+    motion: str  # "periodic", "steady spin", "separatrix", "rest" or "torqued"
     period_s: float  # inf when the motion has no period
     flip_count: int
     flip_times_s: NDArray[np.float64]  # the first LISTED_FLIPS of them
@@ -144,8 +146,34 @@ def _flips(segment: Segment) -> tuple[int, NDArray[np.float64], float | None]:
     return count, listed[:LISTED_FLIPS], half
 
 
+def _torqued_motion(segment: Segment) -> SegmentMotion:
+    """A segment under torques: its state at the start; no period, flips or cone."""
+    solver = segment.solver
+    return SegmentMotion(
+        start_s=segment.start_s,
+        end_s=segment.end_s,
+        formula="torqued",
+        motion="torqued",
+        period_s=math.inf,
+        flip_count=0,
+        flip_times_s=np.empty(0),
+        flip_period_s=None,
+        spin_axis_body=None,
+        nutation_min_rad=None,
+        nutation_max_rad=None,
+        nutation_period_s=None,
+        spin_period_s=None,
+        precession_period_s=None,
+        kinetic_energy_J=solver.initial_kinetic_energy,
+        inertial_angular_momentum_N_m_s=solver.initial_inertial_angular_momentum,
+        angular_momentum_norm_N_m_s=float(np.linalg.norm(segment.state.angular_momentum)),
+    )
+
+
 def _segment_motion(segment: Segment) -> SegmentMotion:
     solver = segment.solver
+    if solver.formula == "torqued":
+        return _torqued_motion(segment)
     count, flips, flip_period = _flips(segment)
     axis = nutation_min = nutation_max = nutation_period = spin = precession = None
     steady = solver.formula == "steady" or _is_steady(segment)

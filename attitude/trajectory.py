@@ -1,7 +1,9 @@
 """The propagated motion of a scenario: exact solver segments between events.
 
 ``propagate(scenario)`` applies the events in time order; each starts a new
-``EulerSolver`` from the state just after it.  The resulting :class:`Trajectory` is
+``EulerSolver`` from the state just after it, or, where the scenario's torques act
+(``attitude.scenario_torques``), a :class:`~attitude.torqued_segment.TorquedMotion`
+(the torqued solver, with the same interface).  The resulting :class:`Trajectory` is
 evaluated at any times in [epoch, stop], not only on the output grid: pass an
 ``astropy.time.Time`` array, or floats (TT seconds since the scenario epoch) to skip
 the time-scale conversion.  An output time equal to an event's epoch gets the
@@ -26,6 +28,7 @@ from attitude.euler_solver import EulerSolver
 from attitude.events import Event, State
 from attitude.scenario import Scenario
 from attitude.timescales import SAME_INSTANT_S, tt_seconds
+from attitude.torqued_segment import TorquedMotion, scenario_torque_models
 
 __all__ = ["Segment", "Trajectory", "propagate"]
 
@@ -43,7 +46,7 @@ class Segment:
 
     start_s: float
     end_s: float
-    solver: EulerSolver
+    solver: EulerSolver | TorquedMotion
     state: State
     event: Event | None = None
     before: State | None = None
@@ -53,14 +56,23 @@ class Segment:
 _RESOLVED_FRACTION_OF_A_TURN = 1e-3
 
 
-def _solver(state: State, t0: float, where: str) -> EulerSolver:
+def _solver(
+    state: State, t0: float, end_s: float, where: str, scenario: Scenario, models: list
+) -> EulerSolver | TorquedMotion:
+    """The exact solver from ``state`` at ``t0``, or the torqued one if a torque acts
+    within [t0, end_s] (``models``: (start, stop, torque) of the scenario)."""
+    acting = [model for start, stop, model in models if start < end_s and stop > t0]
     try:
+        if acting:
+            return TorquedMotion(state, t0, end_s, acting, scenario.torques)
         return EulerSolver(state.inertia.tensor, state.angular_momentum, state.attitude, t0=t0)
     except InputError as exc:
         raise InputError(f"{where}: {exc}") from None
 
 
-def _check_resolved(solver: EulerSolver, start_s: float, end_s: float, where: str) -> None:
+def _check_resolved(
+    solver: EulerSolver | TorquedMotion, start_s: float, end_s: float, where: str
+) -> None:
     """Refuse a motion faster than TT seconds (floats) can follow over [start_s, end_s].
 
     The body turns at most at |ω| ≤ G/I_min, once every 2π I_min/G seconds, and m(t)
@@ -82,6 +94,8 @@ def _check_resolved(solver: EulerSolver, start_s: float, end_s: float, where: st
         )
     if not math.isfinite(solver.kinetic_energy):
         raise InputError(f"{where}: the kinetic energy is beyond the float range")
+    if isinstance(solver, TorquedMotion) and not math.isfinite(solver.error_estimate):
+        raise InputError(f"{where}: the torqued propagation diverged (no finite error estimate)")
 
 
 def propagate(scenario: Scenario) -> Trajectory:
@@ -100,7 +114,8 @@ def propagate(scenario: Scenario) -> Trajectory:
     state = State(initial.attitude, m0, axes)
     starts: list[tuple[float, State, Event | None, State | None]] = [(0.0, state, None, None)]
     ends = [offset for offset, _ in scenario.events] + [scenario.stop_s]
-    solver = _solver(state, 0.0, "initial_state")
+    models = scenario_torque_models(scenario) if scenario.torques.any else []
+    solver = _solver(state, 0.0, ends[0], "initial_state", scenario, models)
     _check_resolved(solver, 0.0, ends[0], "initial_state")
     solvers = [solver]
     indices = getattr(scenario, "event_indices", range(len(scenario.events)))
@@ -108,7 +123,7 @@ def propagate(scenario: Scenario) -> Trajectory:
         where = f"events[{index}] ({event.kind} at {scenario.format_epoch(offset)})"
         before = State(solver.attitude(offset), solver.angular_momentum(offset), state.inertia)
         state = event.apply(before)
-        solver = _solver(state, offset, f"the state after {where}")
+        solver = _solver(state, offset, end, f"the state after {where}", scenario, models)
         _check_resolved(solver, offset, end, f"the state after {where}")
         solvers.append(solver)
         starts.append((offset, state, event, before))
@@ -205,17 +220,24 @@ class Trajectory:
         return self._by_segment(times, lambda solver, τ: solver.angular_velocity(τ), 3)
 
     def inertial_angular_momentum(self, times: Any) -> NDArray[np.float64]:
-        """Angular momentum in inertial axes, N m s (constant within a segment)."""
-        return self._by_segment(
-            times, lambda solver, τ: np.tile(solver.inertial_angular_momentum, (τ.size, 1)), 3
-        )
+        """Angular momentum in inertial axes, N m s (constant within a torque-free segment)."""
+
+        def evaluate(solver, τ):
+            if isinstance(solver, TorquedMotion):
+                return solver.inertial_angular_momentum_at(τ)
+            return np.tile(solver.inertial_angular_momentum, (τ.size, 1))
+
+        return self._by_segment(times, evaluate, 3)
 
     def kinetic_energy(self, times: Any) -> NDArray[np.float64]:
-        """Rotational kinetic energy, J (constant within a segment)."""
-        values = self._by_segment(
-            times, lambda solver, τ: np.full((τ.size, 1), solver.kinetic_energy), 1
-        )
-        return values[..., 0]
+        """Rotational kinetic energy, J (constant within a torque-free segment)."""
+
+        def evaluate(solver, τ):
+            if isinstance(solver, TorquedMotion):
+                return solver.kinetic_energy_at(τ)[:, None]
+            return np.full((τ.size, 1), solver.kinetic_energy)
+
+        return self._by_segment(times, evaluate, 1)[..., 0]
 
     def flip_times(self) -> NDArray[np.float64]:
         """All Джанибеков flips over [epoch, stop], TT seconds since the epoch (closed form)."""

@@ -15,8 +15,15 @@ LAYERS = [
     ["elliptic"],  # elliptic kernels
     ["inertia", "invariants", "closed_form", "euler_solver", "free_flow"],  # the Euler solver
     ["torques", "splitting", "torqued_solver"],  # torques and splitting
-    ["timescales", "epoch_texts", "spacecraft", "events", "scenario"],  # scenario and events
-    ["trajectory", "motion_analysis"],  # trajectory
+    [  # scenario and events
+        "timescales",
+        "epoch_texts",
+        "spacecraft",
+        "events",
+        "scenario_torques",
+        "scenario",
+    ],
+    ["torqued_segment", "trajectory", "validity_horizon", "motion_analysis"],  # trajectory
     [  # pointing (skyfield)
         "ephemeris",
         "earth",
