@@ -163,6 +163,9 @@ def _describe(loaded, plan, out: Path | None = None) -> str:
             f"  segment {index}   from {scenario.format_epoch(item.start_s)}: {item.motion} "
             f"(formula {item.formula}{period}{flips})"
         )
+    from attitude.torques_summary import torques_lines
+
+    lines += [f"  {line}" for line in torques_lines(plan)]
     lines.append(f"  events      {len(scenario.events)}")
     lines += [
         f"    {scenario.format_epoch(t)} (+{t:.12g} s)  {event.kind}"

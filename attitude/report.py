@@ -82,6 +82,7 @@ from attitude.report_page import render_page
 from attitude.run_plan import RunPlan, plan_run
 from attitude.scenario import Scenario
 from attitude.timeseries_parquet import ParquetWriter
+from attitude.torques_summary import torques_summary
 from attitude.version import __version__
 
 __all__ = ["CHUNK_SAMPLES", "OUTPUT_NAMES", "Progress", "output_grid", "produce"]
@@ -378,6 +379,7 @@ def _build(
         "attitude_version": __version__,
         "scenario": _scenario_summary(scenario, source),
         "motion": motion_summary(trajectory, motion),
+        "torques": torques_summary(plan),
         "extrema": {
             "max_rate_deg_s": math.degrees(stream.peak_rate[0]),
             "max_rate_at": scenario.format_epoch(stream.peak_rate[1]),

@@ -99,6 +99,53 @@ def _pointing_table(vectors: dict[str, Any]) -> str:
     return _table(header, rows)
 
 
+def _propagation(summary: dict[str, Any]) -> str:
+    torques = summary.get("torques") or {}
+    if torques.get("modelled"):
+        return "under " + ", ".join(torques["modelled"]) + ": splitting with the exact free flow"
+    return "exact torque-free motion, no integration"
+
+
+def _torques_section(torques: dict[str, Any] | None) -> list[str]:
+    """The torques modelled, the step and the estimated error; or the validity horizon."""
+    if not torques:
+        return []
+    parts = ["<h2>Torques</h2>"]
+    if not torques["modelled"]:
+        horizon = torques["validity_horizon"]
+        text = horizon["description"] if horizon else torques["validity_horizon_note"]
+        parts.append(
+            f"<p>None modelled: the exact torque-free solver. Validity: {escape(text)}.</p>"
+        )
+        return parts
+    how = "given" if torques["step"] == "given" else f"chosen for {torques['accuracy_rad']:g} rad"
+    parts.append(
+        f"<p>Modelled: {escape(', '.join(torques['modelled']))}. Order {torques['order']}, "
+        f"step {escape(how)}; estimated attitude error "
+        f"{torques['estimated_error_rad']:.2g} rad in all.</p>"
+    )
+    if torques["burns"]:
+        parts.append(
+            _table(
+                ["burn start", "duration (s)", "torque (N m)", "frame", "label"],
+                [
+                    [b["start"], b["duration_s"], str(b["torque_N_m"]), b["frame"], b["label"]]
+                    for b in torques["burns"]
+                ],
+            )
+        )
+    parts.append(
+        _table(
+            ["segment", "method", "step (s)", "estimated error (rad)"],
+            [
+                [s["segment"], s["method"], s["step_s"], s["estimated_error_rad"]]
+                for s in torques["segments"]
+            ],
+        )
+    )
+    return parts
+
+
 def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str]) -> str:
     """The HTML text of the report.
 
@@ -112,7 +159,7 @@ def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str
         f"<title>{escape(scenario['name'])}</title><style>{_STYLE}</style></head><body>",
         f"<h1>{escape(scenario['name'])}</h1>",
         f"<p class='note'>{escape(scenario['file'])}, computed by attitude "
-        f"{escape(summary['attitude_version'])} (exact torque-free motion, no integration).</p>",
+        f"{escape(summary['attitude_version'])} ({escape(_propagation(summary))}).</p>",
         _table(
             [
                 "epoch",
@@ -182,6 +229,7 @@ def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str
             ],
         )
     )
+    parts += _torques_section(summary.get("torques"))
     flips = motion["flips"]
     if flips["count"]:
         shown = ", ".join(escape(t) for t in flips["times"][:12])

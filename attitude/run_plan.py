@@ -7,16 +7,20 @@ the span, the Sun and Moon ephemeris with the interpolation's margins, the size 
 the exact search), chooses the AEM's records for its tolerance, counts the output
 samples and estimates the outputs' sizes and the (constant) memory of the streamed
 run.  It notes an output step that undersamples the motion (more than a tenth of its
-shortest period).  What it refuses, a run would have refused later, after computing;
-what it returns is what the run uses.  Errors are ``attitude.errors.InputError``
-whose message starts with the scenario key.
+shortest period).  Segments under torques are propagated (their whole grid, and the
+error estimate of their step); a torque-free scenario with an orbit gets its validity
+horizon (``attitude.validity_horizon``).  What it refuses, a run would have refused
+later, after computing; what it returns is what the run uses.  Errors are
+``attitude.errors.InputError`` whose message starts with the scenario key.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from attitude.aem_sampling import AemPlan, plan_aem
+from attitude.errors import InputError
 from attitude.motion_analysis import SegmentMotion, analyze
 from attitude.output_budget import OutputBudget, check_fits, estimate
 from attitude.output_formats import OutputChoice
@@ -24,6 +28,7 @@ from attitude.pointing import PointingSpec, SearchGrid, check_pointing, undersam
 from attitude.scenario import Scenario
 from attitude.timeseries_parquet import check_span
 from attitude.trajectory import Trajectory, propagate
+from attitude.validity_horizon import ValidityHorizon, validity_horizon
 
 __all__ = ["RunPlan", "plan_run"]
 
@@ -41,6 +46,7 @@ class RunPlan:
     outputs: OutputChoice = field(default_factory=OutputChoice)
     aem: AemPlan | None = None
     search: SearchGrid | None = None  # the pointing's exact search (None without pointing)
+    horizon: ValidityHorizon | None = None  # torque-free with an orbit: how long it holds
 
 
 def plan_run(
@@ -63,6 +69,16 @@ def plan_run(
     undersampled = undersampling_note(trajectory, motion)
     if undersampled:
         notes.append(undersampled)
+    for segment in trajectory.segments:  # the estimates the summary states, checked here
+        error = getattr(segment.solver, "error_estimate", 0.0)
+        if not math.isfinite(error):
+            raise InputError(
+                f"torques: the propagation from {scenario.format_epoch(segment.start_s)} "
+                f"has no finite error estimate ({error}): give a smaller step"
+            )
+    horizon = None
+    if pointing.orbit is not None and not scenario.torques.any:
+        horizon = validity_horizon(trajectory, pointing.orbit)
     aem = None
     if "aem" in outputs:
         aem = plan_aem(
@@ -81,4 +97,6 @@ def plan_run(
         outputs.formats,
         0 if aem is None else aem.records,
     )
-    return RunPlan(scenario, pointing, trajectory, motion, budget, notes, outputs, aem, search)
+    return RunPlan(
+        scenario, pointing, trajectory, motion, budget, notes, outputs, aem, search, horizon
+    )

@@ -243,6 +243,10 @@ class Scenario:
                     f"the span [{self.format_epoch(0.0)}, {self.format_epoch(self.stop_s)})"
                 )
             self.burns.append(PlacedBurn(start_s, start_s + burn.duration, burn, index))
+        if torques.step is not None and torques.step > self.stop_s:
+            raise InputError(
+                f"torques.step: {torques.step:g} s is longer than the span ({self.stop_s:g} s)"
+            )
         if torques.step is not None and self.stop_s / torques.step > MAX_STEPS:
             raise InputError(
                 f"torques.step: {torques.step:g} s is {self.stop_s / torques.step:.3g} steps "

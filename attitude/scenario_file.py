@@ -44,6 +44,7 @@ from attitude.output_formats import DEFAULT_FORMATS, OutputChoice, parse_formats
 from attitude.pointing import KINDS, BodyVector, PointingSpec
 from attitude.quantities import convert_unit
 from attitude.scenario import InitialState, Scenario
+from attitude.scenario_torques import Burn, ScenarioTorques
 from attitude.spacecraft import Spacecraft
 from attitude.timescales import SCALES, as_time, time_from_tt_seconds
 
@@ -512,6 +513,51 @@ def _pointing(root: _Table, scale: str, epoch, name: str) -> PointingSpec:
     return _checked(table, None, PointingSpec, vectors, orbit, **options)
 
 
+def _burn(table: _Table, scale: str) -> Burn:
+    table.allow("epoch", "offset", "duration", "torque", "frame", "label")
+    at = _event_epoch(table, scale)
+    duration = table.positive("duration", "time")
+    torque = table.quantity("torque", "torque", (3,))
+    frame = table.choice("frame", ("body", "inertial"), default="body")
+    label = table.string("label", required=False, default="")
+    return _checked(table, None, Burn, at, duration, torque, frame, label)
+
+
+def _torques(root: _Table, scale: str, orbit: Orbit | None) -> ScenarioTorques | None:
+    """``[torques]``: gravity gradient (on the orbit of ``[pointing]``), burns, the
+    splitting's step or accuracy and order, the validity horizon's threshold."""
+    table = root.table("torques", required=False)
+    if table is None:
+        return None
+    table.allow("gravity_gradient", "burns", "step", "accuracy", "order", "horizon_threshold")
+    gravity_gradient = table.boolean("gravity_gradient", default=False)
+    if gravity_gradient and orbit is None:
+        table.fail(
+            "gravity gradient needs an orbit: give [pointing] a tle, an oem or "
+            "[pointing.keplerian]",
+            "gravity_gradient",
+        )
+    burns = [_burn(item, scale) for item in table.tables("burns")]
+    if table.has("step") and table.has("accuracy"):
+        table.fail("give step or accuracy, not both")
+    options: dict[str, Any] = {
+        "step": table.positive("step", "time", required=False),
+        "accuracy": table.quantity("accuracy", "angle", (), required=False),
+    }
+    order = table.raw("order", required=False, default=4)
+    if isinstance(order, bool) or order not in (2, 4, 6) or not isinstance(order, int):
+        table.fail(f"expected 2, 4 or 6 (the splitting's order), got {_short(order)}", "order")
+    threshold = table.quantity("horizon_threshold", "angle", (), required=False)
+    if threshold is not None:
+        options["horizon_threshold"] = threshold
+    try:
+        return ScenarioTorques(
+            orbit if gravity_gradient else None, tuple(burns), order=order, **options
+        )
+    except InputError as exc:
+        raise ScenarioFileError(f"{table.file.name}: {exc}") from None
+
+
 def _read(path: Path) -> dict[str, Any]:
     """The TOML document at ``path``; ScenarioFileError for anything that is not one."""
     try:
@@ -542,7 +588,7 @@ def load_scenario(path: str | Path) -> ScenarioFile:
     """Read and check a scenario file; raises :class:`ScenarioFileError`."""
     path = Path(path)
     root = _Table(path, "", _read(path))
-    root.allow("scenario", "spacecraft", "initial_state", "events", "output", "pointing")
+    root.allow("scenario", "spacecraft", "initial_state", "events", "output", "pointing", "torques")
 
     meta = root.table("scenario")
     meta.allow("name", "epoch", "time_scale")
@@ -568,6 +614,7 @@ def load_scenario(path: str | Path) -> ScenarioFile:
     state = _checked(initial, None, InitialState, attitude, **rate)
 
     events = _events(root, scale, epoch, pointing.orbit)
+    torques = _torques(root, scale, pointing.orbit)
 
     output = root.table("output")
     output.allow("start", "stop", "duration", "step", "formats", "aem_tolerance")
@@ -588,6 +635,7 @@ def load_scenario(path: str | Path) -> ScenarioFile:
             duration=duration,
             start=start,
             step=step,
+            torques=torques,
         )
     except InputError as exc:
         end = "stop" if stop is not None else "duration"

@@ -33,6 +33,7 @@ from scipy.spatial.transform import Rotation
 from attitude.events import State
 from attitude.scenario import Scenario
 from attitude.scenario_torques import ScenarioTorques
+from attitude.timescales import offline_time
 from attitude.torqued_solver import TorquedSolver, angles_between
 from attitude.torques import ConstantTorque, GravityGradient, Torque
 
@@ -49,14 +50,48 @@ def scenario_torque_models(scenario: Scenario) -> list[tuple[float, float, Torqu
     torques: ScenarioTorques = scenario.torques
     models: list[tuple[float, float, Torque]] = []
     if torques.gravity_gradient is not None:
-        # An orbit's times are the scenario epoch + t; a callable takes t itself.
-        gradient = GravityGradient(torques.gravity_gradient, epoch=scenario.epoch)
+        gradient = GravityGradient(_position_source(torques.gravity_gradient, scenario))
         models.append((-math.inf, math.inf, gradient))
     for placed in scenario.burns:
         burn = placed.burn
         model = ConstantTorque(burn.torque, placed.start_s, placed.stop_s, burn.frame)
         models.append((placed.start_s, placed.stop_s, model))
     return models
+
+
+def _position_source(source: Any, scenario: Scenario) -> Any:
+    """The inertial position at TT seconds t since the scenario epoch: an orbit of
+    ``attitude.orbit`` read at the two-part TT Julian date (no lossy float JD, no
+    ``Time`` built per call); any other orbit object is left to ``GravityGradient`` with
+    the scenario epoch as its t = 0; a callable already takes t."""
+    if hasattr(source, "state_tt"):
+        with offline_time():
+            tt = scenario.epoch.tt
+        jd1, jd2 = float(tt.jd1), float(tt.jd2)
+
+        def position(t: NDArray[np.float64]) -> NDArray[np.float64]:
+            t = np.asarray(t, dtype=np.float64)
+            flat = t.ravel()
+            r, _ = source.state_tt(np.full(flat.shape, jd1), jd2 + flat / 86400.0)
+            return np.asarray(r, dtype=np.float64).reshape((*t.shape, 3))
+
+        return position
+    if callable(source):
+        return source
+    return _OrbitAtEpoch(source, scenario.epoch)
+
+
+class _OrbitAtEpoch:
+    """An orbit object with the scenario epoch as the ``epoch`` its t = 0 stands for."""
+
+    def __init__(self, orbit: Any, epoch: Any) -> None:
+        self.orbit, self.epoch = orbit, epoch
+        for name in ("position", "position_velocity"):
+            if hasattr(orbit, name):
+                setattr(self, name, getattr(orbit, name))
+
+    def __repr__(self) -> str:
+        return repr(self.orbit)
 
 
 class TorquedMotion:

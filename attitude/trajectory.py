@@ -80,7 +80,12 @@ def _check_resolved(
     thousandth of the shorter of the two, every output would be noise: the elliptic
     phase λt, exact for the t given, is exact for a t that no one meant.
     """
-    G = solver.angular_momentum_norm
+    try:
+        G = solver.angular_momentum_norm  # under torques: the grid over the segment
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
+    if not math.isfinite(G):
+        raise InputError(f"{where}: the angular momentum goes beyond the float range")
     if G == 0.0:
         return
     turn_s = 2.0 * math.pi * (float(np.min(solver.moments_of_inertia)) / G)
@@ -94,8 +99,6 @@ def _check_resolved(
         )
     if not math.isfinite(solver.kinetic_energy):
         raise InputError(f"{where}: the kinetic energy is beyond the float range")
-    if isinstance(solver, TorquedMotion) and not math.isfinite(solver.error_estimate):
-        raise InputError(f"{where}: the torqued propagation diverged (no finite error estimate)")
 
 
 def propagate(scenario: Scenario) -> Trajectory:

@@ -49,6 +49,7 @@ LAYERS = [
         "output_formats",
         "output_budget",
         "run_plan",
+        "torques_summary",
         "output_folder",
         "report",
     ],
