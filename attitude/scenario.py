@@ -25,6 +25,7 @@ Time rules (what a user can rely on):
 from __future__ import annotations
 
 import copy
+import math
 from dataclasses import dataclass
 from typing import Any
 
@@ -241,6 +242,13 @@ class Scenario:
                 raise InputError(
                     f"{where}.epoch: the burn starts at {self.format_epoch(start_s)}, outside "
                     f"the span [{self.format_epoch(0.0)}, {self.format_epoch(self.stop_s)})"
+                )
+            # The momentum it adds, and the kinetic energy (~ H²/2I), must be floats.
+            impulse = math.hypot(*burn.torque) * min(burn.duration, self.stop_s - start_s)
+            if not math.isfinite(impulse * impulse):
+                raise InputError(
+                    f"{where}.torque: {burn.torque.tolist()} N m over the span is an angular "
+                    f"impulse of {impulse:.3g} N m s, beyond what floats hold (its square)"
                 )
             self.burns.append(PlacedBurn(start_s, start_s + burn.duration, burn, index))
         if torques.step is not None and torques.step > self.stop_s:

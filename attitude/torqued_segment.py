@@ -195,7 +195,8 @@ class TorquedMotion:
 
     @cached_property
     def _bounds(self) -> tuple[float, float]:
-        _, G, T = self.solver.grid_invariants(self.end_s)
+        with np.errstate(over="ignore", invalid="ignore"):  # refused above, by the caller
+            _, G, T = self.solver.grid_invariants(self.end_s)
         G = np.append(G, np.linalg.norm(self.state.angular_momentum))
         T = np.append(T, self.initial_kinetic_energy)
         dG = float(np.max(np.abs(np.diff(G)))) if G.size > 1 else 0.0

@@ -85,7 +85,9 @@ def _check_resolved(
     except InputError as exc:
         raise InputError(f"{where}: {exc}") from None
     if not math.isfinite(G):
-        raise InputError(f"{where}: the angular momentum goes beyond the float range")
+        raise InputError(
+            f"{where}: under the torques, the angular momentum goes beyond the float range"
+        )
     if G == 0.0:
         return
     turn_s = 2.0 * math.pi * (float(np.min(solver.moments_of_inertia)) / G)
