@@ -11,9 +11,10 @@ millisecond (:func:`attitude.torqued_solver.first_crossing`, which
 attitude again; the horizon is the first crossing.
 
 The torqued run uses the scenario's ``[torques]`` step or accuracy and order when it
-states one; otherwise order 4 at a step of a fifth of the body's fastest turn, at most
-a fortieth of the orbit period (the error at such steps is 1e-6 rad or less over an
-orbit for the bodies of ``docs/torques.md``, far below a threshold of a degree).  The
+states one; otherwise order 4 at a step of a fifth of the body's fastest turn (at the
+bound √(2T/I_min) of its rate), at most a fortieth of the orbit period: a degree needs
+far less accuracy than the splitting gives there (docs/torques.md, "The scenario
+route", measures the horizon against a run at a quarter of that step).  The
 search covers the span, but at most :data:`MAX_HORIZON_STEPS` steps of that run: when
 the span is longer, the horizon is stated as beyond the time searched.
 """
@@ -98,10 +99,13 @@ class ValidityHorizon:
 
 
 def _step(trajectory: Trajectory, orbit: Any) -> float:
-    """A fifth of the fastest turn of the body over the segments, at most a fortieth of
-    the orbit period at the epoch (two-body, from the radius there)."""
+    """A fifth of the fastest turn of the body over the segments (at its largest rate,
+    |ω| ≤ √(2T/I_min)), at most a fortieth of the orbit period at the epoch (two-body,
+    from the radius there)."""
     rates = [
-        segment.solver.angular_momentum_norm / float(np.min(segment.solver.moments_of_inertia))
+        math.sqrt(
+            2.0 * segment.solver.kinetic_energy / float(np.min(segment.solver.moments_of_inertia))
+        )
         for segment in trajectory.segments
     ]
     candidates = [2.0 * math.pi / max(rates) * _TURN_FRACTION] if max(rates) > 0.0 else []
