@@ -54,9 +54,9 @@ DEFAULT_ACCURACY_RAD = 1e-6
 DEFAULT_HORIZON_THRESHOLD_RAD = math.radians(1.0)
 # Accuracies the step search can meet: below 1e-12 rad the estimate is rounding.
 _ACCURACY_RANGE_RAD = (1e-12, 0.1)
-# More steps than this over the span (hours of computing) is refused as a mistake,
-# as TorquedSolver refuses more than 1e8 steps in one request.
-MAX_STEPS = 1e8
+# More steps than this over the span is refused as a mistake: at 8 free flows a step
+# and tens of µs a flow, 1e7 steps are about an hour of computing.
+MAX_STEPS = 1e7
 
 
 @dataclass(frozen=True)

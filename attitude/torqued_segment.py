@@ -30,9 +30,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
+from attitude.errors import InputError
 from attitude.events import State
 from attitude.scenario import Scenario
-from attitude.scenario_torques import ScenarioTorques
+from attitude.scenario_torques import MAX_STEPS, ScenarioTorques
 from attitude.timescales import offline_time
 from attitude.torqued_solver import TorquedSolver, angles_between
 from attitude.torques import ConstantTorque, GravityGradient, Torque
@@ -94,6 +95,27 @@ class _OrbitAtEpoch:
         return repr(self.orbit)
 
 
+def _refuse_a_long_search(state: State, t0: float, span: float, torques) -> None:
+    """Refuse a step search whose first try alone would take more than MAX_STEPS steps.
+
+    The search (``TorquedSolver``) first runs the span at half a quarter turn of the
+    body (at most a fortieth of the orbit) and at twice that; the body's fastest turn
+    is bounded by |ω| ≤ √(2T/I_min).
+    """
+    rate = math.sqrt(2.0 * state.kinetic_energy / float(np.min(state.inertia.moments)))
+    first = [0.5 * 2.0 * math.pi / rate / 4.0] if rate > 0.0 else []
+    for torque in torques:
+        if isinstance(torque, GravityGradient):
+            radius = float(np.linalg.norm(torque.position(np.array([t0]))[0]))
+            first.append(0.5 * 2.0 * math.pi * math.sqrt(radius**3 / torque.mu) / 20.0)
+    if first and span / min(first) * 1.5 > MAX_STEPS:
+        raise InputError(
+            f"torques.accuracy: choosing the step over {span:g} s would start with "
+            f"{span / min(first) * 1.5:.3g} steps of {min(first):.3g} s (more than "
+            f"{MAX_STEPS:g}): give torques.step, or a shorter span"
+        )
+
+
 class TorquedMotion:
     """One segment [t0, end_s] under ``torques`` (models), from ``state`` at ``t0``.
 
@@ -120,6 +142,7 @@ class TorquedMotion:
         span = self.end_s - t0
         options: dict[str, Any] = {"order": settings.order}
         if settings.step is None and span > _SHORTEST_SEARCH_S:
+            _refuse_a_long_search(state, t0, span, self.torques)
             options.update(tolerance=settings.accuracy_rad, span=span)
         else:
             options["step"] = settings.step if settings.step is not None else max(span, 1.0)

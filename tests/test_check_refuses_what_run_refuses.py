@@ -174,7 +174,16 @@ BAD = {
     ),
     "torques: 1e10 steps": (
         _torques("step = 1e-9", BURN),
-        r"torques\.step: 1e-09 s is 1e\+10 steps over the span of 10 s, more than 1e\+08",
+        r"torques\.step: 1e-09 s is 1e\+10 steps over the span of 10 s, more than 1e\+07",
+    ),
+    "torques: an accuracy over 300 years": (
+        _torques(
+            'accuracy = { value = 1e-6, unit = "rad" }',
+            BURN.replace("duration = 2.0", "duration = 1e10"),
+        ).replace("duration = 10.0", "duration = 1e10"),
+        r"the state after events\[0\] .*: torques\.accuracy: choosing the step over "
+        r"1e\+10 s would start with "
+        r"[\d.e+]+ steps of [\d.]+ s \(more than 1e\+07\): give torques\.step",
     ),
     "torques: negative step": (
         _torques("step = -1.0", BURN),
