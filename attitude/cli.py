@@ -159,9 +159,10 @@ def _describe(loaded, plan, out: Path | None = None) -> str:
     for index, item in enumerate(plan.motion):
         period = "" if math.isinf(item.period_s) else f", body period {item.period_s:.6g} s"
         flips = f", {item.flip_count} flips" if item.flip_count else ""
+        how = "splitting" if item.formula == "torqued" else f"formula {item.formula}"
         lines.append(
             f"  segment {index}   from {scenario.format_epoch(item.start_s)}: {item.motion} "
-            f"(formula {item.formula}{period}{flips})"
+            f"({how}{period}{flips})"
         )
     from attitude.torques_summary import torques_lines
 
@@ -180,7 +181,8 @@ def _describe(loaded, plan, out: Path | None = None) -> str:
         lines.append(
             f"  aem         {plan.aem.records} records (a record every "
             f"{min(steps):.4g} to {max(steps):.4g} s), LAGRANGE interpolation within "
-            f"{plan.aem.tolerance_rad:g} rad of the exact attitude"
+            f"{plan.aem.tolerance_rad:g} rad of the "
+            f"{'propagated' if scenario.torques.any else 'exact'} attitude"
         )
     if out is None:
         lines.append("  disk        not checked: `check --out DIR` checks the free space of DIR")

@@ -165,8 +165,7 @@ class TorquedMotion:
         last = self._last
         if last is not None and last[0].shape == τ.shape and np.array_equal(last[0], τ):
             return last[1], last[2]
-        m = self.solver.angular_momentum(τ)
-        q = self.solver.attitude_quaternion(τ)
+        m, q = self.solver.states(τ)
         self._last = (τ.copy(), m, q)
         return m, q
 

@@ -486,6 +486,14 @@ class TorquedSolver:
     def _to_body(self, v: NDArray) -> NDArray:
         return v if self._principal_to_body is None else self._principal_to_body.apply(v)
 
+    def states(self, t: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Body-frame angular momentum (N m s) and attitude quaternions body → inertial,
+        scalar first, at ``t``, from one evaluation: shapes ``np.shape(t) + (3,)``, ``+ (4,)``."""
+        if not self._torques:
+            return self._free.angular_momentum(t), self._free.attitude_quaternion(t)
+        m, q, shape = self._principal_states(t)
+        return self._to_body(m).reshape((*shape, 3)), self._body_quaternions(q).reshape((*shape, 4))
+
     def angular_momentum(self, t: ArrayLike) -> NDArray[np.float64]:
         """Body-frame angular momentum at ``t`` (N m s), shape ``np.shape(t) + (3,)``."""
         if not self._torques:
