@@ -122,7 +122,7 @@ def _torques_section(torques: dict[str, Any] | None) -> list[str]:
     parts.append(
         f"<p>Modelled: {escape(', '.join(torques['modelled']))}. Order {torques['order']}, "
         f"step {escape(how)}; estimated attitude error "
-        f"{torques['estimated_error_rad']:.2g} rad in all.</p>"
+        f"{torques['estimated_error_rad']:.2g} rad over the run (each segment's own below).</p>"
     )
     if torques["burns"]:
         parts.append(
@@ -136,7 +136,7 @@ def _torques_section(torques: dict[str, Any] | None) -> list[str]:
         )
     parts.append(
         _table(
-            ["segment", "method", "step (s)", "estimated error (rad)"],
+            ["segment", "method", "step (s)", "estimated error from its start (rad)"],
             [
                 [s["segment"], s["method"], s["step_s"], s["estimated_error_rad"]]
                 for s in torques["segments"]

@@ -69,13 +69,14 @@ def plan_run(
     undersampled = undersampling_note(trajectory, motion)
     if undersampled:
         notes.append(undersampled)
-    for segment in trajectory.segments:  # the estimates the summary states, checked here
-        error = getattr(segment.solver, "error_estimate", 0.0)
-        if not math.isfinite(error):
-            raise InputError(
-                f"torques: the propagation from {scenario.format_epoch(segment.start_s)} "
-                f"has no finite error estimate ({error}): give a smaller step"
-            )
+    # The error estimates the summary states (each segment's, and the run's), checked here.
+    errors = [getattr(s.solver, "error_estimate", 0.0) for s in trajectory.segments]
+    errors.append(trajectory.error_estimate)
+    if not all(math.isfinite(error) for error in errors):
+        raise InputError(
+            f"torques: the propagation has no finite error estimate ({errors}): "
+            "give a smaller step or an accuracy"
+        )
     horizon = None
     if pointing.orbit is not None and not scenario.torques.any:
         horizon = validity_horizon(trajectory, pointing.orbit)

@@ -5,9 +5,9 @@ For ``summary.json`` (``torques``), ``attitude check`` and the HTML report, from
 
 - a scenario under torques: the torques (gravity gradient, each burn with its start,
   duration, torque and frame), the splitting method and order, the step (given, or
-  chosen for the stated accuracy) and the estimated attitude error of each segment
-  under torques (``attitude.torqued_segment``), and their sum, a bound on how the
-  segments' errors add up through the events;
+  chosen for the stated accuracy), the estimated attitude error of each segment under
+  torques from its own start state (``attitude.torqued_segment``), and the run's, which
+  carries the errors through the events (:attr:`~attitude.trajectory.Trajectory.error_estimate`);
 - a torque-free scenario: that the exact solver propagated it, and with an orbit its
   validity horizon (``attitude.validity_horizon``).
 """
@@ -66,7 +66,10 @@ def torques_summary(plan: RunPlan) -> dict[str, Any]:
         "step": "given" if settings.step is not None else "chosen for the accuracy",
         "accuracy_rad": settings.accuracy_rad,
         "segments": segments,
-        "estimated_error_rad": sum(item["estimated_error_rad"] for item in segments),
+        "estimated_error_rad": plan.trajectory.error_estimate,
+        "estimated_error_note": "segments[].estimated_error_rad: each segment's own, from its "
+        "start state; estimated_error_rad: the run's, the scenario rerun at twice each step "
+        "through the same events (errors carried into a segment grow with the motion)",
     }
 
 
@@ -88,10 +91,11 @@ def torques_lines(plan: RunPlan) -> list[str]:
     for item in entry["segments"]:
         lines.append(
             f"  segment {item['segment']} {item['method']} at a step of {item['step_s']:.6g} s, "
-            f"estimated error {item['estimated_error_rad']:.2g} rad"
+            f"estimated error {item['estimated_error_rad']:.2g} rad from its start"
         )
-    if len(entry["segments"]) > 1:
-        lines.append(f"  estimated error, all segments: {entry['estimated_error_rad']:.2g} rad")
+    lines.append(
+        f"  estimated error of the run, through the events: {entry['estimated_error_rad']:.2g} rad"
+    )
     return lines
 
 

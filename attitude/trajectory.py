@@ -14,9 +14,11 @@ torque-free motion is far below anything this package reports).
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -29,6 +31,7 @@ from attitude.events import Event, State
 from attitude.scenario import Scenario
 from attitude.timescales import SAME_INSTANT_S, tt_seconds
 from attitude.torqued_segment import TorquedMotion, scenario_torque_models
+from attitude.torqued_solver import angles_between
 
 __all__ = ["Segment", "Trajectory", "propagate"]
 
@@ -57,14 +60,24 @@ _RESOLVED_FRACTION_OF_A_TURN = 1e-3
 
 
 def _solver(
-    state: State, t0: float, end_s: float, where: str, scenario: Scenario, models: list
+    state: State,
+    t0: float,
+    end_s: float,
+    where: str,
+    scenario: Scenario,
+    models: list,
+    step: float | None = None,
 ) -> EulerSolver | TorquedMotion:
     """The exact solver from ``state`` at ``t0``, or the torqued one if a torque acts
-    within [t0, end_s] (``models``: (start, stop, torque) of the scenario)."""
+    within [t0, end_s] (``models``: (start, stop, torque) of the scenario), at ``step``
+    if given, else as the scenario's torques say."""
     acting = [model for start, stop, model in models if start < end_s and stop > t0]
     try:
         if acting:
-            return TorquedMotion(state, t0, end_s, acting, scenario.torques)
+            settings = scenario.torques
+            if step is not None:
+                settings = dataclasses.replace(settings, step=step, accuracy=None)
+            return TorquedMotion(state, t0, end_s, acting, settings)
         return EulerSolver(state.inertia.tensor, state.angular_momentum, state.attitude, t0=t0)
     except InputError as exc:
         raise InputError(f"{where}: {exc}") from None
@@ -103,9 +116,11 @@ def _check_resolved(
         raise InputError(f"{where}: the kinetic energy is beyond the float range")
 
 
-def propagate(scenario: Scenario) -> Trajectory:
+def propagate(scenario: Scenario, steps: list[float | None] | None = None) -> Trajectory:
     """The exact motion of ``scenario`` over [epoch, stop], through its events.
 
+    ``steps``: per segment, the torqued solver's step (None: as the scenario says), to
+    rerun a torqued trajectory at other steps (:attr:`Trajectory.error_estimate`).
     Raises :class:`InputError` naming the state (``initial_state`` or ``events[i]``)
     whose motion the solver refuses, or that turns too fast for TT seconds (floats)
     to follow over the span.
@@ -120,16 +135,20 @@ def propagate(scenario: Scenario) -> Trajectory:
     starts: list[tuple[float, State, Event | None, State | None]] = [(0.0, state, None, None)]
     ends = [offset for offset, _ in scenario.events] + [scenario.stop_s]
     models = scenario_torque_models(scenario) if scenario.torques.any else []
-    solver = _solver(state, 0.0, ends[0], "initial_state", scenario, models)
+    steps = steps or [None] * len(ends)
+    solver = _solver(state, 0.0, ends[0], "initial_state", scenario, models, steps[0])
     _check_resolved(solver, 0.0, ends[0], "initial_state")
     solvers = [solver]
     indices = getattr(scenario, "event_indices", range(len(scenario.events)))
-    for (offset, event), index, end in zip(scenario.events, indices, ends[1:], strict=True):
+    for k, ((offset, event), index, end) in enumerate(
+        zip(scenario.events, indices, ends[1:], strict=True), start=1
+    ):
         where = f"events[{index}] ({event.kind} at {scenario.format_epoch(offset)})"
         before = State(solver.attitude(offset), solver.angular_momentum(offset), state.inertia)
         state = event.apply(before)
-        solver = _solver(state, offset, end, f"the state after {where}", scenario, models)
-        _check_resolved(solver, offset, end, f"the state after {where}")
+        where = f"the state after {where}"
+        solver = _solver(state, offset, end, where, scenario, models, steps[k])
+        _check_resolved(solver, offset, end, where)
         solvers.append(solver)
         starts.append((offset, state, event, before))
     segments = [
@@ -243,6 +262,38 @@ class Trajectory:
             return np.full((τ.size, 1), solver.kinetic_energy)
 
         return self._by_segment(times, evaluate, 1)[..., 0]
+
+    @cached_property
+    def error_estimate(self) -> float:
+        """The estimated worst attitude error of the run (rad); 0 for the exact solver.
+
+        Under torques, the segments' errors carry through the events and grow with the
+        motion (an error of the momentum shifts the phase of a tumble), so each
+        segment's own estimate does not add up to the run's.  This is the run's:
+        the same scenario at twice each segment's step, through the same events,
+        compared at 64 times over the span and at each segment's end, the largest angle
+        over 2^p − 1 (Richardson, p the order).
+        """
+        torqued = [isinstance(s.solver, TorquedMotion) for s in self.segments]
+        if not any(torqued):
+            return 0.0
+        steps = [
+            2.0 * s.solver.step if is_torqued else None
+            for s, is_torqued in zip(self.segments, torqued, strict=True)
+        ]
+        coarse = propagate(self.scenario, steps)
+        checks = np.unique(
+            np.concatenate(
+                [
+                    np.linspace(0.0, self.stop_s, 65)[1:],
+                    [s.end_s for s in self.segments if s.end_s > 0.0],
+                ]
+            )
+        )
+        difference = angles_between(
+            self.attitude_quaternion(checks), coarse.attitude_quaternion(checks)
+        )
+        return float(np.max(difference)) / (2.0**self.scenario.torques.order - 1.0)
 
     def flip_times(self) -> NDArray[np.float64]:
         """All Джанибеков flips over [epoch, stop], TT seconds since the epoch (closed form)."""
