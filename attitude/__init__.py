@@ -6,8 +6,10 @@ The layers, each importing only the ones above it in this list (README "Layout")
 - ``attitude.euler_solver``: ``EulerSolver``, the closed-form torque-free rigid body
 - ``attitude.torques``, ``splitting``, ``torqued_solver``: ``TorquedSolver``, torques
   (gravity gradient, constant torques, user torques) by splitting with the exact free flow
-- ``attitude.spacecraft``, ``events``, ``scenario``, ``timescales``: the scenario layer
-- ``attitude.trajectory``, ``motion_analysis``: the propagated motion
+- ``attitude.spacecraft``, ``events``, ``scenario_torques``, ``scenario``, ``timescales``:
+  the scenario layer
+- ``attitude.torqued_segment``, ``trajectory``, ``validity_horizon``, ``motion_analysis``:
+  the propagated motion
 - ``attitude.ephemeris``, ``earth``, ``frames``, ``orbit``, ``keplerian``, ``oem``,
   ``aem_input``, ``intervals``, ``extrema``, ``eclipse``, ``pointing``: pointing
 - ``attitude.exports``, ``aem``, ``plots``, ``report_page``, ``report``: reports and exports
@@ -42,10 +44,12 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.report import produce
     from attitude.scenario import InitialState, Scenario
     from attitude.scenario_file import load_scenario
+    from attitude.scenario_torques import Burn, ScenarioTorques
     from attitude.spacecraft import Spacecraft
     from attitude.torqued_solver import TorquedSolver, departure_time, propagate_batch
     from attitude.torques import ConstantTorque, GravityGradient, UserTorque
     from attitude.trajectory import Trajectory, propagate
+    from attitude.validity_horizon import validity_horizon
 
 _LAZY = {
     "EulerSolver": "attitude.euler_solver",
@@ -58,6 +62,9 @@ _LAZY = {
     "Spacecraft": "attitude.spacecraft",
     "InitialState": "attitude.scenario",
     "Scenario": "attitude.scenario",
+    "ScenarioTorques": "attitude.scenario_torques",
+    "Burn": "attitude.scenario_torques",
+    "validity_horizon": "attitude.validity_horizon",
     "AngularImpulse": "attitude.events",
     "InertiaChange": "attitude.events",
     "AttitudeReset": "attitude.events",
@@ -83,6 +90,7 @@ __all__ = [
     "AttitudeError",
     "AttitudeReset",
     "BodyVector",
+    "Burn",
     "ConstantTorque",
     "EulerSolver",
     "GravityGradient",
@@ -94,6 +102,7 @@ __all__ = [
     "OemOrbit",
     "PointingSpec",
     "Scenario",
+    "ScenarioTorques",
     "Spacecraft",
     "TleOrbit",
     "TorquedSolver",
@@ -108,6 +117,7 @@ __all__ = [
     "produce",
     "propagate",
     "propagate_batch",
+    "validity_horizon",
     "write_aem",
 ]
 
