@@ -6,9 +6,12 @@ The layers, each importing only the ones above it in this list (README "Layout")
 - ``attitude.euler_solver``: ``EulerSolver``, the closed-form torque-free rigid body
 - ``attitude.torques``, ``splitting``, ``torqued_solver``: ``TorquedSolver``, torques
   (gravity gradient, constant torques, user torques) by splitting with the exact free flow
-- ``attitude.spacecraft``, ``events``, ``scenario``, ``timescales``: the scenario layer
-- ``attitude.trajectory``, ``motion_analysis``: the propagated motion
-- ``attitude.ephemeris``, ``orbit``, ``eclipse``, ``pointing``, ``intervals``: pointing
+- ``attitude.spacecraft``, ``events``, ``scenario_torques``, ``scenario``, ``timescales``:
+  the scenario layer
+- ``attitude.torqued_segment``, ``trajectory``, ``horizon``, ``motion_analysis``:
+  the propagated motion
+- ``attitude.ephemeris``, ``earth``, ``frames``, ``orbit``, ``keplerian``, ``oem``,
+  ``aem_input``, ``intervals``, ``extrema``, ``eclipse``, ``pointing``: pointing
 - ``attitude.exports``, ``aem``, ``plots``, ``report_page``, ``report``: reports and exports
 - ``attitude.scenario_file``, ``cli``: scenario files and the command line
 
@@ -33,12 +36,16 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.aem import write_aem
     from attitude.euler_solver import EulerSolver
     from attitude.events import AngularImpulse, AttitudeReset, InertiaChange
+    from attitude.horizon import validity_horizon
+    from attitude.keplerian import KeplerianOrbit
     from attitude.motion_analysis import analyze
+    from attitude.oem import OemOrbit
     from attitude.orbit import TleOrbit
-    from attitude.pointing import BodyVector, PointingSpec, compute_pointing
+    from attitude.pointing import BodyVector, PointingSpec, pointing_analysis, pointing_samples
     from attitude.report import produce
     from attitude.scenario import InitialState, Scenario
     from attitude.scenario_file import load_scenario
+    from attitude.scenario_torques import Burn, ScenarioTorques
     from attitude.spacecraft import Spacecraft
     from attitude.torqued_solver import TorquedSolver, departure_time, propagate_batch
     from attitude.torques import ConstantTorque, GravityGradient, UserTorque
@@ -55,6 +62,9 @@ _LAZY = {
     "Spacecraft": "attitude.spacecraft",
     "InitialState": "attitude.scenario",
     "Scenario": "attitude.scenario",
+    "ScenarioTorques": "attitude.scenario_torques",
+    "Burn": "attitude.scenario_torques",
+    "validity_horizon": "attitude.horizon",
     "AngularImpulse": "attitude.events",
     "InertiaChange": "attitude.events",
     "AttitudeReset": "attitude.events",
@@ -63,8 +73,11 @@ _LAZY = {
     "analyze": "attitude.motion_analysis",
     "BodyVector": "attitude.pointing",
     "PointingSpec": "attitude.pointing",
-    "compute_pointing": "attitude.pointing",
+    "pointing_samples": "attitude.pointing",
+    "pointing_analysis": "attitude.pointing",
     "TleOrbit": "attitude.orbit",
+    "KeplerianOrbit": "attitude.keplerian",
+    "OemOrbit": "attitude.oem",
     "write_aem": "attitude.aem",
     "load_scenario": "attitude.scenario_file",
     "produce": "attitude.report",
@@ -77,6 +90,7 @@ __all__ = [
     "AttitudeError",
     "AttitudeReset",
     "BodyVector",
+    "Burn",
     "ConstantTorque",
     "EulerSolver",
     "GravityGradient",
@@ -84,8 +98,11 @@ __all__ = [
     "InertiaWarning",
     "InitialState",
     "InputError",
+    "KeplerianOrbit",
+    "OemOrbit",
     "PointingSpec",
     "Scenario",
+    "ScenarioTorques",
     "Spacecraft",
     "TleOrbit",
     "TorquedSolver",
@@ -93,12 +110,14 @@ __all__ = [
     "UserTorque",
     "__version__",
     "analyze",
-    "compute_pointing",
     "departure_time",
     "load_scenario",
+    "pointing_analysis",
+    "pointing_samples",
     "produce",
     "propagate",
     "propagate_batch",
+    "validity_horizon",
     "write_aem",
 ]
 

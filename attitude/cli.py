@@ -159,35 +159,30 @@ def _describe(loaded, plan, out: Path | None = None) -> str:
     for index, item in enumerate(plan.motion):
         period = "" if math.isinf(item.period_s) else f", body period {item.period_s:.6g} s"
         flips = f", {item.flip_count} flips" if item.flip_count else ""
+        how = "splitting" if item.formula == "torqued" else f"formula {item.formula}"
         lines.append(
             f"  segment {index}   from {scenario.format_epoch(item.start_s)}: {item.motion} "
-            f"(formula {item.formula}{period}{flips})"
+            f"({how}{period}{flips})"
         )
+    from attitude.torques_summary import torques_lines
+
+    lines += [f"  {line}" for line in torques_lines(plan)]
     lines.append(f"  events      {len(scenario.events)}")
     lines += [
         f"    {scenario.format_epoch(t)} (+{t:.12g} s)  {event.kind}"
         f"{f' ({event.label})' if event.label else ''}"
         for t, event in scenario.events
     ]
-    spec = loaded.pointing
-    if not spec.is_empty:
-        lines.append(
-            f"  pointing    {len(spec.body_vectors)} body vectors, orbit: "
-            f"{'TLE' if spec.tle else 'Earth centre'}, interval ends to "
-            f"{spec.interval_precision_s:g} s"
-        )
-        for vector in spec.body_vectors:
-            half = vector.sun_exclusion_half_angle_deg
-            lines.append(
-                f"    {vector.name}: {vector.kind}, {vector.vector.tolist()} (body)"
-                + ("" if half is None else f", Sun exclusion half angle {half:.12g} deg")
-            )
+    from attitude.pointing import describe_lines
+
+    lines += [f"  {line}" for line in describe_lines(loaded.pointing)]
     if plan.aem is not None:
         steps = [item.step_s for item in plan.aem.segments]
         lines.append(
             f"  aem         {plan.aem.records} records (a record every "
             f"{min(steps):.4g} to {max(steps):.4g} s), LAGRANGE interpolation within "
-            f"{plan.aem.tolerance_rad:g} rad of the exact attitude"
+            f"{plan.aem.tolerance_rad:g} rad of the "
+            f"{'propagated' if scenario.torques.any else 'exact'} attitude"
         )
     if out is None:
         lines.append("  disk        not checked: `check --out DIR` checks the free space of DIR")

@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 
 from attitude.intervals import Interval, total_duration
 from attitude.motion_analysis import LISTED_FLIPS, SegmentMotion
-from attitude.pointing import PointingResult
+from attitude.pointing import PointingAnalysis, PointingSamples
 from attitude.trajectory import Trajectory
 
 __all__ = [
@@ -33,7 +33,6 @@ __all__ = [
     "CsvWriter",
     "Samples",
     "arrow_texts",
-    "extremum",
     "motion_summary",
     "pointing_columns",
     "pointing_summary",
@@ -256,6 +255,8 @@ _MOTION_TEXT = {
     "separatrix": "separatrix: no period; m leaves the intermediate axis and returns to it "
     "asymptotically, so the body turns over at most once",
     "rest": "at rest: no motion",
+    "torqued": "under torques (propagated by splitting with the exact free flow): no "
+    "period, flips not located; the kinetic energy and momentum are those at its start",
 }
 
 
@@ -316,23 +317,6 @@ def motion_summary(trajectory: Trajectory, motion: list[SegmentMotion]) -> dict[
     return {"segments": segments, "flips": _flips_summary(scenario, motion)}
 
 
-def extremum(
-    seconds: NDArray[np.float64], values: NDArray[np.float64], largest: bool
-) -> tuple[float, float]:
-    """(time, value) of the largest or smallest sample, refined by the parabola through
-    it and its two neighbours (exact for a smooth extremum to O(step³))."""
-    k = int(np.argmax(values) if largest else np.argmin(values))
-    if 0 < k < values.size - 1:
-        y0, y1, y2 = values[k - 1], values[k], values[k + 1]
-        h = seconds[k + 1] - seconds[k]
-        curvature = y0 - 2.0 * y1 + y2
-        if curvature != 0.0 and np.isclose(seconds[k] - seconds[k - 1], h):
-            shift = 0.5 * (y0 - y2) / curvature  # in steps, within (−1, 1) at an extremum
-            if abs(shift) < 1.0:
-                return float(seconds[k] + shift * h), float(y1 - 0.25 * (y0 - y2) * shift)
-    return float(seconds[k]), float(values[k])
-
-
 def right_ascension_deg(radians: NDArray[np.float64]) -> NDArray[np.float64]:
     """Right ascensions in degrees, in [0, 360): an angle a hair below 2π rounds to
     360.0 in degrees, which is written as 0."""
@@ -340,29 +324,55 @@ def right_ascension_deg(radians: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.where(degrees >= 360.0, 0.0, degrees)
 
 
-def pointing_columns(result: PointingResult) -> list[Column]:
-    """The pointing columns of the time series, on the same grid as the trajectory's."""
+def _flag(name: str, values, description: str) -> list[Column]:
+    return [] if values is None else [Column(name, values.astype(float), description)]
+
+
+def _degrees(name: str, values, description: str) -> list[Column]:
+    return [] if values is None else [Column(name, np.degrees(values), description)]
+
+
+def pointing_columns(samples: PointingSamples) -> list[Column]:
+    """The pointing columns of the time series, at the samples' times (any chunk of
+    the output grid: the columns of consecutive chunks follow on)."""
     columns = _components(
-        "sun_icrf_{}", result.sun_direction_icrf, "xyz", "Sun direction (unit), ICRF axes"
+        "sun_icrf_{}",
+        samples.sun_direction_icrf,
+        "xyz",
+        "apparent Sun direction from the spacecraft (unit), ICRF axes",
     )
-    if result.on_orbit:
+    if samples.on_orbit:
         columns.append(
-            Column("sunlit_fraction", result.sunlit_fraction, "visible fraction of the Sun's disc")
+            Column("sunlit_fraction", samples.sunlit_fraction, "visible fraction of the Sun's disc")
         )
-        columns.append(
+        columns += _degrees(
+            "earth_angular_radius_deg",
+            samples.earth_angular_radius_rad,
+            "angular radius of the Earth (equatorial sphere) seen from the spacecraft, deg",
+        )
+    if samples.q_body_to_lvlh is not None:
+        columns += _components(
+            "q_body_to_lvlh_{}",
+            samples.q_body_to_lvlh,
+            "wxyz",
+            "attitude in the orbit's LVLH frame (z nadir, y -orbit normal), quaternion, "
+            "scalar first (w >= 0), body -> LVLH",
+        )
+    if samples.lvlh_euler_deg is not None:
+        sequence = samples.lvlh_euler_sequence
+        kind = "intrinsic" if sequence.isupper() else "extrinsic"
+        columns += [
             Column(
-                "earth_angular_radius_deg",
-                np.degrees(result.earth_angular_radius_rad),
-                "angular radius of the Earth seen from the spacecraft, deg",
+                f"lvlh_euler_{sequence}_{k + 1}_deg",
+                samples.lvlh_euler_deg[:, k],
+                f"Euler angle {k + 1} of body -> LVLH, {kind} sequence {sequence} "
+                f"(about {sequence[k]}), deg",
             )
-        )
-    for item in result.vectors:
+            for k in range(3)
+        ]
+    for item in samples.vectors:
         name = item.vector.name
-        columns.append(
-            Column(
-                f"{name}_sun_angle_deg", np.degrees(item.sun_angle_rad), f"angle {name}–Sun, deg"
-            )
-        )
+        columns += _degrees(f"{name}_sun_angle_deg", item.sun_angle_rad, f"angle {name}-Sun, deg")
         columns.append(
             Column(
                 f"{name}_cos_incidence",
@@ -370,14 +380,19 @@ def pointing_columns(result: PointingResult) -> list[Column]:
                 f"cosine of Sun incidence on {name} (0 if behind or in umbra, × visible fraction)",
             )
         )
-        if item.violated is not None:
-            columns.append(
-                Column(
-                    f"{name}_sun_exclusion_violated",
-                    item.violated.astype(float),
-                    f"1 if the Sun is inside {name}'s exclusion cone (and not in umbra)",
-                )
-            )
+        columns += _flag(
+            f"{name}_sun_exclusion_violated",
+            item.sun_violated,
+            f"1 if the Sun is inside {name}'s exclusion cone (and not in umbra)",
+        )
+        columns += _degrees(
+            f"{name}_moon_angle_deg", item.moon_angle_rad, f"angle {name}-Moon (apparent), deg"
+        )
+        columns += _flag(
+            f"{name}_moon_exclusion_violated",
+            item.moon_violated,
+            f"1 if the Moon is inside {name}'s exclusion cone (and not behind the Earth)",
+        )
         columns.append(
             Column(
                 f"{name}_ra_deg",
@@ -385,34 +400,47 @@ def pointing_columns(result: PointingResult) -> list[Column]:
                 f"{name} right ascension, deg",
             )
         )
-        columns.append(
-            Column(f"{name}_dec_deg", np.degrees(item.declination_rad), f"{name} declination, deg")
+        columns += _degrees(f"{name}_dec_deg", item.declination_rad, f"{name} declination, deg")
+        columns += _degrees(
+            f"{name}_nadir_angle_deg",
+            item.nadir_angle_rad,
+            f"angle between {name} and nadir (the Earth's centre), deg",
         )
-        if item.nadir_angle_rad is not None:
-            columns.append(
-                Column(
-                    f"{name}_nadir_angle_deg",
-                    np.degrees(item.nadir_angle_rad),
-                    f"angle between {name} and nadir (the Earth's centre), deg",
-                )
-            )
+        columns += _degrees(
+            f"{name}_earth_limb_angle_deg",
+            item.earth_limb_angle_rad,
+            f"angle of {name} above the Earth's limb (negative: towards the Earth), deg",
+        )
+        columns += _flag(
+            f"{name}_earth_limb_exclusion_violated",
+            item.earth_limb_violated,
+            f"1 if {name} is less than its exclusion angle above the Earth's limb",
+        )
     return columns
 
 
-def _interval_rows(result: PointingResult) -> list[tuple[str, str, Interval]]:
-    rows = [("eclipse", "", i) for i in result.shadow] + [("umbra", "", i) for i in result.umbra]
-    for item in result.vectors:
-        rows += [("sun_exclusion_violation", item.vector.name, i) for i in item.violations]
-        rows += [("sun_visible", item.vector.name, i) for i in item.sun_visible]
+# The kinds of interval in intervals.csv: (kind, the VectorAnalysis field), per vector.
+_VECTOR_INTERVALS = ("sun_exclusion", "moon_exclusion", "earth_limb_exclusion", "sun_visible")
+
+
+def _interval_rows(analysis: PointingAnalysis) -> list[tuple[str, str, Interval]]:
+    rows = [("eclipse", "", i) for i in analysis.shadow]
+    rows += [("umbra", "", i) for i in analysis.umbra]
+    rows += [("moon_behind_earth", "", i) for i in analysis.moon_hidden]
+    for item in analysis.vectors:
+        for kind in _VECTOR_INTERVALS:
+            rows += [(kind, item.vector.name, i) for i in getattr(item, kind)]
     return sorted(rows, key=lambda row: (row[0], row[1], row[2].start_s))
 
 
-def write_intervals_csv(path: Path, result: PointingResult, iso, preamble: list[str]) -> None:
+def write_intervals_csv(
+    path: Path, analysis: PointingAnalysis, iso, preamble: list[str]
+) -> None:
     """One row per interval: kind, body vector, start and end (ISO and TT s), duration.
 
     ``iso``: a function from TT seconds to ISO texts in the scenario's time scale.
     """
-    rows = _interval_rows(result)
+    rows = _interval_rows(analysis)
     starts = iso(np.array([r[2].start_s for r in rows])) if rows else []
     ends = iso(np.array([r[2].end_s for r in rows])) if rows else []
     with open(path, "w", encoding="utf-8", newline="") as stream:
@@ -428,53 +456,75 @@ def write_intervals_csv(path: Path, result: PointingResult, iso, preamble: list[
             )
 
 
-def _interval_totals(intervals: list[Interval]) -> dict[str, Any]:
-    return {
+def _interval_totals(intervals: list[Interval], format_epoch=None) -> dict[str, Any]:
+    totals: dict[str, Any] = {
         "count": len(intervals),
         "total_s": total_duration(intervals),
         "longest_s": max((i.duration_s for i in intervals), default=0.0),
     }
+    if format_epoch is not None:
+        totals["first"] = [
+            {
+                "start": format_epoch(i.start_s),
+                "end": format_epoch(i.end_s),
+                "duration_s": i.duration_s,
+            }
+            for i in intervals[:20]
+        ]
+    return totals
 
 
-def pointing_summary(result: PointingResult, format_epoch) -> dict[str, Any]:
-    """Extrema with their times, violation and visibility totals, eclipses."""
-    t = result.seconds
+# The extrema in the summary: (key in VectorAnalysis.extrema, summary name, in degrees).
+_EXTREMA = (
+    ("sun_angle", "sun_angle", True),
+    ("moon_angle", "moon_angle", True),
+    ("nadir_angle", "nadir_angle", True),
+    ("earth_limb_angle", "earth_limb_angle", True),
+    ("cos_incidence", "cos_incidence", False),
+)
+
+
+def pointing_summary(analysis: PointingAnalysis, format_epoch) -> dict[str, Any]:
+    """Extrema with their times, constraint and visibility totals, eclipses: all found
+    on the exact motion over the analysed span (``attitude.pointing.pointing_analysis``),
+    none from the output grid."""
     vectors = {}
-    for item in result.vectors:
-        angle = np.degrees(item.sun_angle_rad)
-        t_min, a_min = extremum(t, angle, largest=False)
-        t_max, a_max = extremum(t, angle, largest=True)
-        entry = {
-            "kind": item.vector.kind,
-            "vector_body": item.vector.vector,
-            "sun_angle_min_deg": a_min,
-            "sun_angle_min_at": format_epoch(t_min),
-            "sun_angle_max_deg": a_max,
-            "sun_angle_max_at": format_epoch(t_max),
-            "sun_visible": _interval_totals(item.sun_visible),
-            "mean_cos_incidence": float(np.mean(item.cos_incidence)),
-        }
-        if item.vector.sun_exclusion_half_angle_rad is not None:
-            entry["sun_exclusion_half_angle_deg"] = item.vector.sun_exclusion_half_angle_deg
-            entry["violations"] = _interval_totals(item.violations)
-            entry["violations"]["first"] = [
-                {
-                    "start": format_epoch(i.start_s),
-                    "end": format_epoch(i.end_s),
-                    "duration_s": i.duration_s,
-                }
-                for i in item.violations[:20]
-            ]
-        vectors[item.vector.name] = entry
+    for item in analysis.vectors:
+        v = item.vector
+        entry: dict[str, Any] = {"kind": v.kind, "vector_body": v.vector}
+        for key, name, degrees in _EXTREMA:
+            if key not in item.extrema:
+                continue
+            low, high = item.extrema[key]
+            unit = "_deg" if degrees else ""
+            convert = math.degrees if degrees else float
+            entry[f"{name}_min{unit}"] = convert(low.value)
+            entry[f"{name}_min_at"] = format_epoch(low.time_s)
+            entry[f"{name}_max{unit}"] = convert(high.value)
+            entry[f"{name}_max_at"] = format_epoch(high.time_s)
+        entry["mean_cos_incidence"] = item.mean_cos_incidence
+        entry["sun_visible"] = _interval_totals(item.sun_visible)
+        for constraint, angle in (
+            ("sun_exclusion", "sun_exclusion_half_angle_deg"),
+            ("moon_exclusion", "moon_exclusion_half_angle_deg"),
+            ("earth_limb_exclusion", "earth_limb_exclusion_angle_deg"),
+        ):
+            if getattr(v, angle) is not None:
+                entry[angle] = getattr(v, angle)
+                entry[constraint] = _interval_totals(getattr(item, constraint), format_epoch)
+        vectors[v.name] = entry
     summary: dict[str, Any] = {
-        "position": "TLE orbit" if result.on_orbit else "Earth centre",
-        "interval_precision_s": result.precision_s,
+        "position": analysis.orbit,
+        "span": {"start": format_epoch(analysis.start_s), "stop": format_epoch(analysis.stop_s)},
+        "interval_precision_s": analysis.precision_s,
+        "search_step_s": analysis.grid.step_s,
         "body_vectors": vectors,
     }
-    if result.on_orbit:
+    if analysis.on_orbit:
         summary["eclipses"] = {
-            "shadow": _interval_totals(result.shadow),
-            "umbra": _interval_totals(result.umbra),
-            "sunlit_fraction_of_span": float(np.mean(result.sunlit_fraction)),
+            "shadow": _interval_totals(analysis.shadow),
+            "umbra": _interval_totals(analysis.umbra),
+            "sunlit_fraction_of_span": analysis.sunlit_fraction_mean,
         }
+        summary["moon_behind_earth"] = _interval_totals(analysis.moon_hidden)
     return summary

@@ -27,7 +27,9 @@ Segments without a period are stated as what they are (``SegmentMotion.motion``)
 - ``"separatrix"``: m on the separatrix (Δ2 = 0) but not at the intermediate axis:
   no period; m leaves the intermediate axis and returns to it asymptotically, so the
   body turns over at most once (at u = 0) and nothing repeats;
-- ``"rest"``: G = 0.
+- ``"rest"``: G = 0;
+- ``"torqued"``: a segment under torques (``attitude.torqued_segment``): no period and
+  no closed form; its energy and momentum are given at its start.
 Flips are counted from the closed form without listing them all: at most
 :data:`LISTED_FLIPS` flip times are kept (a day of a fast tumbler has millions).
 """
@@ -40,6 +42,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from attitude.euler_solver import EulerSolver
+from attitude.torqued_segment import TorquedMotion
 from attitude.trajectory import Segment, Trajectory
 from attitude.vectors import basis_across
 
@@ -60,7 +64,7 @@ class SegmentMotion:
     start_s: float
     end_s: float
     formula: str
-    motion: str  # "periodic", "steady spin", "separatrix" or "rest"
+    motion: str  # "periodic", "steady spin", "separatrix", "rest" or "torqued"
     period_s: float  # inf when the motion has no period
     flip_count: int
     flip_times_s: NDArray[np.float64]  # the first LISTED_FLIPS of them
@@ -76,9 +80,16 @@ class SegmentMotion:
     angular_momentum_norm_N_m_s: float  # G, with no overflow of the squares
 
 
+def _free_solver(segment: Segment) -> EulerSolver:
+    """The segment's exact torque-free solver (the analyses below need its invariants)."""
+    if not isinstance(segment.solver, EulerSolver):
+        raise TypeError(f"segment from {segment.start_s} s is not torque-free")
+    return segment.solver
+
+
 def _mean_period_about_momentum(segment: Segment, axis_body: NDArray[np.float64]) -> float:
     """Period of the mean rotation of a body axis about H, over one period of m(t)."""
-    solver = segment.solver
+    solver = _free_solver(segment)
     G = solver.angular_momentum_norm
     h = solver.inertial_angular_momentum / G
     period = solver.period
@@ -95,7 +106,7 @@ def _mean_period_about_momentum(segment: Segment, axis_body: NDArray[np.float64]
 def _is_steady(segment: Segment) -> bool:
     """True if m is fixed in the body: ω = I⁻¹m is parallel to m (then dm/dt = m × ω = 0
     and m stays), tested exactly in principal axes, as the solver sees the state."""
-    solver = segment.solver
+    solver = _free_solver(segment)
     if solver.formula == "steady":
         return True
     if solver.formula == "rest":
@@ -126,7 +137,7 @@ def _flips(segment: Segment) -> tuple[int, NDArray[np.float64], float | None]:
     over; their number over a long segment is counted from the first one, not by
     listing them (the solver's ``flip_times`` lists every one).
     """
-    solver = segment.solver
+    solver = _free_solver(segment)
     start, end = segment.start_s, segment.end_s
     if solver.formula not in ("i", "ii"):
         flips = solver.flip_times(start, end)  # the separatrix: at most one
@@ -144,8 +155,33 @@ def _flips(segment: Segment) -> tuple[int, NDArray[np.float64], float | None]:
     return count, listed[:LISTED_FLIPS], half
 
 
+def _torqued_motion(segment: Segment, solver: TorquedMotion) -> SegmentMotion:
+    """A segment under torques: its state at the start; no period, flips or cone."""
+    return SegmentMotion(
+        start_s=segment.start_s,
+        end_s=segment.end_s,
+        formula="torqued",
+        motion="torqued",
+        period_s=math.inf,
+        flip_count=0,
+        flip_times_s=np.empty(0),
+        flip_period_s=None,
+        spin_axis_body=None,
+        nutation_min_rad=None,
+        nutation_max_rad=None,
+        nutation_period_s=None,
+        spin_period_s=None,
+        precession_period_s=None,
+        kinetic_energy_J=solver.initial_kinetic_energy,
+        inertial_angular_momentum_N_m_s=solver.initial_inertial_angular_momentum,
+        angular_momentum_norm_N_m_s=float(np.linalg.norm(segment.state.angular_momentum)),
+    )
+
+
 def _segment_motion(segment: Segment) -> SegmentMotion:
-    solver = segment.solver
+    if isinstance(segment.solver, TorquedMotion):
+        return _torqued_motion(segment, segment.solver)
+    solver = _free_solver(segment)
     count, flips, flip_period = _flips(segment)
     axis = nutation_min = nutation_max = nutation_period = spin = precession = None
     steady = solver.formula == "steady" or _is_steady(segment)

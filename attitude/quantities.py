@@ -31,6 +31,7 @@ SI_UNITS = {
     "angular_velocity": "rad / s",
     "angle": "rad",
     "length": "m",
+    "torque": "N m",
     "dimensionless": "",
 }
 

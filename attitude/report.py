@@ -8,11 +8,14 @@ previous report untouched.  The formats are the user's choice
 (``attitude.output_formats``):
 
 - ``timeseries.csv`` / ``timeseries.parquet``: attitude, rates, momentum, energy and,
-  with a ``[pointing]`` section, the Sun angles, incidences, violations, boresight
-  RA/Dec, nadir angles, on the output grid;
-- ``intervals.csv`` (with pointing): eclipses, constraint violations, Sun visibility;
+  with a ``[pointing]`` section, the Sun and Moon angles, incidences, nadir and limb
+  angles, constraint flags, boresight RA/Dec and the attitude in LVLH, on the output
+  grid;
+- ``intervals.csv`` (with pointing): eclipses, Sun, Moon and Earth-limb exclusions,
+  Sun visibility, found on the exact motion;
 - ``summary.json`` (always): the scenario, its segments (flips, nutation, spin,
-  precession), extrema with their times, violation totals, flip times, the outputs;
+  precession), extrema with their times (the pointing's on the exact motion),
+  exclusion totals, flip times, the outputs;
 - ``attitude.aem``: the attitude as a CCSDS AEM 2.0 file, a segment per event, sampled
   for a stated interpolation accuracy (``attitude.aem_sampling``);
 - ``*.png`` and ``report.html``: the plots and a page that gathers everything.
@@ -20,6 +23,8 @@ previous report untouched.  The formats are the user's choice
 Memory does not grow with the span: the output grid is evaluated :data:`CHUNK_SAMPLES`
 epochs at a time, and each chunk is appended to every time series file, to the
 plots' per-pixel envelopes and to the summary's extrema before the next is computed.
+The pointing's intervals and extrema do not come from that grid: they are searched
+once over the span on the exact motion (``attitude.pointing``), in bounded memory.
 The AEM is streamed the same way over its own records.  Chunk boundaries leave no
 trace in the files (``tests/test_streamed_outputs_equal_unstreamed.py``).
 """
@@ -27,7 +32,6 @@ trace in the files (``tests/test_streamed_outputs_equal_unstreamed.py``).
 from __future__ import annotations
 
 import contextlib
-import dataclasses
 import math
 import time
 from collections.abc import Callable
@@ -50,7 +54,6 @@ from attitude.exports import (
     write_intervals_csv,
     write_json,
 )
-from attitude.intervals import Interval
 from attitude.output_budget import check_fits
 from attitude.output_folder import claim
 from attitude.output_formats import OUTPUT_NAMES, OutputChoice
@@ -61,7 +64,13 @@ from attitude.plots import (
     plot_polhode,
     plot_sun_angles,
 )
-from attitude.pointing import PointingResult, PointingSpec, VectorPointing
+from attitude.pointing import (
+    PointingAnalysis,
+    PointingSamples,
+    PointingSpec,
+    pointing_analysis,
+    pointing_samples,
+)
 from attitude.report_figures import (
     angular_velocity_envelope,
     eclipse_zoom,
@@ -73,7 +82,7 @@ from attitude.report_page import render_page
 from attitude.run_plan import RunPlan, plan_run
 from attitude.scenario import Scenario
 from attitude.timeseries_parquet import ParquetWriter
-from attitude.trajectory import Trajectory
+from attitude.torques_summary import torques_summary
 from attitude.version import __version__
 
 __all__ = ["CHUNK_SAMPLES", "OUTPUT_NAMES", "Progress", "output_grid", "produce"]
@@ -178,226 +187,25 @@ def output_grid(scenario: Scenario, first: int, stop: int) -> np.ndarray:
     return τ
 
 
-# --- the pointing, through one adapter ---------------------------------------------
+# --- the pointing ------------------------------------------------------------------
 
 
 class _Pointing:
-    """The pointing of a run, behind the interface it is moving to (issue 10):
-
-    - ``stream(τ, following)``: the time series' pointing at the chunk ``τ``;
-    - ``samples(τ)``: the same at any times (the zoom panels);
-    - ``analysis()``: the intervals and extrema over the whole span, for
-      :func:`~attitude.exports.pointing_summary` and ``write_intervals_csv``.
-
-    INTERIM, until ``attitude.pointing`` provides ``pointing_samples`` and
-    ``pointing_analysis``: today's ``compute_pointing`` is called once per chunk (with
-    the next chunk's first epoch, so that the chunks' intervals meet), with one
-    ``Geometry`` for the whole run instead of one per call (it samples the Sun and the
-    orbit over the whole span: 4 s for 30 days), and its intervals and extrema are
-    gathered across chunks by :class:`_Gathered`.  At the merge, this class becomes::
-
-        stream(τ, following) -> pointing_samples(self.trajectory, self.spec, τ)
-        samples(τ)           -> pointing_samples(self.trajectory, self.spec, τ)
-        analysis()           -> pointing_analysis(self.trajectory, self.spec)
-        chunk_limit(step_s)  -> no limit
-
-    and :class:`_Gathered`, ``_compute`` and ``_rows`` go.
+    """The pointing of a run: its samples on any epochs (a chunk of the output grid, a
+    zoom panel's window), from :func:`~attitude.pointing.pointing_samples`, which keeps
+    nothing between calls; and its intervals and extrema over the whole span, found
+    once on the exact motion by :func:`~attitude.pointing.pointing_analysis` (on the
+    search grid the plan checked), independently of the output grid and its chunks.
     """
 
-    # compute_pointing's interval search over a chunk holds ~200 bytes a point.
-    _MAX_SEARCH_POINTS = 1_000_000
+    def __init__(self, plan: RunPlan) -> None:
+        self.trajectory, self.spec, self.grid = plan.trajectory, plan.pointing, plan.search
 
-    def __init__(self, trajectory: Trajectory, spec: PointingSpec) -> None:
-        from attitude.pointing import Geometry
+    def samples(self, seconds: np.ndarray) -> PointingSamples:
+        return pointing_samples(self.trajectory, self.spec, seconds)
 
-        self.trajectory, self.spec = trajectory, spec
-        self._geometry = Geometry(trajectory, spec.tle)
-        self._gathered = _Gathered(spec)
-        self._previous_s: float | None = None
-
-    def chunk_limit(self, step_s: float) -> int:
-        """The most output epochs per chunk for which the interval search stays bounded."""
-        from attitude.pointing import search_grid_count
-
-        span = self.trajectory.scenario.stop_s
-        points_per_s = search_grid_count(self.trajectory, 0.0, span) / span
-        return max(1, int(self._MAX_SEARCH_POINTS / (points_per_s * step_s)))
-
-    def _compute(self, seconds: np.ndarray) -> PointingResult:
-        """``compute_pointing`` on ``seconds`` (≥ 2 of them) with the run's Geometry."""
-        import attitude.pointing as pointing
-
-        made = pointing.Geometry
-        pointing.Geometry = lambda trajectory, tle: self._geometry
-        try:
-            return pointing.compute_pointing(self.trajectory, self.spec, seconds)
-        finally:
-            pointing.Geometry = made
-
-    def samples(self, seconds: np.ndarray) -> PointingResult:
-        return self._compute(seconds)
-
-    def stream(self, seconds: np.ndarray, following: float | None) -> PointingResult:
-        last = following is None
-        if last and seconds.size == 1 and self._previous_s is not None:
-            # A last chunk of one epoch: the chunk before has searched up to it already.
-            result = _rows(self._compute(np.array([self._previous_s, seconds[0]])), 1, 2)
-            self._gathered.add(result, 1, last, search=False)
-            return result
-        self._previous_s = float(seconds[-1])
-        result = self._compute(seconds if last else np.append(seconds, following))
-        self._gathered.add(result, seconds.size, last)
-        return _rows(result, 0, seconds.size)
-
-    def analysis(self) -> PointingResult:
-        return self._gathered.result()
-
-
-def _rows(result: PointingResult, start: int, stop: int) -> PointingResult:
-    """``result``'s samples start … stop − 1 (its intervals are not used)."""
-
-    def cut(values):
-        return None if values is None else values[start:stop]
-
-    vectors = [
-        dataclasses.replace(
-            v,
-            sun_angle_rad=cut(v.sun_angle_rad),
-            cos_incidence=cut(v.cos_incidence),
-            right_ascension_rad=cut(v.right_ascension_rad),
-            declination_rad=cut(v.declination_rad),
-            nadir_angle_rad=cut(v.nadir_angle_rad),
-            violated=cut(v.violated),
-        )
-        for v in result.vectors
-    ]
-    return dataclasses.replace(
-        result,
-        seconds=cut(result.seconds),
-        sun_direction_icrf=cut(result.sun_direction_icrf),
-        sunlit_fraction=cut(result.sunlit_fraction),
-        earth_angular_radius_rad=cut(result.earth_angular_radius_rad),
-        vectors=vectors,
-    )
-
-
-class _Gathered:
-    """INTERIM (see :class:`_Pointing`): the intervals, extrema and means of chunked
-    ``compute_pointing`` results, as one :class:`PointingResult` for
-    ``pointing_summary`` and ``write_intervals_csv``.
-
-    Intervals cut at a chunk's end (``ends_after``) are joined to the next chunk's
-    first interval when that one starts at the chunk's start (``starts_before``).  For
-    the extrema, only the samples around each vector's smallest and largest Sun angle
-    so far are kept (with every vector's angle there), so that ``extremum``'s parabola
-    sees the same three neighbours as on the whole grid; the mean incidence and sunlit
-    fraction are kept as sums.  Memory: a few rows, whatever the span.
-    """
-
-    def __init__(self, spec: PointingSpec) -> None:
-        self.spec = spec
-        self.lists: dict[tuple[str, int], list[Interval]] = {}
-        self.pending: dict[tuple[str, int], Interval | None] = {}
-        self.best: dict[tuple[str, int], tuple[float, list[tuple[float, tuple]]]] = {}
-        self.previous: tuple[float, tuple] | None = None
-        self.count = 0
-        self.cos_sums: list[float] = []
-        self.fraction_sum = 0.0
-        self.template: PointingResult | None = None
-
-    def _merge(self, key: tuple[str, int], found: list[Interval], last: bool) -> None:
-        done = self.lists.setdefault(key, [])
-        pending = self.pending.get(key)
-        for interval in found:
-            if pending is not None:
-                if interval.starts_before:
-                    interval = Interval(
-                        pending.start_s, interval.end_s, pending.starts_before, interval.ends_after
-                    )
-                else:  # the condition ended exactly at the chunk's edge
-                    done.append(dataclasses.replace(pending, ends_after=False))
-                pending = None
-            if interval.ends_after and not last:
-                pending = interval
-            else:
-                done.append(interval)
-        if pending is not None and (last or not found):
-            done.append(dataclasses.replace(pending, ends_after=last))
-            pending = None
-        self.pending[key] = pending
-
-    def add(self, result: PointingResult, emitted: int, last: bool, search: bool = True) -> None:
-        """Gather a chunk: ``result`` over its ``emitted`` epochs and (unless ``last``) the
-        next chunk's first; ``search``: False when its intervals were searched already
-        (a last chunk of one epoch), which then only closes what is open."""
-        self.template = self.template or result
-        if not search:
-            for key in list(self.pending):
-                self._merge(key, [], True)
-        else:
-            self._merge(("shadow", -1), result.shadow, last)
-            self._merge(("umbra", -1), result.umbra, last)
-        angles = np.array([v.sun_angle_rad for v in result.vectors]).reshape(
-            -1, result.seconds.size
-        )
-        t = result.seconds
-
-        def row(j: int) -> tuple[float, tuple] | None:
-            if j < 0:
-                return self.previous
-            if j >= t.size or (last and j >= emitted):
-                return None
-            return float(t[j]), tuple(angles[:, j])
-
-        for i, item in enumerate(result.vectors):
-            if search:
-                self._merge(("visible", i), item.sun_visible, last)
-                self._merge(("violations", i), item.violations, last)
-            for kind, pick in (("min", np.argmin), ("max", np.argmax)):
-                j = int(pick(item.sun_angle_rad[:emitted]))
-                value = float(item.sun_angle_rad[j])
-                best = self.best.get((kind, i))
-                if best is None or (value < best[0] if kind == "min" else value > best[0]):
-                    rows = [r for r in (row(j - 1), row(j), row(j + 1)) if r is not None]
-                    self.best[(kind, i)] = (value, rows)
-            if len(self.cos_sums) <= i:
-                self.cos_sums.append(0.0)
-            self.cos_sums[i] += float(np.sum(item.cos_incidence[:emitted]))
-        self.fraction_sum += float(np.sum(result.sunlit_fraction[:emitted]))
-        self.count += emitted
-        self.previous = row(emitted - 1)
-
-    def result(self) -> PointingResult:
-        template = self.template
-        rows = dict(r for _, kept in self.best.values() for r in kept)
-        seconds = np.array(sorted(rows))
-        angles = np.array([rows[t] for t in seconds]).reshape(seconds.size, -1)
-        ones = np.ones(seconds.size)
-        vectors = [
-            VectorPointing(
-                vector=item.vector,
-                sun_angle_rad=angles[:, i],
-                cos_incidence=ones * (self.cos_sums[i] / self.count),
-                right_ascension_rad=ones,
-                declination_rad=ones,
-                nadir_angle_rad=None,
-                violated=None,
-                violations=self.lists.get(("violations", i), []),
-                sun_visible=self.lists.get(("visible", i), []),
-            )
-            for i, item in enumerate(template.vectors)
-        ]
-        return PointingResult(
-            seconds=seconds,
-            sun_direction_icrf=np.zeros((seconds.size, 3)),
-            sunlit_fraction=ones * (self.fraction_sum / self.count),
-            earth_angular_radius_rad=None,
-            vectors=vectors,
-            shadow=self.lists.get(("shadow", -1), []),
-            umbra=self.lists.get(("umbra", -1), []),
-            precision_s=template.precision_s,
-            on_orbit=template.on_orbit,
-        )
+    def analysis(self) -> PointingAnalysis:
+        return pointing_analysis(self.trajectory, self.spec, grid=self.grid)
 
 
 # --- the run -----------------------------------------------------------------------
@@ -507,10 +315,10 @@ class _Stream:
         vectors = [v.name for v in plan.pointing.body_vectors]
         plots = "plots" in plan.outputs
         self.sun = Envelope(*span, vectors) if plots and vectors else None
-        self.sunlit = Envelope(*span, ["sunlit"]) if plots and plan.pointing.tle else None
+        self.sunlit = Envelope(*span, ["sunlit"]) if plots and plan.pointing.on_orbit else None
         self.peak_rate = (-1.0, 0.0)  # (rad/s, at TT s)
 
-    def add(self, τ: np.ndarray, samples, pointing: PointingResult | None) -> None:
+    def add(self, τ: np.ndarray, samples, pointing: PointingSamples | None) -> None:
         columns = trajectory_columns(samples)
         if pointing is not None:
             columns += pointing_columns(pointing)
@@ -540,17 +348,15 @@ def _build(
     trajectory, motion = plan.trajectory, plan.motion
     count = scenario.output_count()
     texts = EpochTexts(scenario.epoch)
-    source_of_pointing = None if spec.is_empty else _Pointing(trajectory, spec)
+    source_of_pointing = None if spec.is_empty else _Pointing(plan)
     chunk = max(1, int(chunk_samples))
-    if source_of_pointing is not None:
-        chunk = min(chunk, source_of_pointing.chunk_limit(scenario.step_s))
     series = [name for name in ("timeseries.csv", "timeseries.parquet") if name[11:] in outputs]
     progress(
         f"sampling {count} epochs over {scenario.stop_s:g} s, {min(chunk, count)} at a time"
         + (f": writing {', '.join(series)}" if series else "")
         + (
             f"; pointing: {len(spec.body_vectors)} body vectors, "
-            f"{'TLE orbit' if spec.tle else 'Earth centre'}, intervals"
+            f"{'Earth centre' if spec.orbit is None else spec.orbit.describe()}"
             if source_of_pointing
             else ""
         )
@@ -561,12 +367,7 @@ def _build(
         for first in range(0, count, chunk):
             τ = output_grid(scenario, first, first + chunk)
             samples = sample(trajectory, τ)
-            pointing = None
-            if source_of_pointing is not None:
-                following = None
-                if first + chunk < count:
-                    following = float(output_grid(scenario, first + chunk, first + chunk + 1)[0])
-                pointing = source_of_pointing.stream(τ, following)
+            pointing = None if source_of_pointing is None else source_of_pointing.samples(τ)
             stream.add(τ, samples, pointing)
             # After the first chunk (a stream has started), then every few seconds.
             late = first == 0 or time.perf_counter() - shown > _PROGRESS_EVERY_S
@@ -578,6 +379,7 @@ def _build(
         "attitude_version": __version__,
         "scenario": _scenario_summary(scenario, source),
         "motion": motion_summary(trajectory, motion),
+        "torques": torques_summary(plan),
         "extrema": {
             "max_rate_deg_s": math.degrees(stream.peak_rate[0]),
             "max_rate_at": scenario.format_epoch(stream.peak_rate[1]),
@@ -585,7 +387,10 @@ def _build(
     }
     analysis = None
     if source_of_pointing is not None:
-        progress("writing intervals.csv")
+        progress(
+            f"pointing: intervals and extrema on the exact motion ({plan.search.count} "
+            f"search points, every {plan.search.step_s:.3g} s); writing intervals.csv"
+        )
         analysis = source_of_pointing.analysis()
         summary["pointing"] = pointing_summary(analysis, scenario.format_epoch)
         write_intervals_csv(
@@ -694,7 +499,7 @@ def _plots(
     tmp: Path,
     stream: _Stream,
     pointing: _Pointing | None,
-    analysis: PointingResult | None,
+    analysis: PointingAnalysis | None,
 ) -> dict[str, str]:
     """The figures: the motion from the exact solution, the pointing from the stream."""
     scenario, trajectory, motion = plan.scenario, plan.trajectory, plan.motion
@@ -715,10 +520,10 @@ def _plots(
     shadow = [(i.start_s, i.end_s) for i in analysis.shadow]
     umbra = [(i.start_s, i.end_s) for i in analysis.umbra]
     if stream.sun is not None:
-        violations = sorted(
+        sun_exclusions = sorted(
             (i.start_s, i.end_s)
             for v in analysis.vectors
-            for i in v.violations
+            for i in v.sun_exclusion
             if i.start_s > start
         )
 
@@ -731,7 +536,7 @@ def _plots(
             {v.name: v.sun_exclusion_half_angle_deg for v in plan.pointing.body_vectors},
             shadow,
             sun_angle_zoom(
-                trajectory, motion, start, stop, sun_angles_deg, violations, shadow, events
+                trajectory, motion, start, stop, sun_angles_deg, sun_exclusions, shadow, events
             ),
         )
     if stream.sunlit is not None:

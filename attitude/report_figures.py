@@ -189,14 +189,14 @@ def sun_angle_zoom(
     start_s: float,
     stop_s: float,
     sun_angles_deg: Callable[[NDArray[np.float64]], dict[str, NDArray[np.float64]]],
-    violations_s: Sequence[tuple[float, float]],
+    sun_exclusions_s: Sequence[tuple[float, float]],
     shadow_s: Sequence[tuple[float, float]],
     events_s: Sequence[float],
 ) -> Zoom | None:
     """Around the first Sun exclusion, else the first eclipse entry, else the first
     event, else the first turns; ``sun_angles_deg(τ)`` gives each vector's Sun angle."""
     candidates = [
-        (violations_s[0][0], "the first Sun exclusion") if violations_s else None,
+        (sun_exclusions_s[0][0], "the first Sun exclusion") if sun_exclusions_s else None,
         (shadow_s[0][0], "the first eclipse entry") if shadow_s else None,
         next(((t, "the first event") for t in events_s if start_s < t < stop_s), None),
     ]
@@ -204,8 +204,8 @@ def sun_angle_zoom(
     center = found[0] if found else start_s
     k = int(trajectory.segment_index(np.array([min(max(center, start_s), stop_s)]))[0])
     length = 3.0 * _period_of(motion[k], trajectory.segments[k])
-    if found and violations_s and found[1] == "the first Sun exclusion":
-        length = max(length, 3.0 * (violations_s[0][1] - violations_s[0][0]))
+    if found and sun_exclusions_s and found[1] == "the first Sun exclusion":
+        length = max(length, 3.0 * (sun_exclusions_s[0][1] - sun_exclusions_s[0][0]))
     if not math.isfinite(length) or length >= 0.5 * (stop_s - start_s):
         return None
     τ = _window(center, length, start_s, stop_s, 1 / 3 if found else 0.0)

@@ -51,6 +51,101 @@ def _table(header: list[str], rows: list[list[Any]]) -> str:
     return f"<table><tr>{head}</tr>{body}</table>"
 
 
+def _range(v: dict[str, Any], name: str) -> str | None:
+    """'least – greatest' of an extremum pair of the pointing summary, in degrees."""
+    if f"{name}_min_deg" not in v:
+        return None
+    return f"{v[f'{name}_min_deg']:.4f} – {v[f'{name}_max_deg']:.4f}"
+
+
+def _exclusion(v: dict[str, Any], name: str) -> str | None:
+    """'count, total s' of an exclusion of the pointing summary, or None."""
+    found = v.get(name)
+    return None if found is None else f"{found['count']}, {found['total_s']:.6g} s"
+
+
+def _pointing_table(vectors: dict[str, Any]) -> str:
+    rows = [
+        [
+            name,
+            v["kind"],
+            f"{v['sun_angle_min_deg']:.4f} at {v['sun_angle_min_at']}",
+            _range(v, "sun_angle"),
+            _range(v, "moon_angle"),
+            _range(v, "nadir_angle"),
+            _range(v, "earth_limb_angle"),
+            _exclusion(v, "sun_exclusion"),
+            _exclusion(v, "moon_exclusion"),
+            _exclusion(v, "earth_limb_exclusion"),
+            v["sun_visible"]["total_s"],
+            v["mean_cos_incidence"],
+        ]
+        for name, v in vectors.items()
+    ]
+    header = [
+        "body vector",
+        "kind",
+        "least Sun angle (deg)",
+        "Sun angle (deg)",
+        "Moon angle (deg)",
+        "nadir angle (deg)",
+        "above the limb (deg)",
+        "Sun exclusions (n, time)",
+        "Moon exclusions",
+        "limb exclusions",
+        "Sun visible (s)",
+        "mean cos incidence",
+    ]
+    return _table(header, rows)
+
+
+def _propagation(summary: dict[str, Any]) -> str:
+    torques = summary.get("torques") or {}
+    if torques.get("modelled"):
+        return "under " + ", ".join(torques["modelled"]) + ": splitting with the exact free flow"
+    return "exact torque-free motion, no integration"
+
+
+def _torques_section(torques: dict[str, Any] | None) -> list[str]:
+    """The torques modelled, the step and the estimated error; or the validity horizon."""
+    if not torques:
+        return []
+    parts = ["<h2>Torques</h2>"]
+    if not torques["modelled"]:
+        horizon = torques["validity_horizon"]
+        text = horizon["description"] if horizon else torques["validity_horizon_note"]
+        parts.append(
+            f"<p>None modelled: the exact torque-free solver. Validity: {escape(text)}.</p>"
+        )
+        return parts
+    how = "given" if torques["step"] == "given" else f"chosen for {torques['accuracy_rad']:g} rad"
+    parts.append(
+        f"<p>Modelled: {escape(', '.join(torques['modelled']))}. Order {torques['order']}, "
+        f"step {escape(how)}; estimated attitude error "
+        f"{torques['estimated_error_rad']:.2g} rad over the run (each segment's own below).</p>"
+    )
+    if torques["burns"]:
+        parts.append(
+            _table(
+                ["burn start", "duration (s)", "torque (N m)", "frame", "label"],
+                [
+                    [b["start"], b["duration_s"], str(b["torque_N_m"]), b["frame"], b["label"]]
+                    for b in torques["burns"]
+                ],
+            )
+        )
+    parts.append(
+        _table(
+            ["segment", "method", "step (s)", "estimated error from its start (rad)"],
+            [
+                [s["segment"], s["method"], s["step_s"], s["estimated_error_rad"]]
+                for s in torques["segments"]
+            ],
+        )
+    )
+    return parts
+
+
 def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str]) -> str:
     """The HTML text of the report.
 
@@ -64,7 +159,7 @@ def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str
         f"<title>{escape(scenario['name'])}</title><style>{_STYLE}</style></head><body>",
         f"<h1>{escape(scenario['name'])}</h1>",
         f"<p class='note'>{escape(scenario['file'])}, computed by attitude "
-        f"{escape(summary['attitude_version'])} (exact torque-free motion, no integration).</p>",
+        f"{escape(summary['attitude_version'])} ({escape(_propagation(summary))}).</p>",
         _table(
             [
                 "epoch",
@@ -134,6 +229,7 @@ def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str
             ],
         )
     )
+    parts += _torques_section(summary.get("torques"))
     flips = motion["flips"]
     if flips["count"]:
         shown = ", ".join(escape(t) for t in flips["times"][:12])
@@ -143,43 +239,13 @@ def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str
     if pointing:
         parts.append("<h2>Pointing</h2>")
         parts.append(
-            f"<p class='note'>Spacecraft at: {escape(pointing['position'])}. Interval ends "
-            f"refined on the exact motion to {pointing['interval_precision_s']:g} s.</p>"
+            f"<p class='note'>Spacecraft at: {escape(pointing['position'])}. Extrema and "
+            "interval ends found on the exact motion (search step "
+            f"{pointing['search_step_s']:.3g} s), interval ends to "
+            f"{pointing['interval_precision_s']:g} s. Angles are geometric: an extremum may "
+            "fall in an eclipse; exclusions leave out a hidden Sun or Moon.</p>"
         )
-        rows = []
-        for name, v in pointing["body_vectors"].items():
-            violations = v.get("violations")
-            rows.append(
-                [
-                    name,
-                    v["kind"],
-                    f"{v['sun_angle_min_deg']:.4f} at {v['sun_angle_min_at']}",
-                    f"{v['sun_angle_max_deg']:.4f} at {v['sun_angle_max_at']}",
-                    v.get("sun_exclusion_half_angle_deg"),
-                    None if violations is None else violations["count"],
-                    None if violations is None else violations["total_s"],
-                    None if violations is None else violations["longest_s"],
-                    v["sun_visible"]["total_s"],
-                    v["mean_cos_incidence"],
-                ]
-            )
-        parts.append(
-            _table(
-                [
-                    "body vector",
-                    "kind",
-                    "min Sun angle (deg, geometric: eclipses included)",
-                    "max Sun angle (deg, geometric)",
-                    "exclusion (deg)",
-                    "violations",
-                    "violated (s)",
-                    "longest (s)",
-                    "Sun visible (s)",
-                    "mean cos incidence",
-                ],
-                rows,
-            )
-        )
+        parts.append(_pointing_table(pointing["body_vectors"]))
         eclipses = pointing.get("eclipses")
         if eclipses:
             parts.append(

@@ -2,23 +2,30 @@
 
 ``plan_run(scenario, pointing, outputs)`` propagates the scenario (the exact solver
 segments, refused where the motion is faster than TT seconds can follow), analyses
-each segment (flips counted, not listed), checks the pointing (the TLE, SGP4 over the
-span, the Sun ephemeris with the interpolation's margins), chooses the AEM's records
-for its tolerance, counts the output samples and estimates the outputs' sizes and the
-(constant) memory of the streamed run.  What it refuses, a run would have refused
+each segment (flips counted, not listed), checks the pointing (the orbit source over
+the span, the Sun and Moon ephemeris with the interpolation's margins, the size of
+the exact search), chooses the AEM's records for its tolerance, counts the output
+samples and estimates the outputs' sizes and the (constant) memory of the streamed
+run.  It notes an output step that undersamples the motion (more than a tenth of its
+shortest period).  Segments under torques are propagated (their whole grid, and the
+error estimate of their step); a torque-free scenario with an orbit gets its validity
+horizon (``attitude.horizon.validity_horizon``).  What it refuses, a run would have refused
 later, after computing; what it returns is what the run uses.  Errors are
 ``attitude.errors.InputError`` whose message starts with the scenario key.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from attitude.aem_sampling import AemPlan, plan_aem
+from attitude.errors import InputError
+from attitude.horizon import ValidityHorizon, validity_horizon
 from attitude.motion_analysis import SegmentMotion, analyze
 from attitude.output_budget import OutputBudget, check_fits, estimate
 from attitude.output_formats import OutputChoice
-from attitude.pointing import PointingSpec, check_pointing, search_grid_count
+from attitude.pointing import PointingSpec, SearchGrid, check_pointing, undersampling_note
 from attitude.scenario import Scenario
 from attitude.timeseries_parquet import check_span
 from attitude.trajectory import Trajectory, propagate
@@ -38,6 +45,8 @@ class RunPlan:
     notes: list[str] = field(default_factory=list)
     outputs: OutputChoice = field(default_factory=OutputChoice)
     aem: AemPlan | None = None
+    search: SearchGrid | None = None  # the pointing's exact search (None without pointing)
+    horizon: ValidityHorizon | None = None  # torque-free with an orbit: how long it holds
 
 
 def plan_run(
@@ -50,18 +59,27 @@ def plan_run(
     if "parquet" in outputs:
         check_span(scenario.start_s, scenario.stop_s, "--formats parquet")
     trajectory = propagate(scenario)
-    # The search-size and memory checks come before the analysis and the pointing
-    # checks, which do not depend on the output grid but can take a while on a long span.
-    grid = 0
-    if not pointing.is_empty:
-        grid = search_grid_count(trajectory, scenario.start_s, scenario.stop_s)
-    on_orbit = pointing.tle is not None
-    budget = estimate(
-        samples, grid, len(pointing.body_vectors), on_orbit, outputs.formats, aem_records=0
-    )
+    # The size and memory checks come before the analysis and the pointing checks,
+    # which do not depend on the output grid but can take a while on a long span.
+    vectors, on_orbit = len(pointing.body_vectors), pointing.on_orbit
+    budget = estimate(samples, 0, vectors, on_orbit, outputs.formats, aem_records=0)
     check_fits(budget)
     motion = analyze(trajectory)
-    notes = check_pointing(trajectory, pointing)
+    notes, search = check_pointing(trajectory, pointing)
+    undersampled = undersampling_note(trajectory, motion)
+    if undersampled:
+        notes.append(undersampled)
+    # The error estimates the summary states (each segment's, and the run's), checked here.
+    errors = [getattr(s.solver, "error_estimate", 0.0) for s in trajectory.segments]
+    errors.append(trajectory.error_estimate)
+    if not all(math.isfinite(error) for error in errors):
+        raise InputError(
+            f"torques: the propagation has no finite error estimate ({errors}): "
+            "give a smaller step or an accuracy"
+        )
+    horizon = None
+    if pointing.orbit is not None and not scenario.torques.any:
+        horizon = validity_horizon(trajectory, pointing.orbit)
     aem = None
     if "aem" in outputs:
         aem = plan_aem(
@@ -72,7 +90,14 @@ def plan_run(
             outputs.aem_tolerance_rad,
             outputs.tolerance_key,
         )
-        budget = estimate(
-            samples, grid, len(pointing.body_vectors), on_orbit, outputs.formats, aem.records
-        )
-    return RunPlan(scenario, pointing, trajectory, motion, budget, notes, outputs, aem)
+    budget = estimate(
+        samples,
+        0 if search is None else search.count,
+        vectors,
+        on_orbit,
+        outputs.formats,
+        0 if aem is None else aem.records,
+    )
+    return RunPlan(
+        scenario, pointing, trajectory, motion, budget, notes, outputs, aem, search, horizon
+    )

@@ -24,6 +24,8 @@ Time rules (what a user can rely on):
 
 from __future__ import annotations
 
+import copy
+import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -34,6 +36,7 @@ from scipy.spatial.transform import Rotation
 from attitude.errors import InputError
 from attitude.events import Event
 from attitude.quantities import as_si_scalar, as_vector3
+from attitude.scenario_torques import MAX_STEPS, PlacedBurn, ScenarioTorques
 from attitude.spacecraft import Spacecraft
 from attitude.timescales import (
     SAME_INSTANT_S,
@@ -128,6 +131,10 @@ class Scenario:
         First output epoch (default: the epoch).
     step
         Output step, seconds (default: the output span / 1000).
+    torques
+        :class:`~attitude.scenario_torques.ScenarioTorques`: gravity gradient, burns,
+        and the splitting's step and order (default: none, the exact torque-free
+        motion).
     """
 
     def __init__(
@@ -142,6 +149,7 @@ class Scenario:
         duration: Any = None,
         start: Any = None,
         step: Any = None,
+        torques: ScenarioTorques | None = None,
     ) -> None:
         self.name = str(name)
         if not isinstance(spacecraft, Spacecraft):
@@ -150,27 +158,40 @@ class Scenario:
             raise InputError(f"initial_state must be an InitialState, got {initial_state!r}")
         self.spacecraft = spacecraft
         self.initial_state = initial_state
+        self._set_epoch(epoch)
+        self._set_span(stop, duration)
+        self._set_output_grid(start, step)
+        self._place_events(events)
+        self._place_torques(torques)
+
+    def _set_epoch(self, epoch: Any) -> None:
         self.epoch = as_time(epoch, name="epoch")
         if not self.epoch.isscalar:
             raise InputError(f"epoch must be a single epoch, got {len(self.epoch)} of them")
         check_year_range(self.epoch, "epoch")
-        scale = self.epoch.scale
 
+    def _set_span(self, stop: Any, duration: Any) -> None:
+        """The end of the propagation, ``stop_s``: within 10,000 years and years 1–9999."""
         if (stop is None) == (duration is None):
             raise InputError("give exactly one of stop and duration")
         if duration is not None:
             self.stop_s = as_si_scalar(duration, "time", "duration")
         else:
-            self.stop_s = float(tt_seconds(as_time(stop, scale, name="stop"), self.epoch))
+            self.stop_s = float(tt_seconds(as_time(stop, self.time_scale, name="stop"), self.epoch))
         if not self.stop_s > 0.0:
             raise InputError(f"the span must end after the epoch, got {self.stop_s:g} s")
         if self.stop_s > _LONGEST_SPAN_S:
             raise InputError(f"the span must be shorter than 10,000 years, got {self.stop_s:g} s")
         with offline_time():
-            check_year_range(getattr(time_from_tt_seconds(self.epoch, self.stop_s), scale), "stop")
-        self.start_s = (
-            0.0 if start is None else float(tt_seconds(as_time(start, scale, "start"), self.epoch))
-        )
+            end = time_from_tt_seconds(self.epoch, self.stop_s)
+            check_year_range(getattr(end, self.time_scale), "stop")
+
+    def _set_output_grid(self, start: Any, step: Any) -> None:
+        """The output grid's ``start_s`` and ``step_s``: a grid that TT seconds resolve."""
+        if start is None:
+            self.start_s = 0.0
+        else:
+            self.start_s = float(tt_seconds(as_time(start, self.time_scale, "start"), self.epoch))
         if not 0.0 <= self.start_s < self.stop_s:
             raise InputError(
                 f"start must lie in [epoch, stop), got {self.start_s:g} s after the epoch "
@@ -188,13 +209,11 @@ class Scenario:
                 "would repeat epochs"
             )
 
+    def _place_events(self, events: list[Event] | tuple[Event, ...]) -> None:
+        """``events`` as (offset, event) in time order, stably; each within [0, stop]."""
         timed = []
         for index, event in enumerate(events):
-            offset = self._event_offset(event.epoch, f"events[{index}].epoch")
-            if abs(offset) <= SAME_INSTANT_S:
-                offset = 0.0
-            elif abs(offset - self.stop_s) <= SAME_INSTANT_S:
-                offset = self.stop_s
+            offset = self._offset_in_span(event.epoch, f"events[{index}].epoch")
             where = f"events[{index}] ({event.kind} at {self.format_epoch(offset)})"
             if offset < 0.0:
                 raise InputError(f"{where} is before the scenario epoch {self.format_epoch(0.0)}")
@@ -206,6 +225,62 @@ class Scenario:
         self.events: list[tuple[float, Event]] = [(offset, event) for offset, _, event in timed]
         # The place of each event (in time order) in the list given: events[i].
         self.event_indices: list[int] = [index for _, index, _ in timed]
+
+    def _place_torques(self, torques: ScenarioTorques | None) -> None:
+        """``torques`` (none: torque-free) and its burns on the time line, ``burns``.
+
+        A burn starts within [epoch, stop) and may run past the end of the span; a
+        step that would take more than ``MAX_STEPS`` over the span is refused.
+        """
+        if torques is None:
+            torques = ScenarioTorques()
+        if not isinstance(torques, ScenarioTorques):
+            raise InputError(f"torques must be a ScenarioTorques, got {torques!r}")
+        self.torques = torques
+        self.burns: list[PlacedBurn] = []
+        for index, burn in enumerate(torques.burns):
+            where = f"torques.burns[{index}]"
+            start_s = self._offset_in_span(burn.epoch, f"{where}.epoch")
+            if not 0.0 <= start_s < self.stop_s:
+                raise InputError(
+                    f"{where}.epoch: the burn starts at {self.format_epoch(start_s)}, outside "
+                    f"the span [{self.format_epoch(0.0)}, {self.format_epoch(self.stop_s)})"
+                )
+            # The momentum it adds, and the kinetic energy (~ H²/2I), must be floats.
+            impulse = math.hypot(*burn.torque) * min(burn.duration, self.stop_s - start_s)
+            if not math.isfinite(impulse * impulse):
+                raise InputError(
+                    f"{where}.torque: {burn.torque.tolist()} N m over the span is an angular "
+                    f"impulse of {impulse:.3g} N m s, beyond what floats hold (its square)"
+                )
+            self.burns.append(PlacedBurn(start_s, start_s + burn.duration, burn, index))
+        if torques.step is not None and torques.step > self.stop_s:
+            raise InputError(
+                f"torques.step: {torques.step:g} s is longer than the span ({self.stop_s:g} s)"
+            )
+        if torques.step is not None and self.stop_s / torques.step > MAX_STEPS:
+            raise InputError(
+                f"torques.step: {torques.step:g} s is {self.stop_s / torques.step:.3g} steps "
+                f"over the span of {self.stop_s:g} s, more than {MAX_STEPS:g}: give a larger "
+                "step, an accuracy, or a shorter span"
+            )
+
+    def with_torques(self, torques: ScenarioTorques | None) -> Scenario:
+        """The same scenario propagated under ``torques`` (e.g. to measure what a
+        torque-free run neglects)."""
+        other = copy.copy(self)
+        other._place_torques(torques)
+        return other
+
+    def _offset_in_span(self, epoch: Any, name: str) -> float:
+        """An epoch's TT seconds after the scenario epoch, snapped to 0 or to stop when
+        within a nanosecond of either (the rounding of a UTC → TT conversion)."""
+        offset = self._event_offset(epoch, name)
+        if abs(offset) <= SAME_INSTANT_S:
+            return 0.0
+        if abs(offset - self.stop_s) <= SAME_INSTANT_S:
+            return self.stop_s
+        return offset
 
     def _event_offset(self, epoch: Any, name: str) -> float:
         """TT seconds after the epoch of an event's epoch (Time, ISO text or seconds)."""

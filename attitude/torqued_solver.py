@@ -46,7 +46,14 @@ from attitude.quantities import as_si_array, as_si_scalar, as_vector3
 from attitude.splitting import Composition, composition
 from attitude.torques import GravityGradient, PrincipalFrame, Torque, as_torque_list
 
-__all__ = ["StepChoice", "TorquedSolver", "departure_time", "propagate_batch"]
+__all__ = [
+    "StepChoice",
+    "TorquedSolver",
+    "angles_between",
+    "departure_time",
+    "first_crossing",
+    "propagate_batch",
+]
 
 # Steps computed per call of the torques' time functions (orbit positions, vectorized).
 _CHUNK_STEPS = 512
@@ -404,7 +411,7 @@ class TorquedSolver:
             """Richardson estimate of the error of the run at ``step`` (from 2 step)."""
             fine = self._new_propagation(step)
             coarse = self._new_propagation(2.0 * step)
-            difference = np.max(_angles(coarse.states(checks)[1], fine.states(checks)[1]))
+            difference = np.max(angles_between(coarse.states(checks)[1], fine.states(checks)[1]))
             return float(difference) / (2.0**p - 1.0), fine
 
         # Search on the adopted step s, within a factor 1.25 of the largest that passes:
@@ -478,6 +485,14 @@ class TorquedSolver:
     def _to_body(self, v: NDArray) -> NDArray:
         return v if self._principal_to_body is None else self._principal_to_body.apply(v)
 
+    def states(self, t: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """Body-frame angular momentum (N m s) and attitude quaternions body → inertial,
+        scalar first, at ``t``, from one evaluation: shapes ``np.shape(t) + (3,)``, ``+ (4,)``."""
+        if not self._torques:
+            return self._free.angular_momentum(t), self._free.attitude_quaternion(t)
+        m, q, shape = self._principal_states(t)
+        return self._to_body(m).reshape((*shape, 3)), self._body_quaternions(q).reshape((*shape, 4))
+
     def angular_momentum(self, t: ArrayLike) -> NDArray[np.float64]:
         """Body-frame angular momentum at ``t`` (N m s), shape ``np.shape(t) + (3,)``."""
         if not self._torques:
@@ -529,6 +544,18 @@ class TorquedSolver:
     @property
     def torques(self) -> tuple[Torque, ...]:
         return tuple(self._torques)
+
+    def grid_invariants(self, t_end: float) -> tuple[NDArray, NDArray, NDArray]:
+        """The grid up to ``t_end``: its times (s), |m| (N m s) and kinetic energy (J).
+
+        Both quantities are those of the states at the grid points: the free flow
+        conserves them, so a flow still owed there (see ``_Engine``) does not change them.
+        """
+        self._propagation.extend_to(float(t_end))
+        t, m, _, _ = self._propagation.arrays()
+        keep = t <= t_end
+        m = m[keep]
+        return t[keep], np.linalg.norm(m, axis=-1), 0.5 * np.sum(m * m / self._moments, axis=-1)
 
     @property
     def free_flows(self) -> int:
@@ -656,12 +683,18 @@ def departure_time(
     free = EulerSolver(inertia, angular_momentum, attitude, t0)
 
     def angle(t):
-        return _angles(torqued.attitude_quaternion(t), free.attitude_quaternion(t))
+        return angles_between(torqued.attitude_quaternion(t), free.attitude_quaternion(t))
 
-    block = 1000 * torqued.step
-    start = torqued.t0
-    while start < torqued.t0 + horizon:
-        t = np.minimum(start + torqued.step * np.arange(1, 1001), torqued.t0 + horizon)
+    crossing = first_crossing(angle, torqued.t0, torqued.t0 + horizon, torqued.step, threshold)
+    return crossing - torqued.t0
+
+
+def first_crossing(angle, start: float, end: float, sample: float, threshold: float) -> float:
+    """The first time in (start, end] at which ``angle(t)`` (t an array) reaches
+    ``threshold``, or ``math.inf``: sampled every ``sample`` s, 1000 samples at a time
+    (computing no further than needed), then refined by bisection to a millisecond."""
+    while start < end:
+        t = np.minimum(start + sample * np.arange(1, 1001), end)
         beyond = np.flatnonzero(angle(t) >= threshold)
         if beyond.size:
             high = float(t[beyond[0]])
@@ -672,12 +705,12 @@ def departure_time(
                     high = mid
                 else:
                     low = mid
-            return high - torqued.t0
-        start += block
+            return high
+        start = float(t[-1])
     return math.inf
 
 
-def _angles(qa: NDArray, qb: NDArray) -> NDArray:
+def angles_between(qa: NDArray, qb: NDArray) -> NDArray:
     """Rotation angles (rad) between quaternion stacks, without cancellation near 0."""
     diff = np.minimum(np.linalg.norm(qa - qb, axis=-1), np.linalg.norm(qa + qb, axis=-1))
     return 4.0 * np.arcsin(np.minimum(1.0, 0.5 * diff))

@@ -1,7 +1,9 @@
 """The propagated motion of a scenario: exact solver segments between events.
 
 ``propagate(scenario)`` applies the events in time order; each starts a new
-``EulerSolver`` from the state just after it.  The resulting :class:`Trajectory` is
+``EulerSolver`` from the state just after it, or, where the scenario's torques act
+(``attitude.scenario_torques``), a :class:`~attitude.torqued_segment.TorquedMotion`
+(the torqued solver, with the same interface).  The resulting :class:`Trajectory` is
 evaluated at any times in [epoch, stop], not only on the output grid: pass an
 ``astropy.time.Time`` array, or floats (TT seconds since the scenario epoch) to skip
 the time-scale conversion.  An output time equal to an event's epoch gets the
@@ -12,9 +14,11 @@ torque-free motion is far below anything this package reports).
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -26,6 +30,8 @@ from attitude.euler_solver import EulerSolver
 from attitude.events import Event, State
 from attitude.scenario import Scenario
 from attitude.timescales import SAME_INSTANT_S, tt_seconds
+from attitude.torqued_segment import TorquedMotion, scenario_torque_models
+from attitude.torqued_solver import angles_between
 
 if TYPE_CHECKING:  # astropy loads only when a Time is made
     from astropy.time import Time
@@ -46,7 +52,7 @@ class Segment:
 
     start_s: float
     end_s: float
-    solver: EulerSolver
+    solver: EulerSolver | TorquedMotion
     state: State
     event: Event | None = None
     before: State | None = None
@@ -56,14 +62,33 @@ class Segment:
 _RESOLVED_FRACTION_OF_A_TURN = 1e-3
 
 
-def _solver(state: State, t0: float, where: str) -> EulerSolver:
+def _solver(
+    state: State,
+    t0: float,
+    end_s: float,
+    where: str,
+    scenario: Scenario,
+    models: list,
+    step: float | None = None,
+) -> EulerSolver | TorquedMotion:
+    """The exact solver from ``state`` at ``t0``, or the torqued one if a torque acts
+    within [t0, end_s] (``models``: (start, stop, torque) of the scenario), at ``step``
+    if given, else as the scenario's torques say."""
+    acting = [model for start, stop, model in models if start < end_s and stop > t0]
     try:
+        if acting:
+            settings = scenario.torques
+            if step is not None:
+                settings = dataclasses.replace(settings, step=step, accuracy=None)
+            return TorquedMotion(state, t0, end_s, acting, settings)
         return EulerSolver(state.inertia.tensor, state.angular_momentum, state.attitude, t0=t0)
     except InputError as exc:
         raise InputError(f"{where}: {exc}") from None
 
 
-def _check_resolved(solver: EulerSolver, start_s: float, end_s: float, where: str) -> None:
+def _check_resolved(
+    solver: EulerSolver | TorquedMotion, start_s: float, end_s: float, where: str
+) -> None:
     """Refuse a motion faster than TT seconds (floats) can follow over [start_s, end_s].
 
     The body turns at most at |ω| ≤ G/I_min, once every 2π I_min/G seconds, and m(t)
@@ -71,7 +96,14 @@ def _check_resolved(solver: EulerSolver, start_s: float, end_s: float, where: st
     thousandth of the shorter of the two, every output would be noise: the elliptic
     phase λt, exact for the t given, is exact for a t that no one meant.
     """
-    G = solver.angular_momentum_norm
+    try:
+        G = solver.angular_momentum_norm  # under torques: the grid over the segment
+    except InputError as exc:
+        raise InputError(f"{where}: {exc}") from None
+    if not math.isfinite(G):
+        raise InputError(
+            f"{where}: under the torques, the angular momentum goes beyond the float range"
+        )
     if G == 0.0:
         return
     turn_s = 2.0 * math.pi * (float(np.min(solver.moments_of_inertia)) / G)
@@ -87,9 +119,11 @@ def _check_resolved(solver: EulerSolver, start_s: float, end_s: float, where: st
         raise InputError(f"{where}: the kinetic energy is beyond the float range")
 
 
-def propagate(scenario: Scenario) -> Trajectory:
+def propagate(scenario: Scenario, steps: list[float | None] | None = None) -> Trajectory:
     """The exact motion of ``scenario`` over [epoch, stop], through its events.
 
+    ``steps``: per segment, the torqued solver's step (None: as the scenario says), to
+    rerun a torqued trajectory at other steps (:attr:`Trajectory.error_estimate`).
     Raises :class:`InputError` naming the state (``initial_state`` or ``events[i]``)
     whose motion the solver refuses, or that turns too fast for TT seconds (floats)
     to follow over the span.
@@ -104,16 +138,21 @@ def propagate(scenario: Scenario) -> Trajectory:
     state = State(initial.attitude, m0, axes)
     starts: list[tuple[float, State, Event | None, State | None]] = [(0.0, state, None, None)]
     ends = [offset for offset, _ in scenario.events] + [scenario.stop_s]
-    solver = _solver(state, 0.0, "initial_state")
+    models = scenario_torque_models(scenario) if scenario.torques.any else []
+    steps = steps or [None] * len(ends)
+    solver = _solver(state, 0.0, ends[0], "initial_state", scenario, models, steps[0])
     _check_resolved(solver, 0.0, ends[0], "initial_state")
     solvers = [solver]
     indices = getattr(scenario, "event_indices", range(len(scenario.events)))
-    for (offset, event), index, end in zip(scenario.events, indices, ends[1:], strict=True):
+    for k, ((offset, event), index, end) in enumerate(
+        zip(scenario.events, indices, ends[1:], strict=True), start=1
+    ):
         where = f"events[{index}] ({event.kind} at {scenario.format_epoch(offset)})"
         before = State(solver.attitude(offset), solver.angular_momentum(offset), state.inertia)
         state = event.apply(before)
-        solver = _solver(state, offset, f"the state after {where}")
-        _check_resolved(solver, offset, end, f"the state after {where}")
+        where = f"the state after {where}"
+        solver = _solver(state, offset, end, where, scenario, models, steps[k])
+        _check_resolved(solver, offset, end, where)
         solvers.append(solver)
         starts.append((offset, state, event, before))
     segments = [
@@ -212,17 +251,55 @@ class Trajectory:
         return self._by_segment(times, lambda solver, τ: solver.angular_velocity(τ), 3)
 
     def inertial_angular_momentum(self, times: Any) -> NDArray[np.float64]:
-        """Angular momentum in inertial axes, N m s (constant within a segment)."""
-        return self._by_segment(
-            times, lambda solver, τ: np.tile(solver.inertial_angular_momentum, (τ.size, 1)), 3
-        )
+        """Angular momentum in inertial axes, N m s (constant within a torque-free segment)."""
+
+        def evaluate(solver, τ):
+            if isinstance(solver, TorquedMotion):
+                return solver.inertial_angular_momentum_at(τ)
+            return np.tile(solver.inertial_angular_momentum, (τ.size, 1))
+
+        return self._by_segment(times, evaluate, 3)
 
     def kinetic_energy(self, times: Any) -> NDArray[np.float64]:
-        """Rotational kinetic energy, J (constant within a segment)."""
-        values = self._by_segment(
-            times, lambda solver, τ: np.full((τ.size, 1), solver.kinetic_energy), 1
+        """Rotational kinetic energy, J (constant within a torque-free segment)."""
+
+        def evaluate(solver, τ):
+            if isinstance(solver, TorquedMotion):
+                return solver.kinetic_energy_at(τ)[:, None]
+            return np.full((τ.size, 1), solver.kinetic_energy)
+
+        return self._by_segment(times, evaluate, 1)[..., 0]
+
+    @cached_property
+    def error_estimate(self) -> float:
+        """The estimated worst attitude error of the run (rad); 0 for the exact solver.
+
+        Under torques, the segments' errors carry through the events and grow with the
+        motion (an error of the momentum shifts the phase of a tumble), so each
+        segment's own estimate does not add up to the run's.  This is the run's:
+        the same scenario at twice each segment's step, through the same events,
+        compared at 64 times over the span and at each segment's end, the largest angle
+        over 2^p − 1 (Richardson, p the order).
+        """
+        steps = [
+            2.0 * s.solver.step if isinstance(s.solver, TorquedMotion) else None
+            for s in self.segments
+        ]
+        if all(step is None for step in steps):
+            return 0.0
+        coarse = propagate(self.scenario, steps)
+        checks = np.unique(
+            np.concatenate(
+                [
+                    np.linspace(0.0, self.stop_s, 65)[1:],
+                    [s.end_s for s in self.segments if s.end_s > 0.0],
+                ]
+            )
         )
-        return values[..., 0]
+        difference = angles_between(
+            self.attitude_quaternion(checks), coarse.attitude_quaternion(checks)
+        )
+        return float(np.max(difference)) / (2.0**self.scenario.torques.order - 1.0)
 
     def flip_times(self) -> NDArray[np.float64]:
         """All Джанибеков flips over [epoch, stop], TT seconds since the epoch (closed form)."""

@@ -53,7 +53,7 @@ def main(argv: list[str] | None = None) -> dict:
     from attitude.aem import AemSegment, AemWriter, write_aem
     from attitude.epoch_texts import EpochTexts
     from attitude.exports import CsvWriter, pointing_columns, sample, trajectory_columns
-    from attitude.pointing import compute_pointing
+    from attitude.pointing import pointing_samples
     from attitude.scenario_file import load_scenario
     from attitude.timeseries_parquet import ParquetWriter
     from attitude.trajectory import propagate
@@ -70,7 +70,7 @@ def main(argv: list[str] | None = None) -> dict:
         trajectory = propagate(scenario)
         seconds = scenario.output_seconds()
         columns = trajectory_columns(sample(trajectory, seconds))
-        columns += pointing_columns(compute_pointing(trajectory, loaded.pointing, seconds))
+        columns += pointing_columns(pointing_samples(trajectory, loaded.pointing, seconds))
         rows = seconds.size
         data = np.column_stack([c.values for c in columns])
         texts = EpochTexts(scenario.epoch)

@@ -77,7 +77,122 @@ def _epoch(epoch: str, duration: float = 10.0) -> str:
     return _replace("duration = 10.0", f"duration = {duration!r}", text)
 
 
+KEPLERIAN = """
+[pointing]
+[pointing.keplerian]
+semi_major_axis = { value = 7000.0, unit = "km" }
+eccentricity = 0.0
+inclination = { value = 51.6, unit = "deg" }
+raan = { value = 0.0, unit = "deg" }
+argument_of_perigee = { value = 0.0, unit = "deg" }
+mean_anomaly = { value = 0.0, unit = "deg" }
+"""
+
+BURN = "[[torques.burns]]\noffset = 1.0\nduration = 2.0\ntorque = [0.0, 0.0, 0.01]\n"
+
+
+def _torques(table: str, burn: str = "", orbit: bool = True) -> str:
+    """BASE with a [torques] table (and a burn), on a Keplerian orbit unless not."""
+    return BASE + "\n[torques]\n" + table + "\n" + burn + (KEPLERIAN if orbit else "")
+
+
 BAD = {
+    # [torques]: every value a hostile user could write.
+    "burn: negative duration": (
+        _torques("", BURN.replace("duration = 2.0", "duration = -5.0")),
+        r"torques\.burns\[0\]\.duration: must be positive, got -5\.0",
+    ),
+    "burn: NaN duration": (
+        _torques("", BURN.replace("duration = 2.0", "duration = nan")),
+        r"torques\.burns\[0\]\.duration: expected finite numbers, got nan",
+    ),
+    "burn: 10**400 s": (
+        _torques("", BURN.replace("duration = 2.0", "duration = 1" + "0" * 400)),
+        r"torques\.burns\[0\]\.duration: a number is beyond the float range",
+    ),
+    "burn: a torque whose impulse squared overflows": (
+        _torques("", BURN.replace("[0.0, 0.0, 0.01]", "[1e300, 0.0, 0.0]")),
+        r"torques\.burns\[0\]\.torque: \[1e\+300, 0\.0, 0\.0\] N m over the span is an "
+        r"angular impulse of 2e\+300 N m s, beyond what floats hold",
+    ),
+    "burn: a torque that spins the body beyond what TT seconds follow": (
+        _torques("", BURN.replace("[0.0, 0.0, 0.01]", "[1e150, 0.0, 0.0]")),
+        r"initial_state: the body turns in .* too fast for TT seconds",
+    ),
+    "burn: after the span": (
+        _torques("", BURN.replace("offset = 1.0", "offset = 10.0")),
+        r"torques\.burns\[0\]\.epoch: the burn starts at 2027-06-21T00:00:10\.000000000 UTC, "
+        r"outside the span",
+    ),
+    "burn: a string torque": (
+        _torques("", BURN.replace("[0.0, 0.0, 0.01]", '"0.01"')),
+        r"torques\.burns\[0\]\.torque: expected 3 numbers, got '0\.01'",
+    ),
+    "burn: no torque": (
+        _torques("", BURN.replace("torque = [0.0, 0.0, 0.01]\n", "")),
+        r"torques\.burns\[0\]\.torque: missing key",
+    ),
+    "burn: unknown frame": (
+        _torques("", BURN + 'frame = "lvlh"\n'),
+        r"torques\.burns\[0\]\.frame: expected one of body, inertial, got 'lvlh'",
+    ),
+    "torques: step and accuracy": (
+        _torques('step = 1.0\naccuracy = { value = 1e-6, unit = "rad" }', BURN),
+        r"torques: give step or accuracy, not both",
+    ),
+    "torques: unknown key": (
+        _torques("gravity_gradiant = true", BURN),
+        r"torques: unknown key 'gravity_gradiant'",
+    ),
+    "torques: gravity gradient without an orbit": (
+        _torques("gravity_gradient = true", orbit=False),
+        r"torques\.gravity_gradient: gravity gradient needs an orbit",
+    ),
+    "torques: gravity gradient as a string": (
+        _torques('gravity_gradient = "yes"'),
+        r"torques\.gravity_gradient: expected true or false, got 'yes'",
+    ),
+    "torques: order 3": (
+        _torques("order = 3", BURN),
+        r"torques\.order: expected 2, 4 or 6 \(the splitting's order\), got 3",
+    ),
+    "torques: order 4.0": (
+        _torques("order = 4.0", BURN),
+        r"torques\.order: expected 2, 4 or 6",
+    ),
+    "torques: accuracy without its unit": (
+        _torques("accuracy = 1e-6", BURN),
+        r"torques\.accuracy: an angle needs its unit",
+    ),
+    "torques: accuracy of 0 rad": (
+        _torques('accuracy = { value = 0.0, unit = "rad" }', BURN),
+        r"torques\.accuracy: must be between 1e-12 and 0\.1 rad, got 0\.0 rad",
+    ),
+    "torques: step longer than the span": (
+        _torques("step = 1e9", BURN),
+        r"torques\.step: 1e\+09 s is longer than the span \(10 s\)",
+    ),
+    "torques: 1e10 steps": (
+        _torques("step = 1e-9", BURN),
+        r"torques\.step: 1e-09 s is 1e\+10 steps over the span of 10 s, more than 1e\+07",
+    ),
+    "torques: an accuracy over 300 years": (
+        _torques(
+            'accuracy = { value = 1e-6, unit = "rad" }',
+            BURN.replace("duration = 2.0", "duration = 1e10"),
+        ).replace("duration = 10.0", "duration = 1e10"),
+        r"the state after events\[0\] .*: torques\.accuracy: choosing the step over "
+        r"1e\+10 s would start with "
+        r"[\d.e+]+ steps of [\d.]+ s \(more than 1e\+07\): give torques\.step",
+    ),
+    "torques: negative step": (
+        _torques("step = -1.0", BURN),
+        r"torques\.step: must be positive, got -1\.0",
+    ),
+    "torques: horizon threshold of 200 deg": (
+        _torques('horizon_threshold = { value = 200, unit = "deg" }'),
+        r"torques\.horizon_threshold: must be between 0 and 180 deg, got 200\.0 deg",
+    ),
     # The TLE: every error names the file and pointing.tle.
     "TLE checksum": (_with_tle(LINE1[:68] + "0"), r"pointing\.tle: line1: checksum"),
     "TLE short line": (_with_tle(LINE1, LINE2[:60]), r"pointing\.tle: line2 must have 69"),

@@ -15,9 +15,29 @@ LAYERS = [
     ["elliptic"],  # elliptic kernels
     ["inertia", "invariants", "closed_form", "euler_solver", "free_flow"],  # the Euler solver
     ["torques", "splitting", "torqued_solver"],  # torques and splitting
-    ["timescales", "epoch_texts", "spacecraft", "events", "scenario"],  # scenario and events
-    ["trajectory", "motion_analysis"],  # trajectory
-    ["ephemeris", "orbit", "eclipse", "pointing", "intervals"],  # pointing (skyfield)
+    [  # scenario and events
+        "timescales",
+        "epoch_texts",
+        "spacecraft",
+        "events",
+        "scenario_torques",
+        "scenario",
+    ],
+    ["torqued_segment", "trajectory", "horizon", "motion_analysis"],  # trajectory
+    [  # pointing (skyfield)
+        "ephemeris",
+        "earth",
+        "frames",
+        "orbit",
+        "keplerian",
+        "ccsds_files",
+        "oem",
+        "aem_input",
+        "intervals",
+        "extrema",
+        "eclipse",
+        "pointing",
+    ],
     [  # reports and exports
         "exports",
         "timeseries_parquet",
@@ -29,6 +49,7 @@ LAYERS = [
         "output_formats",
         "output_budget",
         "run_plan",
+        "torques_summary",
         "output_folder",
         "report",
     ],

@@ -67,7 +67,10 @@ def test_outputs_are_consistent(runs, name):
     np.testing.assert_allclose(
         data["kinetic_energy_J"], 0.5 * np.sum(ω * h_body, axis=1), rtol=1e-12
     )
+    torqued = {s["index"] for s in summary["motion"]["segments"] if s["motion"] == "torqued"}
     for k in np.unique(data["segment"]):
+        if k in torqued:
+            continue  # under torques H_icrf changes: tests/test_scenario_torques_*.py
         rows = h_icrf[data["segment"] == k]
         assert np.max(np.linalg.norm(rows - rows[0], axis=1)) <= 1e-13 * G.max()
     assert len(summary["motion"]["segments"]) == len(summary["scenario"]["events"]) + 1

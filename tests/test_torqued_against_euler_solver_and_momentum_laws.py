@@ -9,7 +9,9 @@
    symmetric spinner spins it up exactly (ω3 = ω3(0) + τ t/I3, the axis fixed).
 3. propagate_batch: N spacecraft advanced together give what N solvers give.
 4. departure_time: against the crossing found on a DOP853 integration.
-5. A TLE orbit is accepted as the position of the gravity gradient.
+5. The orbit sources (a TLE, Keplerian elements, an OEM file) are accepted as the
+   position of the gravity gradient, through their ``position_velocity``: each gives
+   the orbit's own positions; an OEM has no epoch of its own and needs ``epoch=``.
 """
 
 import math
@@ -156,5 +158,47 @@ def test_tle_orbit_as_the_position():
     t = np.array([0.0, 1234.5])
     direct = orbit.position_velocity(epoch + t * u.s)[0]
     assert np.max(np.abs(gg.position(t) - direct)) <= 1e-6
+    solver = TorquedSolver(INERTIA, M0, ATTITUDE, torques=[gg], step=10.0)
+    assert np.all(np.isfinite(solver.attitude_quaternion(t)))
+
+
+def test_keplerian_and_oem_orbits_as_the_position(tmp_path):
+    import ccsds_ndm
+    from astropy import units as u
+    from astropy.time import Time
+
+    from attitude import InputError, KeplerianOrbit, OemOrbit
+    from attitude.timescales import offline_time
+
+    epoch = Time("2024-03-01T00:00:00", scale="utc")
+    kepler = KeplerianOrbit(epoch, 7.0e6, 0.01, 0.9, 0.3, 0.2, mean_anomaly=0.1)
+    t = np.array([0.0, 1234.5, 3000.0])
+    gg = GravityGradient(kepler)  # the elements' epoch is t = 0
+    direct = kepler.position_velocity(epoch + t * u.s)[0]
+    assert np.max(np.abs(gg.position(t) - direct)) <= 1e-6
+
+    # The same orbit every 60 s in an OEM (ICRF, UTC), read back.
+    nodes = epoch + np.arange(0.0, 3600.0 + 1.0, 60.0) * u.s
+    r, v = kepler.position_velocity(nodes)
+    with offline_time():
+        texts = list(nodes.utc.isot)
+    metadata = ccsds_ndm.OemMetadata(
+        object_name="SAT",
+        object_id="2024-001A",
+        start_time=texts[0],
+        stop_time=texts[-1],
+        center_name="EARTH",
+        ref_frame="ICRF",
+        time_system="UTC",
+    )
+    data = ccsds_ndm.OemData.from_numpy(texts, np.hstack([r, v]) / 1e3)
+    header = ccsds_ndm.OdmHeader(creation_date="2024-03-01T00:00:00", originator="TEST")
+    path = tmp_path / "sat.oem"
+    path.write_text(ccsds_ndm.Oem(header, [ccsds_ndm.OemSegment(metadata, data)]).to_str("kvn"))
+    oem = OemOrbit(path)
+    with pytest.raises(InputError, match="epoch="):
+        GravityGradient(oem)
+    gg = GravityGradient(oem, epoch=epoch)
+    assert np.max(np.abs(gg.position(t) - oem.position_velocity(epoch + t * u.s)[0])) <= 1e-6
     solver = TorquedSolver(INERTIA, M0, ATTITUDE, torques=[gg], step=10.0)
     assert np.all(np.isfinite(solver.attitude_quaternion(t)))
