@@ -56,6 +56,7 @@ import math
 from typing import Any, Protocol
 
 import numpy as np
+from numpy.typing import NDArray
 
 from attitude.elliptic import NEAR_ONE_MC, JacobiParameter, amplitude
 from attitude.float_math import FLOAT
@@ -216,10 +217,8 @@ class Elliptic:
         return self._evaluate(τ, xp, with_ψ=True)
 
     def _evaluate(self, τ: Any, xp: Any, with_ψ: bool):
-        u = self.λ * τ - self.ν
-        j, r, sn_r, cn_r, dn_r = self.parameter.jacobi(u, xp)
-        sn, cn, dn = JacobiParameter.full(j, sn_r, cn_r, dn_r, xp)
-        a, b, c = self.A_s * sn, self.A_c * cn, self.A_d * dn
+        j, r, sn_r, cn_r, dn_r = self.phase(τ, xp)
+        a, b, c = self.momentum_of_phase(j, sn_r, cn_r, dn_r, xp)
         if not with_ψ:
             return a, b, c, None
         Π_minus_F = self.parameter.pi_minus_f(j, r, sn_r, cn_r, dn_r, self.n, self.Π_minus_K, xp)
@@ -229,6 +228,44 @@ class Elliptic:
             + self.κ_sign * _arctan_of_scaled_sc(j, sn_r, cn_r, self.κ, xp)
         )
         return a, b, c, ψ
+
+    def phase(self, τ: Any, xp: Any) -> tuple[Any, Any, Any, Any, Any]:
+        """j, r, sn r, cn r, dn r for the phase u = λτ − ν = 2jK + r, |r| ≤ K."""
+        return self.parameter.jacobi(self.λ * τ - self.ν, xp)
+
+    def momentum_of_phase(self, j: Any, sn_r: Any, cn_r: Any, dn_r: Any, xp: Any):
+        """m in the P-frame, (A_s sn u, A_c cn u, A_d dn u), from ``phase``."""
+        sn, cn, dn = JacobiParameter.full(j, sn_r, cn_r, dn_r, xp)
+        return self.A_s * sn, self.A_c * cn, self.A_d * dn
+
+    def angle_rates(self) -> tuple[float, float]:
+        """s_u and Ω: ψ(τ) = Ω τ − s_u ν + ``periodic_angle``(r), for one state.
+
+        Over each half period 2K of u, Π(am u, n) − u gains its complete value and the
+        arc tangent π (``pi_minus_f``, ``_arctan_of_scaled_sc``): ψ grows on average
+        by s_u = (2 C (Π(n) − K) + κ_sign π)/(2K) per unit of u, and so, with
+        u = λτ − ν, at the rate Ω = G/I_a + s_u λ in time.
+        """
+        s_u = (2.0 * self.C * self.Π_minus_K + self.κ_sign * math.pi) / (2.0 * self.K)
+        return s_u, self.ψ_rate + s_u * self.λ
+
+    def periodic_angle(self, r: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
+        """The periodic part of ψ at the reduced phase r, |r| ≤ K, for one state.
+
+        per(r) = C (Π − F)(am r, n) + κ_sign arctg(κ sc r) − s_u r (``angle_rates``):
+        odd, 2K-periodic (per(±K) = 0) and analytic, so that ψ(τ) = Ω τ − s_u ν +
+        per(r(τ)).  Also returns the magnitude of the largest of its terms, whose
+        rounding is the error of this formula (what a table of it must not exceed).
+        """
+        s_u, _ = self.angle_rates()
+        j, r, sn_r, cn_r, dn_r = self.parameter.jacobi(r, np)  # j = 0 on |r| ≤ K
+        terms = (
+            self.C * self.parameter.pi_minus_f(j, r, sn_r, cn_r, dn_r, self.n, 0.0, np),
+            self.κ_sign * _arctan_of_scaled_sc(j, sn_r, cn_r, self.κ, np),
+            -s_u * r,
+        )
+        largest = max(float(np.max(np.abs(term))) for term in terms)
+        return terms[0] + terms[1] + terms[2], largest
 
 
 def _arctan_of_scaled_sc(j: Any, s: Any, c: Any, κ: Any, xp: Any) -> Any:
@@ -349,8 +386,16 @@ def p_quaternion(a: Any, b: Any, c: Any, G: Any, xp: Any) -> tuple[Any, Any, Any
 
 
 def y_times_p(half_ψ: Any, p0: Any, p1: Any, p2: Any, xp: Any) -> tuple[Any, Any, Any, Any]:
-    """Y(ψ) ⊗ P, scalar first, with Y = (cos ψ/2, 0, 0, sin ψ/2) and P = (p0, p1, p2, 0)."""
-    cy, sy = xp.cos(half_ψ), xp.sin(half_ψ)
+    """Y(ψ) ⊗ P, scalar first, with Y = (cos ψ/2, 0, 0, sin ψ/2) and P = (p0, p1, p2, 0).
+
+    cos and sin of ψ/2 from t = tan ψ/4: (1 − t²)/(1 + t²) and 2t/(1 + t²), to an
+    ulp or two of each component, from one tangent (vectorized in numpy, where its sine
+    and cosine are not).  Near ψ/4 = ±π/2, t is large but finite for any float.
+    """
+    t = xp.tan(0.5 * half_ψ)
+    t2 = t * t
+    w = 1.0 / (1.0 + t2)
+    cy, sy = (1.0 - t2) * w, (t + t) * w
     return cy * p0, cy * p1 - sy * p2, cy * p2 + sy * p1, sy * p0
 
 

@@ -130,15 +130,10 @@ def _maclaurin(x: Any, mc: Any) -> tuple[Any, Any, Any]:
     return sn, cn, dn
 
 
-def _bulirsch(z: Any, mc: Any, xp: Any) -> tuple[Any, Any, Any]:
-    """sn, cn, dn for 1e-4 ≤ |z| ≤ K/2 and mc > 0: Bulirsch's ``sncndn`` [Bul65].
-
-    The descending Gauss transformation driven by the AGM of 1 and √mc: one sine and
-    one cosine, then a rational recurrence.  With an array ``mc`` the AGM runs until
-    every element has converged; extra steps on a converged element are identities to
-    rounding.  Pass a scalar ``mc`` when all elements share it: the AGM is then
-    computed once.
-    """
+def _agm(mc: Any, xp: Any) -> tuple[list, list, Any]:
+    """The AGM of 1 and √mc that drives ``_bulirsch``: the means a_i, the geometric
+    means b_i and the final mean c.  With an array ``mc`` it runs until every element
+    has converged; extra steps on a converged element are identities to rounding."""
     a = 1.0
     emc = mc
     a_seq, b_seq = [], []
@@ -153,9 +148,22 @@ def _bulirsch(z: Any, mc: Any, xp: Any) -> tuple[Any, Any, Any]:
         a = c
     else:  # pragma: no cover  (quadratic convergence: 10 steps at mc = 1e-300)
         raise ArithmeticError("AGM did not converge")
-    x = z * c
-    s = xp.sin(x)
-    a = xp.cos(x) / s
+    return a_seq, b_seq, c
+
+
+def _bulirsch(z: Any, mc: Any, xp: Any, agm: tuple | None = None) -> tuple[Any, Any, Any]:
+    """sn, cn, dn for 1e-4 ≤ |z| ≤ K/2 and mc > 0: Bulirsch's ``sncndn`` [Bul65].
+
+    The descending Gauss transformation driven by the AGM of 1 and √mc (``_agm``, or
+    ``agm`` if the caller keeps it: it depends on mc only): one cotangent, then a
+    rational recurrence.  (Bulirsch starts from cos x / sin x; 1/tan x is the same
+    number to rounding, and numpy's tangent is vectorized, five times cheaper than
+    its sine and cosine.)  Pass a scalar ``mc`` when all elements share it: the
+    AGM is then computed once.
+    """
+    a_seq, b_seq, c = _agm(mc, xp) if agm is None else agm
+    x = z * c  # |x| ≤ π/4, since c K = π/2
+    a = 1.0 / xp.tan(x)  # cot x: one tangent (numpy's is vectorized; sin, cos are not)
     c = c * a
     d = 1.0
     for a_i, b_i in zip(reversed(a_seq), reversed(b_seq), strict=True):
@@ -163,7 +171,7 @@ def _bulirsch(z: Any, mc: Any, xp: Any) -> tuple[Any, Any, Any]:
         c = c * d
         d = (b_i + a) / (a_i + a)
         a = c / a_i
-    s = xp.copysign(1.0 / xp.sqrt(c * c + 1.0), s)
+    s = xp.copysign(1.0 / xp.sqrt(c * c + 1.0), x)  # sin x has the sign of x
     return s, c * s, d
 
 
@@ -233,7 +241,33 @@ def reduced_sn_cn_dn(
     return tuple(np.where(far, f, g) for f, g in zip(shifted, (s, c, d), strict=True))
 
 
-def _reduced_sn_cn_dn_float(r: float, mc: float, K: float) -> tuple[float, float, float]:
+def _reduced_sn_cn_dn_one_mc(
+    r: NDArray[np.float64], mc: float, K: float, agm: tuple | None = None
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """``reduced_sn_cn_dn`` for one float 0 < mc ≤ 1 and an array ``r`` (one state at
+    many times): the same pieces as ``_sn_cn_dn_core`` and ``_quarter_shift``, on the
+    whole array at once.
+
+    Bulirsch's recurrence runs over every element, its AGM computed once; the few
+    elements with |z| below the series threshold (where the cot recurrence would
+    overflow) are then recomputed by the series, and the quarter shift is a ``where``.
+    No boolean gather of the whole array: each piece is a pass over contiguous memory.
+    """
+    far = np.abs(r) > 0.5 * K
+    σ = np.copysign(1.0, r)
+    z = np.where(far, r - σ * K, r)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        s, c, d = _bulirsch(z, mc, np, agm)
+    small = np.flatnonzero(np.abs(z) < _SERIES_THRESHOLD)
+    if small.size:
+        s[small], c[small], d[small] = _maclaurin(z[small], mc)
+    shifted = _quarter_shift(σ, mc, s, c, d, np)
+    return np.where(far, shifted[0], s), np.where(far, shifted[1], c), np.where(far, shifted[2], d)
+
+
+def _reduced_sn_cn_dn_float(
+    r: float, mc: float, K: float, agm: tuple | None = None
+) -> tuple[float, float, float]:
     """``reduced_sn_cn_dn`` for one float (0 < mc ≤ 1): the same pieces, chosen by ``if``."""
     far = abs(r) > 0.5 * K
     σ = math.copysign(1.0, r)
@@ -241,7 +275,7 @@ def _reduced_sn_cn_dn_float(r: float, mc: float, K: float) -> tuple[float, float
     if abs(z) < _SERIES_THRESHOLD:
         s, c, d = _maclaurin(z, mc)
     else:
-        s, c, d = _bulirsch(z, mc, FLOAT)
+        s, c, d = _bulirsch(z, mc, FLOAT, agm)
     return _quarter_shift(σ, mc, s, c, d, FLOAT) if far else (s, c, d)
 
 
@@ -479,6 +513,8 @@ class JacobiParameter:
         else:
             self.K = special.ellipkm1(mc)
         self.kc = xp.exp(0.5 * log_mc)  # k' = √mc (0 below the float range)
+        # The AGM of Bulirsch's recurrence, once for a single state (it depends on mc).
+        self._agm = _agm(mc, FLOAT) if xp is FLOAT and not near_one and mc > 0.0 else None
 
     def jacobi(self, u: Any, xp: Any) -> tuple[Any, Any, Any, Any, Any]:
         """j, r, sn r, cn r, dn r for u = 2jK + r, |r| ≤ K."""
@@ -488,10 +524,16 @@ class JacobiParameter:
             r = u - j * (2.0 * K)
             if self.near_one:
                 return (j, r, *reduced_sn_cn_dn_near_one(r, self.log_mc, K, FLOAT))
-            return (j, r, *_reduced_sn_cn_dn_float(r, self.mc, K))
-        j, r = reduce_argument(u, K)
+            return (j, r, *_reduced_sn_cn_dn_float(r, self.mc, K, self._agm))
+        if np.ndim(K) == 0 and math.isfinite(K):  # one state: reduce_argument, unmasked
+            j = np.rint(u / (2.0 * K))
+            r = u - j * (2.0 * K)
+        else:
+            j, r = reduce_argument(u, K)
         if self.near_one:
             return (j, r, *reduced_sn_cn_dn_near_one(r, self.log_mc, K))
+        if np.ndim(self.mc) == 0:  # one state at many times
+            return (j, r, *_reduced_sn_cn_dn_one_mc(r, float(self.mc), float(K), self._agm))
         return (j, r, *reduced_sn_cn_dn(r, self.mc, K))
 
     @staticmethod
@@ -508,6 +550,8 @@ class JacobiParameter:
         """
         if self.near_one:
             return (n / (1.0 - n)) * (self.K - _arctan_integral(1.0, n, xp))
+        if xp is FLOAT and n == 0.0:  # a symmetric body: Π = F
+            return 0.0
         value = (n / 3.0) * special.elliprj(0.0, self.mc, 1.0, 1.0 - n)
         return float(value) if xp is FLOAT else value
 
@@ -518,6 +562,8 @@ class JacobiParameter:
         ``complete = complete_pi_minus_k(n)``: ``pi_minus_f`` or its near-one form."""
         if self.near_one:
             incomplete = (n / (1.0 - n)) * (r - _arctan_integral(sn, n, xp))
+        elif (xp is FLOAT or np.ndim(n) == 0) and n == 0.0:  # symmetric: Π = F, no R_J
+            incomplete = 0.0 * r
         else:
             c2, s2 = cn * cn, sn * sn
             r_j = special.elliprj(c2, dn * dn, 1.0, c2 + (1.0 - n) * s2)

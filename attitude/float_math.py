@@ -52,6 +52,7 @@ class _FloatMath:
     log = staticmethod(_log)
     sin = staticmethod(math.sin)
     cos = staticmethod(math.cos)
+    tan = staticmethod(math.tan)
     tanh = staticmethod(math.tanh)
     arctan = staticmethod(math.atan)
     arctan2 = staticmethod(_arctan2)
