@@ -133,27 +133,48 @@ def _maclaurin(x: Any, mc: Any) -> tuple[Any, Any, Any]:
     return sn, cn, dn
 
 
-def _agm(mc: Any, xp: Any) -> tuple[list, list, Any]:
+def _agm(mc: Any, xp: Any) -> tuple[list, list, Any, Any]:
     """The AGM of 1 and √mc that drives ``_bulirsch``: the means a_i, the geometric
-    means b_i and the final mean c.  With an array ``mc`` it runs until every element
-    has converged; extra steps on a converged element are identities to rounding."""
+    means b_i, the final mean c, and the number of levels.
+
+    With an array ``mc`` each element keeps its own: the loop runs until every element
+    has converged, and ``levels`` (an integer array) and ``c`` are each element's at its
+    own convergence, so that ``_bulirsch`` gives it the same bits as alone (for one
+    float, ``levels`` is None).
+    """
     a = 1.0
     emc = mc
     a_seq, b_seq = [], []
-    sqrt = xp.sqrt
-    converged = bool if xp is FLOAT else xp.all
-    for _ in range(40):
+    if xp is FLOAT or np.ndim(mc) == 0:
+        sqrt = xp.sqrt
+        for _ in range(40):
+            a_seq.append(a)
+            emc = sqrt(emc)
+            b_seq.append(emc)
+            c = 0.5 * (a + emc)
+            if abs(a - emc) <= _AGM_TOLERANCE * a:
+                return a_seq, b_seq, c, None
+            emc = emc * a
+            a = c
+        raise ArithmeticError("AGM did not converge")  # pragma: no cover  (10 steps at 1e-300)
+    levels = np.zeros(np.shape(mc), dtype=np.intp)
+    c_final = np.zeros(np.shape(mc))
+    pending = np.ones(np.shape(mc), dtype=bool)
+    for level in range(1, 41):
         a_seq.append(a)
-        emc = sqrt(emc)
+        emc = np.sqrt(emc)
         b_seq.append(emc)
         c = 0.5 * (a + emc)
-        if converged(abs(a - emc) <= _AGM_TOLERANCE * a):
-            break
+        now = pending & (abs(a - emc) <= _AGM_TOLERANCE * a)
+        if now.any():
+            levels[now] = level
+            c_final[now] = c[now] if np.ndim(c) else c
+            pending &= ~now
+            if not pending.any():
+                return a_seq, b_seq, c_final, levels
         emc = emc * a
         a = c
-    else:  # pragma: no cover  (quadratic convergence: 10 steps at mc = 1e-300)
-        raise ArithmeticError("AGM did not converge")
-    return a_seq, b_seq, c
+    raise ArithmeticError("AGM did not converge")  # pragma: no cover
 
 
 def _bulirsch(z: Any, mc: Any, xp: Any, agm: tuple | None = None) -> tuple[Any, Any, Any]:
@@ -164,18 +185,26 @@ def _bulirsch(z: Any, mc: Any, xp: Any, agm: tuple | None = None) -> tuple[Any, 
     rational recurrence.  (Bulirsch starts from cos x / sin x; 1/tan x is the same
     number to rounding, and numpy's tangent is vectorized, five times cheaper than
     its sine and cosine.)  Pass a scalar ``mc`` when all elements share it: the
-    AGM is then computed once.
+    AGM is then computed once.  With an array ``mc``, each element runs through its
+    own levels only (the others are held by a ``where``).
     """
-    a_seq, b_seq, c = _agm(mc, xp) if agm is None else agm
+    a_seq, b_seq, c, levels = _agm(mc, xp) if agm is None else agm
     x = z * c  # |x| ≤ π/4, since c K = π/2
     a = 1.0 / xp.tan(x)  # cot x: one tangent (numpy's is vectorized; sin, cos are not)
     c = c * a
     d = 1.0
-    for a_i, b_i in zip(reversed(a_seq), reversed(b_seq), strict=True):
-        a = a * c
-        c = c * d
-        d = (b_i + a) / (a_i + a)
-        a = c / a_i
+    shared = len(a_seq) if levels is None else int(levels.min())  # levels every element has
+    for i in range(len(a_seq) - 1, -1, -1):
+        a_i, b_i = a_seq[i], b_seq[i]
+        a_next = a * c
+        c_next = c * d
+        d_next = (b_i + a_next) / (a_i + a_next)
+        a_next = c_next / a_i
+        if i < shared:
+            a, c, d = a_next, c_next, d_next
+        else:
+            own = i < levels
+            a, c, d = np.where(own, a_next, a), np.where(own, c_next, c), np.where(own, d_next, d)
     s = xp.copysign(1.0 / xp.sqrt(c * c + 1.0), x)  # sin x has the sign of x
     return s, c * s, d
 
