@@ -338,6 +338,8 @@ def _jacobi_reduced(u: ArrayLike, mc: NDArray[np.float64], K: NDArray[np.float64
 
 def _parity_sign(j: Any, xp: Any) -> Any:
     """(−1)^j for an integer-valued float j: sn and cn change sign every 2K."""
+    if xp is FLOAT:
+        return -1.0 if j % 2.0 else 1.0
     return 1.0 - 2.0 * xp.abs(j - 2.0 * xp.rint(0.5 * j))
 
 
