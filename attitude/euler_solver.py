@@ -52,12 +52,14 @@ from attitude.quaternions import left_matrix, right_matrix
 
 __all__ = ["EulerSolver"]
 
-# Evaluations over many times run in slices of this many samples (see _evaluate).
-_CHUNK = 16384
+# Evaluations over many times run in slices of this many samples (see _evaluate): a
+# slice's temporaries (at most ~130 B a sample) stay in the processor's cache, and
+# bound what a call holds besides its output to ~1 MB.
+_CHUNK = 8192
 # From this many times in one call, the attitude takes the periodic part of ψ from a
 # table built once (``_angle_table``: 1000 to 6000 formula evaluations, which cost
 # about as much as this many samples of the formula) instead of one R_J a sample.
-_TABLE_MIN_SAMPLES = _CHUNK
+_TABLE_MIN_SAMPLES = 16384
 _UNBUILT = object()
 try:  # numpy's array-API namespace as scipy's Rotation keeps it (see _one_rotation)
     from scipy._lib._array_api import array_namespace as _array_namespace
@@ -295,21 +297,45 @@ class EulerSolver:
         no R_J per sample.
         """
         f = self._formula
+        # Each intermediate is dropped as soon as it is used, and the product is
+        # summed into ``out`` itself: a slice holds as few arrays as the formulas allow
+        # (the same operations in the same order as without the in-place forms: the
+        # same bits).
         if table is None:
             a, b, c, ψ = f.momentum_and_angle(τ, np)
-            half_ψ = 0.5 * (ψ - self._ψ_t0)
+            ψ -= self._ψ_t0
+            ψ *= 0.5
+            half_ψ = ψ
         else:
             j, r, sn_r, cn_r, dn_r = f.phase(τ, np)
             a, b, c = f.momentum_of_phase(j, sn_r, cn_r, dn_r, np)
-            half_ψ = 0.5 * (self._Ω * τ + (table(r) - self._per_t0))
-        yp = y_times_p(half_ψ, *p_quaternion(a, b, c, self._G, np), np)
+            del j, sn_r, cn_r, dn_r
+            periodic = table(r)
+            del r
+            periodic -= self._per_t0
+            half_ψ = self._Ω * τ
+            half_ψ += periodic
+            half_ψ *= 0.5
+            del periodic
+        p = p_quaternion(a, b, c, self._G, np)
+        del a, b, c
+        yp = y_times_p(half_ψ, *p, np)
+        del p, half_ψ
         M = self._M
-        q = [
-            yp[0] * M[i, 0] + yp[1] * M[i, 1] + yp[2] * M[i, 2] + yp[3] * M[i, 3] for i in range(4)
-        ]
-        norm = np.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+        term = np.empty_like(yp[0])
         for i in range(4):
-            np.divide(q[i], norm, out=out[:, columns[i]])
+            q_i = out[:, columns[i]]
+            np.multiply(yp[0], M[i, 0], out=q_i)
+            for k in (1, 2, 3):
+                q_i += np.multiply(yp[k], M[i, k], out=term)
+        del yp
+        q = [out[:, columns[i]] for i in range(4)]
+        norm = np.multiply(q[0], q[0])
+        for i in (1, 2, 3):
+            norm += np.multiply(q[i], q[i], out=term)
+        np.sqrt(norm, out=norm)
+        for q_i in q:
+            q_i /= norm
 
     def _quaternion_at(self, τ: float, t: Any) -> tuple[float, float, float, float]:
         """The unit attitude quaternion (w, x, y, z) at one time, on Python floats: the

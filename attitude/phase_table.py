@@ -15,7 +15,7 @@ pieces is doubled until the last two Chebyshev coefficients of every piece are b
 the rounding of the values themselves, so that the table adds nothing to the error of
 the formula it replaces; the table is then checked against the formula between the
 nodes.  Each piece is stored in the power basis of its local variable t ∈ [−1, 1] and
-evaluated by Horner's rule, with the coefficients of all samples gathered at once.
+evaluated by Horner's rule, one coefficient of all samples gathered at a time.
 """
 
 from __future__ import annotations
@@ -43,8 +43,10 @@ class PiecewiseChebyshev:
     """
 
     def __init__(self, coefficients: NDArray[np.float64], lower: float, upper: float) -> None:
-        # (degree + 1, pieces): row k holds the coefficient of t^k of each piece.
+        # (degree + 1, pieces): row k holds the coefficient of t^k of each piece; kept
+        # also as separate rows, gathered one at a time (``__call__``).
         self._coefficients = np.ascontiguousarray(coefficients)
+        self._rows = [row.copy() for row in self._coefficients]
         self.degree = coefficients.shape[0] - 1
         self.pieces = coefficients.shape[1]
         self.lower = lower
@@ -103,9 +105,11 @@ class PiecewiseChebyshev:
         index = position.astype(np.intp)  # truncation: −0.x (a rounding below) → 0
         np.minimum(index, self.pieces - 1, out=index)  # x = upper: the last piece
         t = 2.0 * (position - index) - 1.0
-        coefficients = np.take(self._coefficients, index, axis=1, mode="clip")
-        value = coefficients[self.degree].copy()
+        # Horner's rule, gathering one coefficient of every sample's piece at a time:
+        # a (degree + 1, n) gather at once would hold 11 floats a sample.
+        value = self._rows[self.degree].take(index, mode="clip")
+        coefficient = position  # its buffer, no longer needed
         for k in range(self.degree - 1, -1, -1):
             value *= t
-            value += coefficients[k]
+            value += self._rows[k].take(index, out=coefficient, mode="clip")
         return value

@@ -10,8 +10,9 @@ absolute times move with the load, which is printed; ratios are what carry over)
 2. ``angular_momentum(t)`` and ``angular_velocity(t)``, the same way;
 3. one scalar ``attitude(t)`` call against one scalar ``ellipj`` call, with what
    scipy's ``Rotation`` construction alone costs;
-4. ``attitude_quaternion(t)`` against ``attitude(t)``, and the peak memory of each per
-   sample (tracemalloc: every numpy allocation is traced);
+4. ``attitude_quaternion(t)`` against ``attitude(t)``, timed side by side in every
+   regime, and the peak memory of each per sample (tracemalloc: every numpy
+   allocation is traced), with what it holds besides its output;
 5. the cost per sample of ``attitude_quaternion`` from 1e3 to ``--largest`` (1e7)
    samples: flat if nothing falls off a cliff (BLAS threads, cache).
 
@@ -132,8 +133,8 @@ def main(argv=None) -> dict:
         "regimes": {},
     }
     print(f"{N} samples; ratios to scipy.special.ellipj on {N} points in the same run")
-    header = ("regime", "formula", "mc", "attitude", "quaternion", "momentum", "velocity")
-    print("{:24s} {:>7s} {:>9s} {:>9s} {:>10s} {:>9s} {:>9s}".format(*header))
+    header = ("regime", "formula", "mc", "attitude", "quaternion", "momentum", "velocity", "q/att")
+    print("{:24s} {:>7s} {:>9s} {:>9s} {:>10s} {:>9s} {:>9s} {:>6s}".format(*header))
     for name, (inertia, momentum) in CASES.items():
         solver = EulerSolver(inertia, momentum, ATTITUDE0)
         solver.attitude(t[:2000])  # warm up
@@ -150,6 +151,13 @@ def main(argv=None) -> dict:
                 "ellipj_ns_per_point": peer / N * 1e9,
                 "ratio_to_ellipj": ours / peer,
             }
+        # the two attitude outputs against each other, alternately
+        quaternion, rotation = _paired(
+            lambda: solver.attitude_quaternion(t),  # noqa: B023
+            lambda: solver.attitude(t),  # noqa: B023
+            2 * args.repeats,
+        )
+        row["quaternion_over_attitude"] = quaternion / rotation
         report["regimes"][name] = row
         load.append(os.getloadavg()[0])
         print(
@@ -159,6 +167,7 @@ def main(argv=None) -> dict:
                 for k in ("attitude", "attitude_quaternion", "angular_momentum")
             )
             + f" {row['angular_velocity']['ratio_to_ellipj']:8.2f}x"
+            + f" {row['quaternion_over_attitude']:6.3f}"
         )
     ns = [row["attitude"]["ellipj_ns_per_point"] for row in report["regimes"].values()]
     print(f"  (ellipj: {min(ns):.0f} to {max(ns):.0f} ns a point across the runs)")
@@ -196,10 +205,18 @@ def main(argv=None) -> dict:
         ("angular_momentum", lambda: solver.angular_momentum(t)),
     ):
         memory[key] = _peak_bytes(call) / N
+    beyond = {
+        key: memory[key] * N - width * 8 * N
+        for key, width in (("attitude", 4), ("attitude_quaternion", 4), ("angular_momentum", 3))
+    }
     report["peak_bytes_per_sample"] = memory
+    report["peak_bytes_beyond_the_output"] = beyond
     print(
-        f"\npeak memory per sample ({name}, {N} samples, tracemalloc): "
+        f"\npeak memory per sample ({name}, {N} samples, tracemalloc; attitude: the "
+        "first array call, with its table build): "
         + ", ".join(f"{k} {v:.1f} B" for k, v in memory.items())
+        + "\n  besides the output (32 B a quaternion, 24 B a vector): "
+        + ", ".join(f"{k} {v / 2**20:.2f} MiB" for k, v in beyond.items())
     )
 
     # ------------------------------------------------------------ flat cost per sample
