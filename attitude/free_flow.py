@@ -35,10 +35,10 @@ from attitude.errors import InputError
 from attitude.float_math import FLOAT
 from attitude.quantities import as_si_array
 
-__all__ = ["advance"]
+__all__ = ["advance", "advance_floats"]
 
 # Below this many states a batch runs one state at a time on floats (see advance).
-_SMALL_BATCH = 24
+_SMALL_BATCH = 36
 # A larger batch runs in slices of this many states: their temporaries stay in cache.
 _CHUNK = 4096
 
@@ -80,7 +80,8 @@ def advance(
     q = _as_floats(quaternion_wxyz, None, "quaternion_wxyz")
     τ = _as_floats(dt, "time", "dt")
     if inertia.shape == (3,) and m.shape == (3,) and q.shape == (4,) and τ.ndim == 0:
-        return _advance_one(*_one_state(inertia, m, q, τ))
+        m_new, q_new = _advance_one(*_one_state(inertia, m, q, τ))
+        return np.array(m_new), np.array(q_new)
     inertia, m, q, τ = _broadcast(inertia, m, q, τ)
     n = inertia.shape[0]
     if n < _SMALL_BATCH:
@@ -96,6 +97,29 @@ def advance(
         part = slice(start, start + _CHUNK)
         m_new[part], q_new[part] = _advance_many(inertia[part], m[part], q[part], τ[part], start)
     return m_new, q_new
+
+
+def advance_floats(
+    moments: tuple[float, float, float],
+    angular_momentum: tuple[float, float, float],
+    quaternion_wxyz: tuple[float, float, float, float],
+    dt: float,
+) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+    """``advance`` of one state on Python floats, for callers that step one state many
+    times (attitude.torqued_solver): tuples in, tuples out, no numpy on the way.
+
+    The same formulas and bits as ``advance`` on that state; the quaternion must be a
+    unit one (it is not normalized here, only its result is), the moments positive and
+    every value finite: they are not checked one by one as by ``advance``, but a
+    non-finite state or result raises an InputError.
+    """
+    try:
+        return _advance_one(moments, angular_momentum, quaternion_wxyz, dt)
+    except (ValueError, OverflowError):  # a NaN or an infinity met by the exact integers
+        raise InputError(
+            f"the free flow needs a finite state, got angular_momentum {list(angular_momentum)}"
+            f" with moments {list(moments)}"
+        ) from None
 
 
 def _as_floats(value: Any, kind: str | None, name: str) -> NDArray[np.float64]:
@@ -229,7 +253,7 @@ def _advance_one(inertia: tuple, m: tuple, q0: tuple, τ: float, at: str = ""):
     """One state, on Python floats throughout (``at``: its index, for messages)."""
     state = OneState(inertia, m)
     if isinstance(state.formula, Rest):
-        return np.zeros(3), np.array(q0)
+        return (0.0, 0.0, 0.0), tuple(q0)
     try:
         m_frame, step = _step_in_formula_frame(state.formula, state.G, τ, FLOAT)
     except (ValueError, OverflowError):  # math on an angle beyond the float range
@@ -244,7 +268,7 @@ def _advance_one(inertia: tuple, m: tuple, q0: tuple, τ: float, at: str = ""):
     norm = math.sqrt(w * w + x * x + y * y + z * z)  # 1 to a few ulps; kept from drifting
     if not (math.isfinite(norm) and all(map(math.isfinite, m_new))):
         raise InputError(_too_far(τ, at))
-    return np.array(m_new), np.array((w / norm, x / norm, y / norm, z / norm))
+    return tuple(m_new), (w / norm, x / norm, y / norm, z / norm)
 
 
 def _advance_many(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray, first: int = 0):

@@ -40,7 +40,7 @@ from scipy.spatial.transform import Rotation
 
 from attitude.errors import InputError
 from attitude.euler_solver import EulerSolver
-from attitude.free_flow import advance
+from attitude.free_flow import advance, advance_floats
 from attitude.inertia import principal_axes
 from attitude.quantities import as_si_array, as_si_scalar, as_vector3
 from attitude.splitting import Composition, composition
@@ -84,6 +84,7 @@ class _Engine:
         self.torques = torques
         self.frame = frame
         self.moments = moments  # (3,) or (N, 3), for advance()
+        self.moment_floats = tuple(moments.tolist()) if moments.shape == (3,) else None
         self.rk4 = any(t.depends_on_angular_velocity for t in torques)
         self.clock = method.kick_clock
         self.kicks = [j for j, b in enumerate(method.kicks) if b != 0.0]
@@ -94,9 +95,8 @@ class _Engine:
     def flow(self, m, q, dt):
         """The exact free flow over dt (float, or array for a batch)."""
         self.flows += 1
-        if isinstance(m[0], float):
-            m_new, q_new = advance(self.moments, np.array(m), np.array(q), dt)
-            return tuple(m_new.tolist()), tuple(q_new.tolist())
+        if isinstance(m[0], float):  # one spacecraft: Python floats throughout
+            return advance_floats(self.moment_floats, m, q, dt)
         m_array = np.stack(np.broadcast_arrays(*m), axis=-1)
         n = m_array.shape[0]
         # Every argument at its full (N, ...) shape: the free flow need not broadcast.

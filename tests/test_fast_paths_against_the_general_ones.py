@@ -6,9 +6,12 @@
   scipy's private one-quaternion constructor gives the public constructor's rotation;
   a symmetric body computes no R_J.
 - ``free_flow.advance``: a state alone against the same state in a batch of 1e5, and a
-  batch evaluated in slices of any size.
+  batch evaluated in slices of any size; ``free_flow.advance_floats`` (tuples) against
+  ``advance`` on the same state.
 (The table of ψ's periodic part, the other fast path: test_phase_table_against_mpmath.py.)
 """
+
+import math
 
 import numpy as np
 import pytest
@@ -17,6 +20,7 @@ from scipy.spatial.transform import Rotation
 import attitude.euler_solver as euler_solver
 import attitude.free_flow as free_flow
 from attitude import EulerSolver
+from attitude.errors import InputError
 from attitude.euler_solver import _TABLE_MIN_SAMPLES, _one_rotation
 
 ATTITUDE0 = Rotation.from_euler("ZYX", [10.0, 20.0, 30.0], degrees=True)
@@ -152,3 +156,26 @@ def test_a_batch_gives_the_same_bits_in_slices_of_any_size(monkeypatch):
     m_other, q_other = free_flow.advance(moments, momentum, q, dt)
     np.testing.assert_array_equal(m_other, m_new)
     np.testing.assert_array_equal(q_other, q_new)
+
+
+def test_the_float_entry_point_gives_the_bits_of_advance():
+    """``advance_floats`` (tuples, for the torqued solver's one spacecraft) runs what
+    ``advance`` runs on one state after its checks and normalization: the same bits."""
+    moments, momentum, q, dt, kinds = _mixed_batch(300, seed=14)
+    for k in range(300):
+        w, x, y, z = q[k].tolist()
+        norm = math.sqrt(w * w + x * x + y * y + z * z)  # as advance normalizes
+        unit = (w / norm, x / norm, y / norm, z / norm)
+        m_floats, q_floats = free_flow.advance_floats(
+            tuple(moments[k].tolist()), tuple(momentum[k].tolist()), unit, float(dt[k])
+        )
+        m_one, q_one = free_flow.advance(moments[k], momentum[k], q[k], dt[k])
+        assert isinstance(m_floats, tuple) and isinstance(q_floats[0], float)
+        np.testing.assert_array_equal(np.array(m_floats), m_one, err_msg=kinds[k])
+        np.testing.assert_array_equal(np.array(q_floats), q_one, err_msg=kinds[k])
+
+
+@pytest.mark.parametrize("bad", [math.nan, math.inf])
+def test_the_float_entry_point_refuses_a_non_finite_momentum(bad):
+    with pytest.raises(InputError, match="finite"):
+        free_flow.advance_floats((1.0, 2.0, 3.0), (0.1, bad, 0.2), (1.0, 0.0, 0.0, 0.0), 1.0)
