@@ -35,7 +35,7 @@ from attitude.errors import InputError
 from attitude.float_math import FLOAT
 from attitude.quantities import as_si_array
 
-__all__ = ["advance", "advance_floats"]
+__all__ = ["advance", "advance_floats", "advance_unit_batch"]
 
 # Below this many states a batch runs one state at a time on floats (see advance).
 _SMALL_BATCH = 36
@@ -120,6 +120,47 @@ def advance_floats(
             f"the free flow needs a finite state, got angular_momentum {list(angular_momentum)}"
             f" with moments {list(moments)}"
         ) from None
+
+
+def advance_unit_batch(
+    moments: NDArray[np.float64],
+    angular_momentum: NDArray[np.float64],
+    quaternion_wxyz: NDArray[np.float64],
+    dt: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``advance`` of a batch the caller built itself, for callers that step one batch
+    many times (attitude.torqued_solver): float64 arrays (N, 3), (N, 3), (N, 4) and
+    (N,), unit quaternions (not normalized again), positive moments.
+
+    Only the momentum is checked (finite; the rest comes from a previous step), so that
+    a step costs the flow itself; the results are those of ``advance`` on the same
+    arrays to rounding (``advance`` normalizes the quaternions first).  Fewer than
+    ``_SMALL_BATCH`` states run one by one on floats, as in ``advance``.
+    """
+    if not np.isfinite(angular_momentum).all():
+        k = int(np.flatnonzero(~np.isfinite(angular_momentum).all(axis=1))[0])
+        raise InputError(
+            f"the free flow needs a finite state, got angular_momentum[{k}] "
+            f"{angular_momentum[k].tolist()}"
+        )
+    n = moments.shape[0]
+    m_new, q_new = np.empty((n, 3)), np.empty((n, 4))
+    if n < _SMALL_BATCH:  # as in advance: state by state on floats
+        for k in range(n):
+            m_new[k], q_new[k] = _advance_one(
+                tuple(moments[k].tolist()),
+                tuple(angular_momentum[k].tolist()),
+                tuple(quaternion_wxyz[k].tolist()),
+                float(dt[k]),
+                f"[{k}]",
+            )
+        return m_new, q_new
+    for start in range(0, n, _CHUNK):  # as in advance
+        part = slice(start, start + _CHUNK)
+        m_new[part], q_new[part] = _advance_many(
+            moments[part], angular_momentum[part], quaternion_wxyz[part], dt[part], start
+        )
+    return m_new, q_new
 
 
 def _as_floats(value: Any, kind: str | None, name: str) -> NDArray[np.float64]:
