@@ -29,6 +29,7 @@ rounded (within an ulp, nearly always the correctly rounded value).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -222,6 +223,11 @@ def _as_integers(a: float, b: float, c: float) -> tuple[int, int, int]:
     )
 
 
+# A spacecraft stepped by the torqued solver keeps its moments from flow to flow: their
+# integers are computed once (the cache is keyed on the float values, so exact).
+_moment_integers = functools.lru_cache(maxsize=256)(_as_integers)
+
+
 class _ExactΔ:
     """Δ1, Δ2, Δ3 of the float inputs, exactly, and the ratios taken from them.
 
@@ -234,7 +240,7 @@ class _ExactΔ:
     """
 
     def __init__(self, I1: float, I2: float, I3: float, m1: float, m2: float, m3: float):
-        J1, J2, J3 = _as_integers(I1, I2, I3)
+        J1, J2, J3 = _moment_integers(I1, I2, I3)
         M1, M2, M3 = _as_integers(m1, m2, m3)
         S1, S2, S3 = M1 * M1, M2 * M2, M3 * M3
         J12, J13, J23 = J1 * J2, J1 * J3, J2 * J3  # P/J3, P/J2, P/J1
