@@ -125,6 +125,7 @@ def main(argv=None) -> dict:
     ellipj = lambda: special.ellipj(u, m)  # noqa: E731
     load = [os.getloadavg()[0]]
     report: dict = {
+        "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
         "machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores",
         "python": platform.python_version(),
         "numpy": np.__version__,
