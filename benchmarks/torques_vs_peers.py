@@ -626,7 +626,7 @@ def main(argv=None) -> dict:
         match = tumbler.get("vs_basilisk", {}).get("attitude_step") or 30.0
         if args.batch:
             log("batch:")
-            steps = sorted({match, 25.0, 15.0, 10.0}, reverse=True)
+            steps = sorted({match, 25.0, 22.0, 20.0, 15.0, 10.0}, reverse=True)
             report["batch"] = batch(args.batch, steps, have_basilisk, log)
         if args.days:
             log(f"{args.days:g} days:")
