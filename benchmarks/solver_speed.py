@@ -37,6 +37,8 @@ from scipy import special
 from scipy.spatial.transform import Rotation
 
 from attitude import EulerSolver
+from benchmarks.free_flow import _best_per_call
+from benchmarks.trajectory_sampling import _best
 
 RESULTS = Path(__file__).parent / "results"
 ATTITUDE0 = Rotation.from_euler("ZYX", [10.0, 20.0, 30.0], degrees=True)
@@ -66,29 +68,6 @@ CASES: dict[str, tuple[np.ndarray, np.ndarray]] = {
     "symmetric I2 = I3": (np.array([2.0, 5.0, 5.0]), np.array([0.3, 0.4, 0.5])),
     "mc < 2^-128 (ln mc)": (np.array([1.0, 2.0, 3.0]), np.array([1e-30, 1.0, 2e-30])),
 }
-
-
-def _best(function, repeats: int) -> float:
-    best = np.inf
-    for _ in range(repeats):
-        start = time.perf_counter()
-        function()
-        best = min(best, time.perf_counter() - start)
-    return best
-
-
-def _best_per_call(function, repeats: int, window_s: float = 0.003) -> float:
-    """The best mean time of a call over ``repeats`` windows of ~``window_s``."""
-    start = time.perf_counter()
-    function()
-    calls = max(1, int(window_s / max(time.perf_counter() - start, 1e-7)))
-    best = np.inf
-    for _ in range(repeats):
-        start = time.perf_counter()
-        for _ in range(calls):
-            function()
-        best = min(best, (time.perf_counter() - start) / calls)
-    return best
 
 
 def _peak_bytes(function) -> int:
