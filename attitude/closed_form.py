@@ -56,10 +56,11 @@ import math
 from typing import Any, Protocol
 
 import numpy as np
+from numpy.typing import NDArray
 
 from attitude.elliptic import NEAR_ONE_MC, JacobiParameter, amplitude
 from attitude.float_math import FLOAT
-from attitude.invariants import Invariants
+from attitude.invariants import Invariants, invariants
 
 __all__ = [
     "CaseFormula",
@@ -217,19 +218,58 @@ class Elliptic:
         return self._evaluate(τ, xp, with_ψ=True)
 
     def _evaluate(self, τ: Any, xp: Any, with_ψ: bool):
-        u = self.λ * τ - self.ν
-        j, r, sn_r, cn_r, dn_r = self.parameter.jacobi(u, xp)
-        sn, cn, dn = JacobiParameter.full(j, sn_r, cn_r, dn_r, xp)
-        a, b, c = self.A_s * sn, self.A_c * cn, self.A_d * dn
+        j, r, sn_r, cn_r, dn_r = self.phase(τ, xp)
+        a, b, c = self.momentum_of_phase(j, sn_r, cn_r, dn_r, xp)
         if not with_ψ:
             return a, b, c, None
+        return a, b, c, self._angle(τ, j, r, sn_r, cn_r, dn_r, xp)
+
+    def _angle(self, τ: Any, j: Any, r: Any, sn_r: Any, cn_r: Any, dn_r: Any, xp: Any) -> Any:
+        """ψ at τ, from the reduced phase u = λτ − ν = 2jK + r and its sn, cn, dn."""
         Π_minus_F = self.parameter.pi_minus_f(j, r, sn_r, cn_r, dn_r, self.n, self.Π_minus_K, xp)
-        ψ = (
+        return (
             self.ψ_rate * τ
             + self.C * Π_minus_F
             + self.κ_sign * _arctan_of_scaled_sc(j, sn_r, cn_r, self.κ, xp)
         )
-        return a, b, c, ψ
+
+    def phase(self, τ: Any, xp: Any) -> tuple[Any, Any, Any, Any, Any]:
+        """j, r, sn r, cn r, dn r for the phase u = λτ − ν = 2jK + r, |r| ≤ K."""
+        return self.parameter.jacobi(self.λ * τ - self.ν, xp)
+
+    def momentum_of_phase(self, j: Any, sn_r: Any, cn_r: Any, dn_r: Any, xp: Any):
+        """m in the P-frame, (A_s sn u, A_c cn u, A_d dn u), from ``phase``."""
+        sn, cn, dn = JacobiParameter.full(j, sn_r, cn_r, dn_r, xp)
+        return self.A_s * sn, self.A_c * cn, self.A_d * dn
+
+    def angle_rates(self) -> tuple[float, float]:
+        """s_u and Ω: ψ(τ) = Ω τ − s_u ν + ``periodic_angle``(r), for one state.
+
+        Over each half period 2K of u, Π(am u, n) − u gains its complete value and the
+        arc tangent π (``pi_minus_f``, ``_arctan_of_scaled_sc``): ψ grows on average
+        by s_u = (2 C (Π(n) − K) + κ_sign π)/(2K) per unit of u, and so, with
+        u = λτ − ν, at the rate Ω = G/I_a + s_u λ in time.
+        """
+        s_u = (2.0 * self.C * self.Π_minus_K + self.κ_sign * math.pi) / (2.0 * self.K)
+        return s_u, self.ψ_rate + s_u * self.λ
+
+    def periodic_angle(self, r: NDArray[np.float64]) -> tuple[NDArray[np.float64], float]:
+        """The periodic part of ψ at the reduced phase r, |r| ≤ K, for one state.
+
+        per(r) = C (Π − F)(am r, n) + κ_sign arctg(κ sc r) − s_u r (``angle_rates``):
+        odd, 2K-periodic (per(±K) = 0) and analytic, so that ψ(τ) = Ω τ − s_u ν +
+        per(r(τ)).  Also returns the magnitude of the largest of its terms, whose
+        rounding is the error of this formula (what a table of it must not exceed).
+        """
+        s_u, _ = self.angle_rates()
+        j, r, sn_r, cn_r, dn_r = self.parameter.jacobi(r, np)  # j = 0 on |r| ≤ K
+        terms = (
+            self.C * self.parameter.pi_minus_f(j, r, sn_r, cn_r, dn_r, self.n, 0.0, np),
+            self.κ_sign * _arctan_of_scaled_sc(j, sn_r, cn_r, self.κ, np),
+            -s_u * r,
+        )
+        largest = max(float(np.max(np.abs(term))) for term in terms)
+        return terms[0] + terms[1] + terms[2], largest
 
 
 def _arctan_of_scaled_sc(j: Any, s: Any, c: Any, κ: Any, xp: Any) -> Any:
@@ -350,8 +390,16 @@ def p_quaternion(a: Any, b: Any, c: Any, G: Any, xp: Any) -> tuple[Any, Any, Any
 
 
 def y_times_p(half_ψ: Any, p0: Any, p1: Any, p2: Any, xp: Any) -> tuple[Any, Any, Any, Any]:
-    """Y(ψ) ⊗ P, scalar first, with Y = (cos ψ/2, 0, 0, sin ψ/2) and P = (p0, p1, p2, 0)."""
-    cy, sy = xp.cos(half_ψ), xp.sin(half_ψ)
+    """Y(ψ) ⊗ P, scalar first, with Y = (cos ψ/2, 0, 0, sin ψ/2) and P = (p0, p1, p2, 0).
+
+    cos and sin of ψ/2 from t = tan ψ/4: (1 − t²)/(1 + t²) and 2t/(1 + t²), to an
+    ulp or two of each component, from one tangent (vectorized in numpy, where its sine
+    and cosine are not).  Near ψ/4 = ±π/2, t is large but finite for any float.
+    """
+    t = xp.tan(0.5 * half_ψ)
+    t2 = t * t
+    w = 1.0 / (1.0 + t2)
+    cy, sy = (1.0 - t2) * w, (t + t) * w
     return cy * p0, cy * p1 - sy * p2, cy * p2 + sy * p1, sy * p0
 
 
@@ -400,13 +448,12 @@ class OneState:
     formula: CaseFormula
 
     def __init__(self, moments: tuple[float, float, float], momentum: tuple[float, ...]) -> None:
-        from attitude.invariants import invariants
-
-        order = sorted(range(3), key=lambda k: (moments[k], k))  # stable, as numpy's
-        odd = (order[1] - order[0]) * (order[2] - order[0]) * (order[2] - order[1]) < 0
+        order = sorted(range(3), key=moments.__getitem__)  # stable, as numpy's
+        o0, o1, o2 = order
+        odd = (o1 - o0) * (o2 - o0) * (o2 - o1) < 0
         sorted_signs = (1.0, -1.0 if odd else 1.0, 1.0)
-        I1, I2, I3 = (moments[k] for k in order)
-        m1, m2, m3 = (s * momentum[k] for s, k in zip(sorted_signs, order, strict=True))
+        I1, I2, I3 = moments[o0], moments[o1], moments[o2]
+        m1, m2, m3 = momentum[o0], sorted_signs[1] * momentum[o1], momentum[o2]
         G = norm(m1, m2, m3, FLOAT)
         self.G, self.I = G, (I1, I2, I3)
         if G == 0.0:
@@ -421,7 +468,7 @@ class OneState:
             else:
                 case = "ii" if inv.sign > 0.0 else "i"
                 flips = preferred_flips(case == "i" and m1 < 0.0, case == "ii" and m3 < 0.0, FLOAT)
-        m1, m2, m3 = (f * m for f, m in zip(flips, (m1, m2, m3), strict=True))
+        m1, m2, m3 = flips[0] * m1, flips[1] * m2, flips[2] * m3
         formula: CaseFormula
         if case in ("i", "ii"):
             formula = Elliptic(
@@ -442,10 +489,12 @@ class OneState:
         self.formula = formula
         self.preferred = (m1, m2, m3)
         # P[k] = r_sign[k] f[r_index[k]] s[r_index[k]] principal[order[r_index[k]]].
-        r_index, r_sign = RELABEL[case]
-        self.index = tuple(order[r] for r in r_index)
-        self.sign = tuple(
-            rs * flips[r] * sorted_signs[r] for rs, r in zip(r_sign, r_index, strict=True)
+        (r0, r1, r2), (rs0, rs1, rs2) = RELABEL[case]
+        self.index = (order[r0], order[r1], order[r2])
+        self.sign = (
+            rs0 * flips[r0] * sorted_signs[r0],
+            rs1 * flips[r1] * sorted_signs[r1],
+            rs2 * flips[r2] * sorted_signs[r2],
         )
 
 
@@ -459,35 +508,36 @@ class ManyStates:
     """
 
     def __init__(self, moments: np.ndarray, momentum: np.ndarray) -> None:
-        from attitude.invariants import invariants
-
         N = moments.shape[0]
-        order = np.argsort(moments, axis=1, kind="stable")
-        sorted_moments = np.take_along_axis(moments, order, axis=1)
-        o0, o1, o2 = order.T
-        odd = (o1 - o0) * (o2 - o0) * (o2 - o1) < 0
+        (I1, I2, I3), (m1, m2, m3), order, odd = _sorted_rows(moments, momentum)
         sorted_signs = np.ones((N, 3))
         sorted_signs[:, 1] = np.where(odd, -1.0, 1.0)
-        m = sorted_signs * np.take_along_axis(momentum, order, axis=1)
-        I1, I2, I3 = sorted_moments.T
-        m1, m2, m3 = m.T
+        m2 = sorted_signs[:, 1] * m2
+        m = np.stack([m1, m2, m3], axis=-1)
         G = norm(m1, m2, m3, np)
         self.G = G
         case = np.full(N, _CODE["rest"], dtype=np.int8)
         sphere = (G > 0.0) & (I1 == I3)
         general = (G > 0.0) & ~sphere
         case[sphere] = _CODE["steady"]
-        g = np.flatnonzero(general)
-        mc = np.full(N, np.nan)
-        log_mc = np.full(N, np.nan)
-        δ1 = np.zeros(N)
-        δ3 = np.zeros(N)
-        if g.size:
-            inv = invariants(I1[g], I2[g], I3[g], m1[g], m2[g], m3[g], np)
-            case[g] = np.where(
+        if general.all():  # the usual batch: no gather
+            inv = invariants(I1, I2, I3, m1, m2, m3, np)
+            case = np.where(
                 inv.sign < 0.0, _CODE["i"], np.where(inv.sign > 0.0, _CODE["ii"], _CODE["iii"])
-            )
-            mc[g], log_mc[g], δ1[g], δ3[g] = inv.mc, inv.log_mc, inv.δ1, inv.δ3
+            ).astype(np.int8)
+            mc, log_mc, δ1, δ3 = inv.mc, inv.log_mc, inv.δ1, inv.δ3
+        else:
+            g = np.flatnonzero(general)
+            mc = np.full(N, np.nan)
+            log_mc = np.full(N, np.nan)
+            δ1 = np.zeros(N)
+            δ3 = np.zeros(N)
+            if g.size:
+                inv = invariants(I1[g], I2[g], I3[g], m1[g], m2[g], m3[g], np)
+                case[g] = np.where(
+                    inv.sign < 0.0, _CODE["i"], np.where(inv.sign > 0.0, _CODE["ii"], _CODE["iii"])
+                )
+                mc[g], log_mc[g], δ1[g], δ3[g] = inv.mc, inv.log_mc, inv.δ1, inv.δ3
         elliptic = (case == _CODE["i"]) | (case == _CODE["ii"])
         flip1 = (m1 < 0.0) & ((case == _CODE["i"]) | (case == _CODE["iii"]))
         flip3 = (m3 < 0.0) & ((case == _CODE["ii"]) | (case == _CODE["iii"]))
@@ -497,6 +547,17 @@ class ManyStates:
         self.groups: list[tuple[np.ndarray, CaseFormula]] = []
 
         def constants(k):
+            if k.size == N:  # every state: the arrays themselves, no gather
+                return (
+                    I1,
+                    I2,
+                    I3,
+                    m[:, 0],
+                    m[:, 1],
+                    m[:, 2],
+                    G,
+                    Invariants(None, δ1, δ3, mc, log_mc),
+                )
             inv_k = Invariants(None, δ1[k], δ3[k], mc[k], log_mc[k])
             return (I1[k], I2[k], I3[k], m[k, 0], m[k, 1], m[k, 2], G[k], inv_k)
 
@@ -539,6 +600,27 @@ class ManyStates:
             * np.take_along_axis(flips, r_index, axis=1)
             * np.take_along_axis(sorted_signs, r_index, axis=1)
         )
+
+
+def _sorted_rows(moments: np.ndarray, momentum: np.ndarray):
+    """Each row's moments sorted (stably) and its momentum permuted alike, as columns:
+    (I1, I2, I3), (m1, m2, m3), the permutation (N, 3) and its parity.  A sorting
+    network of three compare-exchanges over columns (bubble sort, stable), several
+    times cheaper than ``argsort`` along rows of three."""
+    Is = [moments[:, 0], moments[:, 1], moments[:, 2]]
+    M = [momentum[:, 0], momentum[:, 1], momentum[:, 2]]
+    N = moments.shape[0]
+    index = [np.zeros(N, np.intp), np.ones(N, np.intp), np.full(N, 2, np.intp)]
+    odd = np.zeros(N, dtype=bool)
+    for a, b in ((0, 1), (1, 2), (0, 1)):
+        swap = Is[a] > Is[b]
+        for column in (Is, M, index):
+            column[a], column[b] = (
+                np.where(swap, column[b], column[a]),
+                np.where(swap, column[a], column[b]),
+            )
+        odd ^= swap
+    return Is, M, np.stack(index, axis=-1), odd
 
 
 # The relabelling of each case as arrays indexed by a small integer code, for batches.

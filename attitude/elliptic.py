@@ -38,6 +38,9 @@ References
     (the DLMF), chapters 19 (elliptic integrals) and 22 (Jacobi functions).
 [Bul65] R. Bulirsch, "Numerical calculation of elliptic integrals and elliptic
     functions", Numerische Mathematik 7 (1965) 78–90, procedure ``sncndn``.
+[Bul69] R. Bulirsch, "Numerical calculation of elliptic integrals and elliptic
+    functions. III", Numerische Mathematik 13 (1969) 305–315,
+    doi:10.1007/BF02165405, procedure ``cel``.
 """
 
 from __future__ import annotations
@@ -130,40 +133,79 @@ def _maclaurin(x: Any, mc: Any) -> tuple[Any, Any, Any]:
     return sn, cn, dn
 
 
-def _bulirsch(z: Any, mc: Any, xp: Any) -> tuple[Any, Any, Any]:
-    """sn, cn, dn for 1e-4 ≤ |z| ≤ K/2 and mc > 0: Bulirsch's ``sncndn`` [Bul65].
+def _agm(mc: Any, xp: Any) -> tuple[list, list, Any, Any]:
+    """The AGM of 1 and √mc that drives ``_bulirsch``: the means a_i, the geometric
+    means b_i, the final mean c, and the number of levels.
 
-    The descending Gauss transformation driven by the AGM of 1 and √mc: one sine and
-    one cosine, then a rational recurrence.  With an array ``mc`` the AGM runs until
-    every element has converged; extra steps on a converged element are identities to
-    rounding.  Pass a scalar ``mc`` when all elements share it: the AGM is then
-    computed once.
+    With an array ``mc`` each element keeps its own: the loop runs until every element
+    has converged, and ``levels`` (an integer array) and ``c`` are each element's at its
+    own convergence, so that ``_bulirsch`` gives it the same bits as alone (for one
+    float, ``levels`` is None).
     """
     a = 1.0
     emc = mc
     a_seq, b_seq = [], []
-    for _ in range(40):
+    if xp is FLOAT or np.ndim(mc) == 0:
+        sqrt = xp.sqrt
+        for _ in range(40):
+            a_seq.append(a)
+            emc = sqrt(emc)
+            b_seq.append(emc)
+            c = 0.5 * (a + emc)
+            if abs(a - emc) <= _AGM_TOLERANCE * a:
+                return a_seq, b_seq, c, None
+            emc = emc * a
+            a = c
+        raise ArithmeticError("AGM did not converge")  # pragma: no cover  (10 steps at 1e-300)
+    levels = np.zeros(np.shape(mc), dtype=np.intp)
+    c_final = np.zeros(np.shape(mc))
+    pending = np.ones(np.shape(mc), dtype=bool)
+    for level in range(1, 41):
         a_seq.append(a)
-        emc = xp.sqrt(emc)
+        emc = np.sqrt(emc)
         b_seq.append(emc)
         c = 0.5 * (a + emc)
-        if xp.all(abs(a - emc) <= _AGM_TOLERANCE * a):
-            break
+        now = pending & (abs(a - emc) <= _AGM_TOLERANCE * a)
+        if now.any():
+            levels[now] = level
+            c_final[now] = c[now] if np.ndim(c) else c
+            pending &= ~now
+            if not pending.any():
+                return a_seq, b_seq, c_final, levels
         emc = emc * a
         a = c
-    else:  # pragma: no cover  (quadratic convergence: 10 steps at mc = 1e-300)
-        raise ArithmeticError("AGM did not converge")
-    x = z * c
-    s = xp.sin(x)
-    a = xp.cos(x) / s
+    raise ArithmeticError("AGM did not converge")  # pragma: no cover
+
+
+def _bulirsch(z: Any, mc: Any, xp: Any, agm: tuple | None = None) -> tuple[Any, Any, Any]:
+    """sn, cn, dn for 1e-4 ≤ |z| ≤ K/2 and mc > 0: Bulirsch's ``sncndn`` [Bul65].
+
+    The descending Gauss transformation driven by the AGM of 1 and √mc (``_agm``, or
+    ``agm`` if the caller keeps it: it depends on mc only): one cotangent, then a
+    rational recurrence.  (Bulirsch starts from cos x / sin x; 1/tan x is the same
+    number to rounding, and numpy's tangent is vectorized, five times cheaper than
+    its sine and cosine.)  Pass a scalar ``mc`` when all elements share it: the
+    AGM is then computed once.  With an array ``mc``, each element runs through its
+    own levels only (the others are held by a ``where``).
+    """
+    a_seq, b_seq, c, levels = _agm(mc, xp) if agm is None else agm
+    x = z * c  # |x| ≤ π/4, since c K = π/2
+    a = 1.0 / xp.tan(x)  # cot x: one tangent (numpy's is vectorized; sin, cos are not)
     c = c * a
     d = 1.0
-    for a_i, b_i in zip(reversed(a_seq), reversed(b_seq), strict=True):
-        a = a * c
-        c = c * d
-        d = (b_i + a) / (a_i + a)
-        a = c / a_i
-    s = xp.copysign(1.0 / xp.sqrt(c * c + 1.0), s)
+    shared = len(a_seq) if levels is None else int(levels.min())  # levels every element has
+    for i in range(len(a_seq) - 1, -1, -1):
+        a_i, b_i = a_seq[i], b_seq[i]
+        a_next = a * c
+        c_next = c * d
+        d_next = (b_i + a_next) / (a_i + a_next)
+        a_next = c_next / a_i
+        if i < shared:
+            a, c, d = a_next, c_next, d_next
+        else:
+            own = i < levels
+            a, c, d = np.where(own, a_next, a), np.where(own, c_next, c), np.where(own, d_next, d)
+    s = xp.copysign(1.0 / xp.sqrt(c * c + 1.0), x)  # sin x has the sign of x
     return s, c * s, d
 
 
@@ -233,7 +275,36 @@ def reduced_sn_cn_dn(
     return tuple(np.where(far, f, g) for f, g in zip(shifted, (s, c, d), strict=True))
 
 
-def _reduced_sn_cn_dn_float(r: float, mc: float, K: float) -> tuple[float, float, float]:
+def _reduced_sn_cn_dn_positive_mc(
+    r: NDArray[np.float64], mc: Any, K: Any, agm: tuple | None = None
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """``reduced_sn_cn_dn`` for 0 < mc ≤ 1 (one float, or an array like ``r``): the
+    same pieces as ``_sn_cn_dn_core`` and ``_quarter_shift``, on the whole array.
+
+    Bulirsch's recurrence runs over every element (its AGM once for a float mc, or
+    until every element has converged); the few elements with |z| below the series
+    threshold (where the cot recurrence would overflow) are then recomputed by the
+    series, and the quarter shift is a ``where``.  No boolean gather of the whole
+    array: each piece is a pass over contiguous memory.
+    """
+    far = np.abs(r) > 0.5 * K
+    σ = np.copysign(1.0, r)
+    z = np.where(far, r - σ * K, r)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        s, c, d = _bulirsch(z, mc, np, agm)
+    small = np.flatnonzero(np.abs(z) < _SERIES_THRESHOLD)
+    if small.size:  # s, c, d are new arrays: their flat views write through
+        mc_small = mc if np.ndim(mc) == 0 else np.broadcast_to(mc, z.shape).reshape(-1)[small]
+        values = _maclaurin(z.reshape(-1)[small], mc_small)
+        for out, value in zip((s, c, d), values, strict=True):
+            out.reshape(-1)[small] = value
+    shifted = _quarter_shift(σ, mc, s, c, d, np)
+    return np.where(far, shifted[0], s), np.where(far, shifted[1], c), np.where(far, shifted[2], d)
+
+
+def _reduced_sn_cn_dn_float(
+    r: float, mc: float, K: float, agm: tuple | None = None
+) -> tuple[float, float, float]:
     """``reduced_sn_cn_dn`` for one float (0 < mc ≤ 1): the same pieces, chosen by ``if``."""
     far = abs(r) > 0.5 * K
     σ = math.copysign(1.0, r)
@@ -241,7 +312,7 @@ def _reduced_sn_cn_dn_float(r: float, mc: float, K: float) -> tuple[float, float
     if abs(z) < _SERIES_THRESHOLD:
         s, c, d = _maclaurin(z, mc)
     else:
-        s, c, d = _bulirsch(z, mc, FLOAT)
+        s, c, d = _bulirsch(z, mc, FLOAT, agm)
     return _quarter_shift(σ, mc, s, c, d, FLOAT) if far else (s, c, d)
 
 
@@ -267,6 +338,8 @@ def _jacobi_reduced(u: ArrayLike, mc: NDArray[np.float64], K: NDArray[np.float64
 
 def _parity_sign(j: Any, xp: Any) -> Any:
     """(−1)^j for an integer-valued float j: sn and cn change sign every 2K."""
+    if xp is FLOAT:
+        return -1.0 if j % 2.0 else 1.0
     return 1.0 - 2.0 * xp.abs(j - 2.0 * xp.rint(0.5 * j))
 
 
@@ -376,6 +449,54 @@ def elliptic_pi_complete(n: ArrayLike, mc: ArrayLike) -> NDArray[np.float64]:
     return special.elliprf(0.0, mc, 1.0) + (n / 3.0) * special.elliprj(0.0, mc, 1.0, 1.0 - n)
 
 
+def _cel(kc: Any, p: Any, a: Any, b: Any, xp: Any = np) -> Any:
+    """Bulirsch's general complete elliptic integral, vectorized ([Bul69] ``cel``):
+
+        cel(kc, p, a, b) = ∫₀^{π/2} (a cos²θ + b sin²θ) dθ
+                           / ((cos²θ + p sin²θ) √(cos²θ + kc² sin²θ)),   kc > 0, p > 0.
+
+    With kc² = mc, p = 1 − n, a = 0 and b = n it is Π(n|m) − K(m) ([OLBC10] 19.2.7 with
+    n sin²θ/(1 − n sin²θ) = 1/(1 − n sin²θ) − 1), the same number as
+    (n/3) R_J(0, mc, 1, 1 − n) ([OLBC10] 19.25.2) for a third of the cost: a Gauss
+    (AGM) transformation of the integrand, quadratically convergent; the iteration
+    stops when the arithmetic and geometric means agree to 2^-27, that is the
+    integral to ~2^-54.  Each element of an array takes its value at its own
+    convergence, so that a state gives the same bits alone (floats) and in a batch.
+    """
+    sqrt = xp.sqrt
+    e = kc
+    mean = 1.0
+    p = sqrt(p)
+    a = a + 0.0 * kc
+    b = b / p
+    result = pending = None
+    for _ in range(40):
+        f = a
+        a = a + b / p
+        g = e / p
+        b = 2.0 * (b + f * g)
+        p = g + p
+        g = mean
+        mean = kc + mean
+        converged = abs(g - kc) <= _AGM_TOLERANCE * g
+        if xp is FLOAT:
+            if converged:
+                return (0.5 * math.pi) * (a * mean + b) / (mean * (mean + p))
+        else:
+            # Each element's value at its own convergence, as for one state alone.
+            if result is None:
+                result, pending = np.empty(np.shape(converged)), np.ones(np.shape(converged), bool)
+            now = converged & pending
+            if now.any():
+                result[now] = ((0.5 * math.pi) * (a * mean + b) / (mean * (mean + p)))[now]
+                pending &= ~now
+                if not pending.any():
+                    return result
+        kc = 2.0 * sqrt(e)
+        e = kc * mean
+    raise ArithmeticError("cel did not converge")  # pragma: no cover  (8 steps at 2^-128)
+
+
 # ----------------------------------------------------------------- m within 2^-128 of 1
 
 
@@ -479,6 +600,8 @@ class JacobiParameter:
         else:
             self.K = special.ellipkm1(mc)
         self.kc = xp.exp(0.5 * log_mc)  # k' = √mc (0 below the float range)
+        # The AGM of Bulirsch's recurrence, once for a single state (it depends on mc).
+        self._agm = _agm(mc, FLOAT) if xp is FLOAT and not near_one and mc > 0.0 else None
 
     def jacobi(self, u: Any, xp: Any) -> tuple[Any, Any, Any, Any, Any]:
         """j, r, sn r, cn r, dn r for u = 2jK + r, |r| ≤ K."""
@@ -488,11 +611,17 @@ class JacobiParameter:
             r = u - j * (2.0 * K)
             if self.near_one:
                 return (j, r, *reduced_sn_cn_dn_near_one(r, self.log_mc, K, FLOAT))
-            return (j, r, *_reduced_sn_cn_dn_float(r, self.mc, K))
-        j, r = reduce_argument(u, K)
+            return (j, r, *_reduced_sn_cn_dn_float(r, self.mc, K, self._agm))
+        if np.ndim(K) == 0 and math.isfinite(K):  # one state: reduce_argument, unmasked
+            j = np.rint(u / (2.0 * K))
+            r = u - j * (2.0 * K)
+        else:
+            j, r = reduce_argument(u, K)
         if self.near_one:
             return (j, r, *reduced_sn_cn_dn_near_one(r, self.log_mc, K))
-        return (j, r, *reduced_sn_cn_dn(r, self.mc, K))
+        if np.ndim(self.mc) == 0:  # one state at many times
+            return (j, r, *_reduced_sn_cn_dn_positive_mc(r, float(self.mc), float(K), self._agm))
+        return (j, r, *_reduced_sn_cn_dn_positive_mc(r, self.mc, K))  # a batch, mc ≥ 2^-128
 
     @staticmethod
     def full(j: Any, sn_r: Any, cn_r: Any, dn_r: Any, xp: Any) -> tuple[Any, Any, Any]:
@@ -503,13 +632,15 @@ class JacobiParameter:
     def complete_pi_minus_k(self, n: Any, xp: Any) -> Any:
         """Π(n|m) − K(m): what Π(am u, n) − u gains over each half period 2K.
 
-        (n/3) R_J(0, mc, 1, 1 − n) ([OLBC10] 19.25.2), or n/(1 − n) (K − A(1)) near
-        m = 1 (``pi_minus_f_near_one``).  A constant of the state: computed once.
+        (n/3) R_J(0, mc, 1, 1 − n) ([OLBC10] 19.25.2), evaluated as Bulirsch's ``cel``
+        (``_cel``), or n/(1 − n) (K − A(1)) near m = 1 (``pi_minus_f_near_one``).  A
+        constant of the state: computed once.
         """
         if self.near_one:
             return (n / (1.0 - n)) * (self.K - _arctan_integral(1.0, n, xp))
-        value = (n / 3.0) * special.elliprj(0.0, self.mc, 1.0, 1.0 - n)
-        return float(value) if xp is FLOAT else value
+        # Bulirsch's cel: the same integral as (n/3) R_J(0, mc, 1, 1 − n), to an ulp
+        # where scipy's R_J is off by several (and it costs a third as much).
+        return _cel(xp.sqrt(self.mc), 1.0 - n, 0.0, n, xp)
 
     def pi_minus_f(
         self, j: Any, r: Any, sn: Any, cn: Any, dn: Any, n: Any, complete: Any, xp: Any
@@ -518,6 +649,8 @@ class JacobiParameter:
         ``complete = complete_pi_minus_k(n)``: ``pi_minus_f`` or its near-one form."""
         if self.near_one:
             incomplete = (n / (1.0 - n)) * (r - _arctan_integral(sn, n, xp))
+        elif (xp is FLOAT or np.ndim(n) == 0) and n == 0.0:  # symmetric: Π = F, no R_J
+            incomplete = 0.0 * r
         else:
             c2, s2 = cn * cn, sn * sn
             r_j = special.elliprj(c2, dn * dn, 1.0, c2 + (1.0 - n) * s2)

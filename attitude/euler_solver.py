@@ -53,13 +53,27 @@ from attitude.closed_form import (
 from attitude.errors import InputError
 from attitude.float_math import FLOAT
 from attitude.inertia import PrincipalAxes, principal_axes
+from attitude.phase_table import PiecewiseChebyshev
 from attitude.quantities import as_si_array, as_si_scalar, as_vector3
 from attitude.quaternions import left_matrix, right_matrix
 
 __all__ = ["EulerSolver"]
 
-# Evaluations over many times run in slices of this many samples (see _in_chunks).
-_CHUNK = 16384
+# Evaluations over many times run in slices of this many samples (see _evaluate): a
+# slice's temporaries (at most ~130 B a sample) stay in the processor's cache, and
+# bound what a call holds besides its output to ~1 MB.
+_CHUNK = 8192
+# From this many times in one call, the attitude takes the periodic part of ψ from a
+# table built once (``_angle_table``: 1000 to 6000 formula evaluations, which cost
+# about as much as this many samples of the formula) instead of one R_J a sample.
+_TABLE_MIN_SAMPLES = 16384
+_UNBUILT = object()
+try:  # numpy's array-API namespace as scipy's Rotation keeps it (see _one_rotation)
+    from scipy._lib._array_api import array_namespace as _array_namespace
+
+    _NUMPY_NAMESPACE = _array_namespace(np.empty(0))
+except ImportError:  # pragma: no cover
+    _NUMPY_NAMESPACE = None
 
 
 def _as_rotation(attitude: Any) -> Rotation:
@@ -76,6 +90,21 @@ def _as_rotation(attitude: Any) -> Rotation:
     if not np.all(np.isfinite(q)):
         raise InputError(f"attitude must be finite, got quaternion {q.tolist()}")
     return attitude
+
+
+def _one_rotation(q_scalar_last: NDArray[np.float64]) -> Rotation:
+    """One ``Rotation`` from a unit quaternion, scalar last.
+
+    scipy's public constructors cost ~8 µs for a single quaternion (array-API
+    dispatch and checks), five times the rest of a scalar ``attitude(t)``; its internal
+    constructor, which skips them, ~2 µs.  That one is private, so it is used only
+    where it exists with the signature we know, and tests/test_solver_speed_paths.py
+    checks that it gives the public constructor's rotation.
+    """
+    try:
+        return Rotation._from_raw_quat(q_scalar_last, xp=_NUMPY_NAMESPACE)
+    except (AttributeError, TypeError):  # pragma: no cover  (another scipy)
+        return Rotation(q_scalar_last, normalize=False, copy=False)
 
 
 class EulerSolver:
@@ -123,7 +152,18 @@ class EulerSolver:
         self._S_matrix = self._body_to_formula_frame(axes)
         # The moments along the axes of the formula's frame (for ω = m/I there).
         self._I_frame = np.array([float(axes.moments[k]) for k in self._state.index])
-        self._M_T_scalar_last, self._ψ_t0 = self._constant_rotation()
+        self._I_frame_floats = tuple(self._I_frame.tolist())
+        # Column k of S: its non-zero entries (i, S_ik), all three for a tensor.
+        S = self._S_matrix.tolist()
+        self._S_columns = tuple(
+            tuple((i, S[i][k]) for i in range(3) if S[i][k] != 0.0)
+            if axes.is_diagonal
+            else tuple((i, S[i][k]) for i in range(3))
+            for k in range(3)
+        )
+        self._M, self._ψ_t0 = self._constant_rotation()
+        self._M_rows = tuple(tuple(row) for row in self._M.tolist())  # for one time
+        self._table = _UNBUILT  # the periodic part of ψ tabulated: see _angle_table
         I1, I2, I3 = self._state.I
         m1, m2, m3 = self._state.preferred
         G = self._G
@@ -161,11 +201,9 @@ class EulerSolver:
         return np.ascontiguousarray(S_matrix)
 
     def _constant_rotation(self) -> tuple[NDArray[np.float64], float]:
-        """R = Q0 ∘ S⁻¹ ∘ P(t0)⁻¹, folded with S into one 4×4 matrix, and ψ(t0).
+        """R = Q0 ∘ S⁻¹ ∘ P(t0)⁻¹, folded with S into one 4×4 matrix M, and ψ(t0).
 
-        q(t) = R ⊗ (Y ⊗ P)(t) ⊗ S = L(R) Rr(S) (Y ⊗ P)(t).  Kept transposed, with its
-        columns reordered so that the product comes out scalar last, the layout
-        Rotation.from_quat takes without a copy.
+        q(t) = R ⊗ (Y ⊗ P)(t) ⊗ S = L(R) Rr(S) (Y ⊗ P)(t) = M (Y ⊗ P)(t), scalar first.
         """
         S = Rotation.from_matrix(self._S_matrix).as_quat(scalar_first=True)
         Q0 = self._initial_attitude.as_quat(scalar_first=True)
@@ -176,8 +214,7 @@ class EulerSolver:
             P0 = np.array([*p_quaternion(a, b, c, self._G, FLOAT), 0.0])
         conjugate = np.array([1.0, -1.0, -1.0, -1.0])
         R = left_matrix(Q0) @ left_matrix(S * conjugate) @ (P0 * conjugate)
-        M = left_matrix(R) @ right_matrix(S)
-        return np.ascontiguousarray(M[[1, 2, 3, 0]].T), float(ψ_t0)
+        return left_matrix(R) @ right_matrix(S), float(ψ_t0)
 
     @classmethod
     def from_angular_velocity(
@@ -194,68 +231,186 @@ class EulerSolver:
 
     # ----------------------------------------------------------------- evaluation
 
-    def _τ(self, t: Any) -> NDArray[np.float64]:
-        return as_si_array(t, "time", "t") - self._t0
+    def _times(self, t: Any) -> NDArray[np.float64]:
+        """``t`` as float seconds (no copy of a float64 array); τ = t − t0 is formed a
+        slice at a time by ``_evaluate``."""
+        return as_si_array(t, "time", "t")
 
-    def _evaluate(self, chunk, t: Any, width: int, τ: NDArray[np.float64] | None = None):
-        """``chunk`` over the times ``t`` in slices, refusing a time too far from t0.
+    def _evaluate(self, chunk, t: Any, width: int, times: NDArray[np.float64] | None = None):
+        """``chunk(τ, out)`` over τ = t − t0 in slices of ``_CHUNK``, into one array.
 
-        Far enough from t0 (|t − t0| beyond ~1.8e308 divided by the motion's fastest
-        angular rate) an angle λ(t − t0) or ψ(t) leaves the float range and the
-        result would be NaN: that time gets an InputError that names it instead.
+        A slice's temporaries stay in the processor's cache (over a million samples
+        this is several times faster than whole-array passes), and each writes its own
+        rows of the output: besides the result, memory holds only a slice's
+        temporaries.  Far enough from t0 (|t − t0| beyond ~1.8e308 divided by the
+        motion's fastest angular rate) an angle λ(t − t0) or ψ(t) leaves the float
+        range and the result would be NaN: that time gets an InputError that names it
+        instead.
         """
-        if τ is None:
-            τ = self._τ(t)
-        with np.errstate(over="ignore", invalid="ignore"):
-            out = self._in_chunks(chunk, τ, width)
-        if not np.isfinite(out).all():
-            bad = np.flatnonzero(~np.isfinite(out).reshape(-1, width).all(axis=-1))[0]
-            t_bad = np.ravel(as_si_array(t, "time", "t"))[bad] if np.ndim(t) else t
-            rate = max(abs(getattr(self._formula, "λ", 0.0)), self._G / self._state.I[0])
-            raise InputError(
-                f"t = {float(t_bad)!r} s is too far from t0 = {self._t0!r} s for this motion: "
-                f"its angles, at rates up to {rate:.3g} rad/s, times t - t0 exceed the float "
-                "range (1.8e308)"
-            )
-        return out
+        if times is None:
+            times = self._times(t)
+        flat = times.ravel()
+        out = np.empty((flat.size, width))
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            for start in range(0, flat.size, _CHUNK):
+                block = out[start : start + _CHUNK]
+                chunk(flat[start : start + _CHUNK] - self._t0, block)
+                if not np.isfinite(block).all():
+                    bad = start + int(np.flatnonzero(~np.isfinite(block).all(axis=1))[0])
+                    raise self._too_far(t, bad)
+        return out.reshape((*times.shape, width))
+
+    def _too_far(self, t: Any, index: int) -> InputError:
+        t_bad = np.ravel(as_si_array(t, "time", "t"))[index] if np.ndim(t) else t
+        rate = max(abs(getattr(self._formula, "λ", 0.0)), self._G / self._state.I[0])
+        return InputError(
+            f"t = {float(t_bad)!r} s is too far from t0 = {self._t0!r} s for this motion: "
+            f"its angles, at rates up to {rate:.3g} rad/s, times t - t0 exceed the float "
+            "range (1.8e308)"
+        )
 
     def _to_body(self, v_frame: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Row vectors of the formula's frame in body axes, v_frame @ S."""
         return np.dot(v_frame, self._S_matrix)
 
-    def _momentum_chunk(self, τ: NDArray[np.float64]) -> NDArray[np.float64]:
-        return self._to_body(np.stack(self._formula.momentum(τ, np), axis=-1))
+    def _write_body(self, components: tuple, out: NDArray[np.float64], divisors=None) -> None:
+        """``out[:, k]``: the body components of a vector given by its ``components`` in
+        the formula's frame (each divided by ``divisors``, if given), that is v_frame @ S
+        written column by column: a signed permutation for principal body axes (exact),
+        three fused sums for a tensor.  No BLAS call: numpy's (n, 3) @ (3, 3) starts
+        OpenBLAS threads above some n, and its cost per row jumps by a large factor."""
+        if divisors is not None:
+            components = tuple(c / d for c, d in zip(components, divisors, strict=True))
+        for k, column in enumerate(self._S_columns):
+            if len(column) == 1:  # v_body[k] = ±v_frame[i]
+                i, S_ik = column[0]
+                np.multiply(components[i], S_ik, out=out[:, k])
+            else:
+                out[:, k] = components[0] * column[0][1] + components[1] * column[1][1]
+                out[:, k] += components[2] * column[2][1]
 
-    def _velocity_chunk(self, τ: NDArray[np.float64]) -> NDArray[np.float64]:
-        return self._to_body(np.stack(self._formula.momentum(τ, np), axis=-1) / self._I_frame)
+    def _momentum_chunk(self, τ: NDArray[np.float64], out: NDArray[np.float64]) -> None:
+        self._write_body(self._formula.momentum(τ, np), out)
 
-    def _quaternion_chunk(self, τ: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Attitude quaternions at τ = t − t0, scalar LAST (x, y, z, w), body → inertial."""
-        a, b, c, ψ = self._formula.momentum_and_angle(τ, np)
-        p0, p1, p2 = p_quaternion(a, b, c, self._G, np)
-        yp = np.stack(y_times_p(0.5 * (ψ - self._ψ_t0), p0, p1, p2, np), axis=-1)
-        return np.dot(yp, self._M_T_scalar_last)
+    def _velocity_chunk(self, τ: NDArray[np.float64], out: NDArray[np.float64]) -> None:
+        self._write_body(self._formula.momentum(τ, np), out, self._I_frame)
 
-    @staticmethod
-    def _in_chunks(function, τ: NDArray[np.float64], width: int) -> NDArray[np.float64]:
-        """Apply ``function`` to τ in slices of ``_CHUNK`` elements.
+    def _quaternion_chunk(
+        self, τ: NDArray[np.float64], out: NDArray[np.float64], table, columns: tuple
+    ) -> None:
+        """Unit attitude quaternions at τ = t − t0, body → inertial, component i of
+        (w, x, y, z) into ``out[:, columns[i]]``.
 
-        A slice's temporaries stay in the processor's cache; over a million samples
-        this is about 1.7 times faster than one pass over the whole array.
+        q = M (Y(ψ − ψ(t0)) ⊗ P)  (``_constant_rotation``), the 4×4 product written as
+        four fused sums (no BLAS: see ``_write_body``).  With a ``table`` of the periodic
+        part of ψ (``_angle_table``), ψ(τ) − ψ(t0) = Ω τ + per(r(τ)) − per(r(0)):
+        no R_J per sample.
         """
-        flat = τ.ravel()
-        if flat.size <= _CHUNK:
-            return function(flat).reshape((*τ.shape, width))
-        out = np.empty((flat.size, width))
-        for start in range(0, flat.size, _CHUNK):
-            out[start : start + _CHUNK] = function(flat[start : start + _CHUNK])
-        return out.reshape((*τ.shape, width))
+        f = self._formula
+        # Each intermediate is dropped as soon as it is used, and the product is
+        # summed into ``out`` itself: a slice holds as few arrays as the formulas allow
+        # (the same operations in the same order as without the in-place forms: the
+        # same bits).
+        if table is None:
+            a, b, c, ψ = f.momentum_and_angle(τ, np)
+            ψ -= self._ψ_t0
+            ψ *= 0.5
+            half_ψ = ψ
+        else:
+            j, r, sn_r, cn_r, dn_r = f.phase(τ, np)
+            a, b, c = f.momentum_of_phase(j, sn_r, cn_r, dn_r, np)
+            del j, sn_r, cn_r, dn_r
+            periodic = table(r)
+            del r
+            periodic -= self._per_t0
+            half_ψ = self._Ω * τ
+            half_ψ += periodic
+            half_ψ *= 0.5
+            del periodic
+        p = p_quaternion(a, b, c, self._G, np)
+        del a, b, c
+        yp = y_times_p(half_ψ, *p, np)
+        del p, half_ψ
+        M = self._M
+        term = np.empty_like(yp[0])
+        for i in range(4):
+            q_i = out[:, columns[i]]
+            np.multiply(yp[0], M[i, 0], out=q_i)
+            for k in (1, 2, 3):
+                q_i += np.multiply(yp[k], M[i, k], out=term)
+        del yp
+        q = [out[:, columns[i]] for i in range(4)]
+        norm = np.multiply(q[0], q[0])
+        for i in (1, 2, 3):
+            norm += np.multiply(q[i], q[i], out=term)
+        np.sqrt(norm, out=norm)
+        for q_i in q:
+            q_i /= norm
+
+    def _quaternion_at(self, τ: float, t: Any) -> tuple[float, float, float, float]:
+        """The unit attitude quaternion (w, x, y, z) at one time, on Python floats: the
+        formulas of ``_quaternion_chunk`` (without a table) at ~1/100 of numpy's cost."""
+        f = self._formula
+        if f.name == "rest":
+            return tuple(self._initial_attitude.as_quat(scalar_first=True).tolist())
+        try:
+            a, b, c, ψ = f.momentum_and_angle(τ, FLOAT)
+            yp = y_times_p(0.5 * (ψ - self._ψ_t0), *p_quaternion(a, b, c, self._G, FLOAT), FLOAT)
+        except (ValueError, OverflowError):  # math on an angle beyond the float range
+            raise self._too_far(t, 0) from None
+        q = [yp[0] * M0 + yp[1] * M1 + yp[2] * M2 + yp[3] * M3 for M0, M1, M2, M3 in self._M_rows]
+        norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+        if not math.isfinite(norm):
+            raise self._too_far(t, 0)
+        return q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm
+
+    def _angle_table(self):
+        """The periodic part of ψ tabulated (attitude.phase_table), built at the first
+        call with at least ``_TABLE_MIN_SAMPLES`` times; None where the formula has no
+        R_J to save (separatrix, symmetric bodies, the near-one kernels: their ψ costs
+        a few elementary functions) or the table would not reach its rounding."""
+        if self._table is _UNBUILT:
+            self._table = None
+            f = self._formula
+            if isinstance(f, Elliptic) and not f.parameter.near_one and f.n != 0.0:
+                table = PiecewiseChebyshev.fit(f.periodic_angle, -f.K, f.K)
+                if table is not None:
+                    _, r0, *_ = f.phase(np.zeros(1), np)
+                    self._per_t0 = float(table(r0)[0])
+                    self._Ω = f.angle_rates()[1]
+                    self._table = table
+        return self._table
+
+    def _body_vector_at(self, τ: float, t: Any, divisors=None) -> NDArray[np.float64]:
+        """``_write_body`` of the momentum (or, with ``divisors``, the angular velocity)
+        at one time, on Python floats: the same operations, at ~1/30 of numpy's cost."""
+        try:
+            v = self._formula.momentum(τ, FLOAT)
+        except (ValueError, OverflowError):  # math on an angle beyond the float range
+            raise self._too_far(t, 0) from None
+        if divisors is not None:
+            v = tuple(c / d for c, d in zip(v, divisors, strict=True))
+        out = np.empty(3)
+        for k, column in enumerate(self._S_columns):
+            if len(column) == 1:
+                i, S_ik = column[0]
+                out[k] = v[i] * S_ik
+            else:
+                out[k] = (v[0] * column[0][1] + v[1] * column[1][1]) + v[2] * column[2][1]
+        if not np.isfinite(out).all():
+            raise self._too_far(t, 0)
+        return out
 
     def angular_momentum(self, t: ArrayLike) -> NDArray[np.float64]:
         """Body-frame angular momentum at ``t`` (N m s), shape ``np.shape(t) + (3,)``."""
+        if isinstance(t, float) and math.isfinite(t):
+            return self._body_vector_at(t - self._t0, t)
         return self._evaluate(self._momentum_chunk, t, 3)
 
     def angular_velocity(self, t: ArrayLike) -> NDArray[np.float64]:
         """Body-frame angular velocity at ``t`` (rad/s), shape ``np.shape(t) + (3,)``."""
+        if isinstance(t, float) and math.isfinite(t):
+            return self._body_vector_at(t - self._t0, t, self._I_frame_floats)
         return self._evaluate(self._velocity_chunk, t, 3)
 
     def attitude(self, t: ArrayLike) -> Rotation:
@@ -263,12 +418,19 @@ class EulerSolver:
 
         One ``Rotation`` for a scalar ``t``, a stack for a 1-D array.
         """
-        τ = self._τ(t)
-        if τ.ndim > 1:
+        if isinstance(t, float) and math.isfinite(t):  # one time: no numpy on the way
+            w, x, y, z = self._quaternion_at(t - self._t0, t)
+            return _one_rotation(np.array([x, y, z, w]))
+        times = self._times(t)
+        if times.ndim > 1:
             raise InputError(
-                f"t must be a scalar or a 1-D array for attitude(), got shape {τ.shape}"
+                f"t must be a scalar or a 1-D array for attitude(), got shape {times.shape}"
             )
-        return Rotation.from_quat(self._quaternions_scalar_last(t, τ))
+        if times.ndim == 0:
+            w, x, y, z = self._quaternion_at(float(times) - self._t0, t)
+            return _one_rotation(np.array([x, y, z, w]))
+        # Unit quaternions, scalar last: scipy takes them as they are, without a copy.
+        return Rotation(self._quaternions(t, times, (3, 0, 1, 2)), normalize=False, copy=False)
 
     def attitude_quaternion(self, t: ArrayLike, scalar_first: bool = True) -> NDArray[np.float64]:
         """The attitude at ``t`` as unit quaternions, body → inertial, shape ``np.shape(t) + (4,)``.
@@ -277,14 +439,24 @@ class EulerSolver:
         without building a ``Rotation``: for writing files and for callers that
         assemble many segments.
         """
-        q = self._quaternions_scalar_last(t, self._τ(t))
-        q /= np.linalg.norm(q, axis=-1, keepdims=True)
-        return q[..., [3, 0, 1, 2]] if scalar_first else q
+        columns = (0, 1, 2, 3) if scalar_first else (3, 0, 1, 2)
+        times = np.float64(t) if isinstance(t, float) and math.isfinite(t) else self._times(t)
+        if times.ndim == 0:
+            q = self._quaternion_at(float(times) - self._t0, t)
+            return np.array(q if scalar_first else (q[1], q[2], q[3], q[0]))
+        return self._quaternions(t, times, columns)
 
-    def _quaternions_scalar_last(self, t: Any, τ: NDArray[np.float64]) -> NDArray[np.float64]:
+    def _quaternions(self, t: Any, times: NDArray[np.float64], columns: tuple) -> NDArray:
         if self._formula.name == "rest":
-            return np.broadcast_to(self._initial_attitude.as_quat(), (*τ.shape, 4)).copy()
-        return self._evaluate(self._quaternion_chunk, t, 4, τ)
+            q = np.empty((*times.shape, 4))
+            q[..., list(columns)] = self._initial_attitude.as_quat(scalar_first=True)
+            return q
+        table = self._angle_table() if times.size >= _TABLE_MIN_SAMPLES else None
+
+        def chunk(τ, out):
+            self._quaternion_chunk(τ, out, table, columns)
+
+        return self._evaluate(chunk, t, 4, times)
 
     def spin_axis_cone(self) -> tuple[NDArray[np.float64], float, float] | None:
         """The body axis about which m circulates, and the cone it describes about m.

@@ -36,14 +36,6 @@ def _rint(x: float) -> float:
     return float(round(x))  # half to even, as numpy.rint
 
 
-def _arctan2(y: float, x: float) -> float:
-    return math.atan2(y, x)
-
-
-def _asinh(x: float) -> float:
-    return math.asinh(x)
-
-
 class _FloatMath:
     """The subset of numpy's namespace that the solver's formulas use, on floats."""
 
@@ -52,10 +44,11 @@ class _FloatMath:
     log = staticmethod(_log)
     sin = staticmethod(math.sin)
     cos = staticmethod(math.cos)
+    tan = staticmethod(math.tan)
     tanh = staticmethod(math.tanh)
     arctan = staticmethod(math.atan)
-    arctan2 = staticmethod(_arctan2)
-    arcsinh = staticmethod(_asinh)
+    arctan2 = staticmethod(math.atan2)
+    arcsinh = staticmethod(math.asinh)
     hypot = staticmethod(math.hypot)
     copysign = staticmethod(math.copysign)
     abs = staticmethod(abs)

@@ -35,10 +35,10 @@ from attitude.errors import InputError
 from attitude.float_math import FLOAT
 from attitude.quantities import as_si_array
 
-__all__ = ["advance"]
+__all__ = ["advance", "advance_floats", "advance_unit_batch"]
 
 # Below this many states a batch runs one state at a time on floats (see advance).
-_SMALL_BATCH = 24
+_SMALL_BATCH = 36
 # A larger batch runs in slices of this many states: their temporaries stay in cache.
 _CHUNK = 4096
 
@@ -80,7 +80,8 @@ def advance(
     q = _as_floats(quaternion_wxyz, None, "quaternion_wxyz")
     τ = _as_floats(dt, "time", "dt")
     if inertia.shape == (3,) and m.shape == (3,) and q.shape == (4,) and τ.ndim == 0:
-        return _advance_one(*_one_state(inertia, m, q, τ))
+        m_new, q_new = _advance_one(*_one_state(inertia, m, q, τ))
+        return np.array(m_new), np.array(q_new)
     inertia, m, q, τ = _broadcast(inertia, m, q, τ)
     n = inertia.shape[0]
     if n < _SMALL_BATCH:
@@ -95,6 +96,70 @@ def advance(
     for start in range(0, n, _CHUNK):  # slices whose temporaries stay in cache
         part = slice(start, start + _CHUNK)
         m_new[part], q_new[part] = _advance_many(inertia[part], m[part], q[part], τ[part], start)
+    return m_new, q_new
+
+
+def advance_floats(
+    moments: tuple[float, float, float],
+    angular_momentum: tuple[float, float, float],
+    quaternion_wxyz: tuple[float, float, float, float],
+    dt: float,
+) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+    """``advance`` of one state on Python floats, for callers that step one state many
+    times (attitude.torqued_solver): tuples in, tuples out, no numpy on the way.
+
+    The same formulas and bits as ``advance`` on that state; the quaternion must be a
+    unit one (it is not normalized here, only its result is), the moments positive and
+    every value finite: they are not checked one by one as by ``advance``, but a
+    non-finite state or result raises an InputError.
+    """
+    try:
+        return _advance_one(moments, angular_momentum, quaternion_wxyz, dt)
+    except (ValueError, OverflowError):  # a NaN or an infinity met by the exact integers
+        raise InputError(
+            f"the free flow needs a finite state, got angular_momentum {list(angular_momentum)}"
+            f" with moments {list(moments)}"
+        ) from None
+
+
+def advance_unit_batch(
+    moments: NDArray[np.float64],
+    angular_momentum: NDArray[np.float64],
+    quaternion_wxyz: NDArray[np.float64],
+    dt: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """``advance`` of a batch the caller built itself, for callers that step one batch
+    many times (attitude.torqued_solver): float64 arrays (N, 3), (N, 3), (N, 4) and
+    (N,), unit quaternions (not normalized again), positive moments.
+
+    Only the momentum is checked (finite; the rest comes from a previous step), so that
+    a step costs the flow itself; the results are those of ``advance`` on the same
+    arrays to rounding (``advance`` normalizes the quaternions first).  Fewer than
+    ``_SMALL_BATCH`` states run one by one on floats, as in ``advance``.
+    """
+    if not np.isfinite(angular_momentum).all():
+        k = int(np.flatnonzero(~np.isfinite(angular_momentum).all(axis=1))[0])
+        raise InputError(
+            f"the free flow needs a finite state, got angular_momentum[{k}] "
+            f"{angular_momentum[k].tolist()}"
+        )
+    n = moments.shape[0]
+    m_new, q_new = np.empty((n, 3)), np.empty((n, 4))
+    if n < _SMALL_BATCH:  # as in advance: state by state on floats
+        for k in range(n):
+            m_new[k], q_new[k] = _advance_one(
+                tuple(moments[k].tolist()),
+                tuple(angular_momentum[k].tolist()),
+                tuple(quaternion_wxyz[k].tolist()),
+                float(dt[k]),
+                f"[{k}]",
+            )
+        return m_new, q_new
+    for start in range(0, n, _CHUNK):  # as in advance
+        part = slice(start, start + _CHUNK)
+        m_new[part], q_new[part] = _advance_many(
+            moments[part], angular_momentum[part], quaternion_wxyz[part], dt[part], start
+        )
     return m_new, q_new
 
 
@@ -113,11 +178,12 @@ def _one_state(inertia: NDArray, m: NDArray, q: NDArray, τ: Any, k: int | None 
     at = "" if k is None else f"[{k}]"
     I_list, m_list, q_list, τ_float = inertia.tolist(), m.tolist(), q.tolist(), float(τ)
     for name, values in (("moments", I_list), ("angular_momentum", m_list)):
-        if not all(math.isfinite(v) for v in values):
+        if not all(map(math.isfinite, values)):
             raise InputError(f"{name}{at} must be finite, got {values}")
-    if not all(v > 0.0 for v in I_list):
+    if not min(I_list) > 0.0:
         raise InputError(f"moments{at} must be positive, got {I_list}")
-    norm = math.sqrt(sum(v * v for v in q_list))
+    w, x, y, z = q_list
+    norm = math.sqrt(w * w + x * x + y * y + z * z)
     if not (math.isfinite(norm) and norm > 0.0):
         raise InputError(
             f"quaternion_wxyz{at} must be a finite, non-zero quaternion (w, x, y, z), got {q_list}"
@@ -129,7 +195,7 @@ def _one_state(inertia: NDArray, m: NDArray, q: NDArray, τ: Any, k: int | None 
             f"angular_momentum{at} {m_list} with moments {I_list}: the angular velocity "
             "|m|/I1 is beyond the float range"
         )
-    return tuple(I_list), tuple(m_list), tuple(v / norm for v in q_list), τ_float, at
+    return tuple(I_list), tuple(m_list), (w / norm, x / norm, y / norm, z / norm), τ_float, at
 
 
 def _broadcast(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray):
@@ -166,21 +232,25 @@ def _checked_batch(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray) -> NDA
         if not finite.all():
             k = int(np.flatnonzero(~finite.reshape(len(array), -1).all(axis=1))[0])
             raise InputError(f"{name}[{k}] must be finite, got {array[k].tolist()}")
-    bad = np.flatnonzero(~np.all(inertia > 0.0, axis=1))
-    if bad.size:
+    if not (inertia > 0.0).all():
+        bad = np.flatnonzero(~np.all(inertia > 0.0, axis=1))
         raise InputError(f"moments[{bad[0]}] must be positive, got {inertia[bad[0]].tolist()}")
     norms = np.linalg.norm(q, axis=1)
-    bad = np.flatnonzero(~(np.isfinite(norms) & (norms > 0.0)))
-    if bad.size:
+    if not (np.isfinite(norms) & (norms > 0.0)).all():
+        bad = np.flatnonzero(~(np.isfinite(norms) & (norms > 0.0)))
         raise InputError(
             f"quaternion_wxyz[{bad[0]}] must be a finite, non-zero quaternion "
             f"(w, x, y, z), got {q[bad[0]].tolist()}"
         )
-    G = np.hypot(np.hypot(m[:, 0], m[:, 1]), m[:, 2])
-    with np.errstate(over="ignore", divide="ignore"):
-        fast = G / np.min(inertia, axis=1)
-    bad = np.flatnonzero(~np.isfinite(fast))
-    if bad.size:
+    # |m|/I1 ≤ √3 max|m_k| / min I: beyond the float range only past this bound.
+    if np.max(np.abs(m)) > 1e300 * np.min(inertia):
+        G = np.hypot(np.hypot(m[:, 0], m[:, 1]), m[:, 2])
+        with np.errstate(over="ignore", divide="ignore"):
+            fast = G / np.min(inertia, axis=1)
+        bad = np.flatnonzero(~np.isfinite(fast))
+    else:
+        bad = ()
+    if len(bad):
         k = bad[0]
         raise InputError(
             f"angular_momentum[{k}] {m[k].tolist()} with moments {inertia[k].tolist()}: "
@@ -203,6 +273,9 @@ def _hamilton(p: tuple, q: tuple) -> tuple[Any, Any, Any, Any]:
 
 def _step_in_formula_frame(formula: Any, G: Any, τ: Any, xp: Any):
     """m(dt) in the formula's frame and P(m(0))⁻¹ ⊗ Y(ψ(dt) − ψ(0)) ⊗ P(m(dt))."""
+    # Both ends from the same formula (not m(0) from the state), so that their rounding
+    # errors, a shift of the phase ν, are the same and cancel in the step: a zero step
+    # is the identity, and ψ(dt) − ψ(0) is as accurate as dt is short.
     if xp is FLOAT:
         a0, b0, c0, ψ0 = formula.momentum_and_angle(0.0, xp)
         a1, b1, c1, ψ1 = formula.momentum_and_angle(τ, xp)
@@ -221,21 +294,22 @@ def _advance_one(inertia: tuple, m: tuple, q0: tuple, τ: float, at: str = ""):
     """One state, on Python floats throughout (``at``: its index, for messages)."""
     state = OneState(inertia, m)
     if isinstance(state.formula, Rest):
-        return np.zeros(3), np.array(q0)
+        return (0.0, 0.0, 0.0), tuple(q0)
     try:
         m_frame, step = _step_in_formula_frame(state.formula, state.G, τ, FLOAT)
     except (ValueError, OverflowError):  # math on an angle beyond the float range
         raise InputError(_too_far(τ, at)) from None
+    # Back to the body: x_body[index[k]] = sign[k] x_frame[k].
     m_new = [0.0, 0.0, 0.0]
     v = [0.0, 0.0, 0.0]
-    for k in range(3):  # back to the body: x_body[index[k]] = sign[k] x_frame[k]
-        m_new[state.index[k]] = state.sign[k] * m_frame[k]
-        v[state.index[k]] = state.sign[k] * step[1 + k]
-    q_new = _hamilton(q0, (step[0], *v))
-    if not all(math.isfinite(x) for x in (*q_new, *m_new)):
+    (i0, i1, i2), (s0, s1, s2) = state.index, state.sign
+    m_new[i0], m_new[i1], m_new[i2] = s0 * m_frame[0], s1 * m_frame[1], s2 * m_frame[2]
+    v[i0], v[i1], v[i2] = s0 * step[1], s1 * step[2], s2 * step[3]
+    w, x, y, z = _hamilton(q0, (step[0], v[0], v[1], v[2]))
+    norm = math.sqrt(w * w + x * x + y * y + z * z)  # 1 to a few ulps; kept from drifting
+    if not (math.isfinite(norm) and all(map(math.isfinite, m_new))):
         raise InputError(_too_far(τ, at))
-    norm = math.sqrt(sum(x * x for x in q_new))  # 1 to a few ulps; kept from drifting
-    return np.array(m_new), np.array(q_new) / norm
+    return tuple(m_new), (w / norm, x / norm, y / norm, z / norm)
 
 
 def _advance_many(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray, first: int = 0):
@@ -250,6 +324,7 @@ def _advance_many(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray, first: 
         for k, formula in states.groups:
             if isinstance(formula, Rest):
                 continue
+            k = slice(None) if k.size == n else k  # one case for every state: no gather
             (a, b, c), s = _step_in_formula_frame(formula, states.G[k], τ[k], np)
             m_frame[k] = np.stack([a, b, c], axis=-1)
             step[k] = np.stack(s, axis=-1)

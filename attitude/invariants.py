@@ -29,6 +29,7 @@ rounded (within an ulp, nearly always the correctly rounded value).
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -122,64 +123,69 @@ def _dd_over_dd(x: tuple, y: tuple) -> tuple[Any, Any]:
 # ----------------------------------------------------------------- the invariants
 
 
-def _double_double(I1: Any, I2: Any, I3: Any, m1: Any, m2: Any, m3: Any, xp: Any):
+def _double_double(I1: Any, I2: Any, I3: Any, m1: Any, m2: Any, m3: Any):
     """Δ's in double-double, with the certainty of the sign of Δ2 and of mc's rounding.
 
     Returns (sign, δ1, δ3, mc, log_mc, certain); where ``certain`` is False the other
-    values are to be replaced by the exact path.
+    values are to be replaced by the exact path.  Arrays of a batch: the like terms are
+    stacked, so that each double-double operation is one numpy call over all of them.
     """
     # Exact scaling by powers of two (Δ's ratios are scale-free).
-    eI = xp.frexp(I3)[1]
-    I1, I2, I3 = (xp.ldexp(v, -eI) for v in (I1, I2, I3))
-    em = xp.frexp(xp.maximum(xp.maximum(abs(m1), abs(m2)), abs(m3)))[1]
-    m1, m2, m3 = (xp.ldexp(v, -em) for v in (m1, m2, m3))
+    moments = np.ldexp(np.stack([I1, I2, I3]), -np.frexp(I3)[1])
+    m = np.stack([m1, m2, m3])
+    m = np.ldexp(m, -np.frexp(np.max(np.abs(m), axis=0))[1])
+    representable = (m == 0.0) | (np.abs(m) >= _SMALLEST_SCALED)
+    valid = representable.all(axis=0) & (moments[0] >= _SMALLEST_SCALED)
 
-    def representable(v):
-        return (v == 0.0) | (abs(v) >= _SMALLEST_SCALED)
-
-    valid = representable(m1) & representable(m2) & representable(m3) & (I1 >= _SMALLEST_SCALED)
-
-    sq1, sq2, sq3 = _two_prod(m1, m1), _two_prod(m2, m2), _two_prod(m3, m3)
-    I21, I31, I32 = _two_sum(I2, -I1), _two_sum(I3, -I1), _two_sum(I3, -I2)
-    t1 = _dd_times_float(_dd_times_dd(sq1, I21), I3)  # m1² I21 I3
-    t3 = _dd_times_float(_dd_times_dd(sq3, I32), I1)  # m3² I32 I1
-    N2 = _dd_plus_dd(t3, (-t1[0], -t1[1]))  # I1 I3 Δ2 (scaled)
-    N2_error = _BOUND * (abs(t1[0]) + abs(t3[0]))
-    sign_certain = abs(N2[0]) > 2.0 * N2_error
-    # I1 I2 (−Δ3) and I2 I3 Δ1 (scaled), sums of two terms of one sign.
-    P3 = _dd_plus_dd(
-        _dd_times_float(_dd_times_dd(sq1, I31), I2), _dd_times_float(_dd_times_dd(sq2, I32), I1)
+    sq = _two_prod(m, m)  # m_k², exact
+    I_diff = _two_sum(moments[[1, 2, 2]], -moments[[0, 0, 1]])  # I21, I31, I32, exact
+    # The six terms m_k² I_kj I_l: m1² I21 I3 and m3² I32 I1 (Δ2), m1² I31 I2 and
+    # m2² I32 I1 (−Δ3), m2² I21 I3 and m3² I31 I2 (Δ1), all scaled.
+    k, d, other = [0, 2, 0, 1, 1, 2], [0, 2, 1, 2, 0, 1], [2, 0, 1, 0, 2, 1]
+    t = _dd_times_float(
+        _dd_times_dd((sq[0][k], sq[1][k]), (I_diff[0][d], I_diff[1][d])), moments[other]
     )
-    N1 = _dd_plus_dd(
-        _dd_times_float(_dd_times_dd(sq2, I21), I3), _dd_times_float(_dd_times_dd(sq3, I31), I2)
+    # I1 I3 Δ2 = t3 − t1, I1 I2 (−Δ3) and I2 I3 Δ1: sums of two terms (of one sign for
+    # the last two).
+    sums = _dd_plus_dd(
+        (t[0][[1, 2, 4]], t[1][[1, 2, 4]]),
+        (t[0][[0, 3, 5]] * [[-1.0], [1.0], [1.0]], t[1][[0, 3, 5]] * [[-1.0], [1.0], [1.0]]),
     )
-    G2 = _dd_plus_dd(_dd_plus_dd(sq1, sq2), sq3)
+    N2, P3, N1 = (sums[0][0], sums[1][0]), (sums[0][1], sums[1][1]), (sums[0][2], sums[1][2])
+    N2_error = _BOUND * (np.abs(t[0][0]) + np.abs(t[0][1]))
+    sign_certain = np.abs(N2[0]) > 2.0 * N2_error
+    G2 = _dd_plus_dd(_dd_plus_dd((sq[0][0], sq[1][0]), (sq[0][1], sq[1][1])), (sq[0][2], sq[1][2]))
     case_i = N2[0] < 0.0
-    sign = xp.where(case_i, -1.0, 1.0)
+    sign = np.where(case_i, -1.0, 1.0)
     with np.errstate(divide="ignore", invalid="ignore"):
         # δ1 = Δ1/G² = N1/(I2 I3 G²), δ3 = −P3/(I1 I2 G²): faithful, nearly always the
-        # correctly rounded values of the exact path.
-        δ1 = _dd_over_dd(N1, _dd_times_float(_dd_times_float(G2, I2), I3))[0]
-        δ3 = -_dd_over_dd(P3, _dd_times_float(_dd_times_float(G2, I1), I2))[0]
+        # correctly rounded values of the exact path (a few ulps off would be amplified
+        # next to the separatrix, where the batch must agree with one state alone).
+        G2_I = _dd_times_float(
+            _dd_times_float((np.stack([G2[0], G2[0]]), np.stack([G2[1], G2[1]])), moments[[1, 0]]),
+            moments[[2, 1]],
+        )
+        δ = _dd_over_dd((np.stack([N1[0], P3[0]]), np.stack([N1[1], P3[1]])), G2_I)[0]
+        δ1, δ3 = δ[0], -δ[1]
     # mc = |N2| I2 I31 / (I3 P3 I21) in case (i), |N2| I2 I31 / (I1 N1 I32) in case (ii).
-    N2_abs = (abs(N2[0]), xp.copysign(1.0, N2[0]) * N2[1])
-    numerator = _dd_times_dd(_dd_times_float(N2_abs, I2), I31)
-    D, I_other, I_diff0, I_diff1 = (
-        (xp.where(case_i, P3[0], N1[0]), xp.where(case_i, P3[1], N1[1])),
-        xp.where(case_i, I3, I1),
-        xp.where(case_i, I21[0], I32[0]),
-        xp.where(case_i, I21[1], I32[1]),
+    N2_abs = (np.abs(N2[0]), np.copysign(1.0, N2[0]) * N2[1])
+    numerator = _dd_times_dd(_dd_times_float(N2_abs, moments[1]), (I_diff[0][1], I_diff[1][1]))
+    D = (np.where(case_i, P3[0], N1[0]), np.where(case_i, P3[1], N1[1]))
+    I_other = np.where(case_i, moments[2], moments[0])
+    I_d = (
+        np.where(case_i, I_diff[0][0], I_diff[0][2]),
+        np.where(case_i, I_diff[1][0], I_diff[1][2]),
     )
-    denominator = _dd_times_dd(_dd_times_float(D, I_other), (I_diff0, I_diff1))
+    denominator = _dd_times_dd(_dd_times_float(D, I_other), I_d)
     with np.errstate(divide="ignore", invalid="ignore"):
         mc, mc_low = _dd_over_dd(numerator, denominator)
         # Relative error: that of N2 plus the chains' (four products, a sum, a quotient).
-        error = mc * (N2_error / abs(N2[0]) + 4.0 * _BOUND)
-        spacing = xp.spacing(mc)
-        below = xp.where(xp.frexp(mc)[0] == 0.5, 0.5 * spacing, spacing)
+        error = mc * (N2_error / np.abs(N2[0]) + 4.0 * _BOUND)
+        spacing = np.spacing(mc)
+        below = np.where(np.frexp(mc)[0] == 0.5, 0.5 * spacing, spacing)
         rounding_certain = (mc_low + error < 0.5 * spacing) & (mc_low - error > -0.5 * below)
         certain = valid & sign_certain & rounding_certain & (mc >= 2.0**-900) & (mc <= 1.0)
-        log_mc = xp.log(mc) + mc_low / mc
+        log_mc = np.log(mc) + mc_low / mc
     return sign, δ1, δ3, mc, log_mc, certain
 
 
@@ -193,7 +199,7 @@ def invariants(I1: Any, I2: Any, I3: Any, m1: Any, m2: Any, m3: Any, xp: Any = n
         # double-double (~18 µs), and they are exact.
         return _ExactΔ(I1, I2, I3, m1, m2, m3).invariants()
     with np.errstate(over="ignore", under="ignore", invalid="ignore", divide="ignore"):
-        sign, δ1, δ3, mc, log_mc, certain = _double_double(I1, I2, I3, m1, m2, m3, np)
+        sign, δ1, δ3, mc, log_mc, certain = _double_double(I1, I2, I3, m1, m2, m3)
     for k in np.flatnonzero(~certain):
         exact = _ExactΔ(I1[k], I2[k], I3[k], m1[k], m2[k], m3[k]).invariants()
         sign[k], δ1[k], δ3[k], mc[k], log_mc[k] = (
@@ -206,11 +212,20 @@ def invariants(I1: Any, I2: Any, I3: Any, m1: Any, m2: Any, m3: Any, xp: Any = n
     return Invariants(sign, δ1, δ3, mc, log_mc)
 
 
-def _as_integers(*values: float) -> list[int]:
-    """The floats ``values`` times one common power of two, as exact integers."""
-    ratios = [float(v).as_integer_ratio() for v in values]
-    scale = max(q for _, q in ratios)  # every q is a power of two and divides scale
-    return [p * (scale // q) for p, q in ratios]
+def _as_integers(a: float, b: float, c: float) -> tuple[int, int, int]:
+    """The floats a, b, c times one common power of two, as exact integers."""
+    (pa, qa), (pb, qb), (pc, qc) = a.as_integer_ratio(), b.as_integer_ratio(), c.as_integer_ratio()
+    bits = max(qa, qb, qc).bit_length()  # every q is a power of two
+    return (
+        pa << (bits - qa.bit_length()),
+        pb << (bits - qb.bit_length()),
+        pc << (bits - qc.bit_length()),
+    )
+
+
+# A spacecraft stepped by the torqued solver keeps its moments from flow to flow: their
+# integers are computed once (the cache is keyed on the float values, so exact).
+_moment_integers = functools.lru_cache(maxsize=256)(_as_integers)
 
 
 class _ExactΔ:
@@ -225,16 +240,17 @@ class _ExactΔ:
     """
 
     def __init__(self, I1: float, I2: float, I3: float, m1: float, m2: float, m3: float):
-        J = _as_integers(I1, I2, I3)
-        M = _as_integers(m1, m2, m3)
-        P = J[0] * J[1] * J[2]
-        squares = [Mk * Mk for Mk in M]
-        self.J = J
-        self.D = [
-            sum(squares[k] * (J[k] - J[j]) * (P // J[k]) for k in range(3) if k != j)
-            for j in range(3)
-        ]
-        self.PS = P * sum(squares)
+        J1, J2, J3 = _moment_integers(I1, I2, I3)
+        M1, M2, M3 = _as_integers(m1, m2, m3)
+        S1, S2, S3 = M1 * M1, M2 * M2, M3 * M3
+        J12, J13, J23 = J1 * J2, J1 * J3, J2 * J3  # P/J3, P/J2, P/J1
+        self.J = (J1, J2, J3)
+        self.D = (
+            S2 * (J2 - J1) * J13 + S3 * (J3 - J1) * J12,
+            S1 * (J1 - J2) * J23 + S3 * (J3 - J2) * J12,
+            S1 * (J1 - J3) * J23 + S2 * (J2 - J3) * J13,
+        )
+        self.PS = J12 * J3 * (S1 + S2 + S3)
 
     def invariants(self) -> Invariants:
         D1, D2, D3 = self.D

@@ -40,7 +40,7 @@ from scipy.spatial.transform import Rotation
 
 from attitude.errors import InputError
 from attitude.euler_solver import EulerSolver
-from attitude.free_flow import advance
+from attitude.free_flow import advance_floats, advance_unit_batch
 from attitude.inertia import principal_axes
 from attitude.quantities import as_si_array, as_si_scalar, as_vector3
 from attitude.splitting import Composition, composition
@@ -91,6 +91,7 @@ class _Engine:
         self.torques = torques
         self.frame = frame
         self.moments = moments  # (3,) or (N, 3), for advance()
+        self.moment_floats = tuple(moments.tolist()) if moments.shape == (3,) else None
         self.rk4 = any(t.depends_on_angular_velocity for t in torques)
         self.clock = method.kick_clock
         self.kicks = [j for j, b in enumerate(method.kicks) if b != 0.0]
@@ -101,19 +102,21 @@ class _Engine:
     def flow(self, m, q, dt):
         """The exact free flow over dt (float, or array for a batch)."""
         self.flows += 1
-        if isinstance(m[0], float):
-            m_new, q_new = advance(self.moments, np.array(m), np.array(q), dt)
-            return tuple(m_new.tolist()), tuple(q_new.tolist())
+        if isinstance(m[0], float):  # one spacecraft: Python floats throughout
+            return advance_floats(self.moment_floats, m, q, dt)
         m_array = np.stack(np.broadcast_arrays(*m), axis=-1)
         n = m_array.shape[0]
         # Every argument at its full (N, ...) shape: the free flow need not broadcast.
-        m_new, q_new = advance(
+        arguments = (
             np.broadcast_to(self.moments, (n, 3)),
             m_array,
             np.stack(np.broadcast_arrays(*q), axis=-1),
             np.broadcast_to(np.asarray(dt, dtype=np.float64), (n,)),
         )
-        return tuple(m_new.T), tuple(q_new.T)
+        # Straight to the flow: its states come from the last step, checked there.
+        m_new, q_new = advance_unit_batch(*arguments)
+        # Components as contiguous rows: the kicks' arithmetic runs on them.
+        return tuple(np.ascontiguousarray(m_new.T)), tuple(np.ascontiguousarray(q_new.T))
 
     def torque(self, data, m, q):
         I1, I2, I3 = self.frame.moments

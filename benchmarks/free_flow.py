@@ -3,9 +3,11 @@
 In one run, as ratios to peers timed side by side (absolute times depend on the load,
 which is printed):
 
-- one state, one step: ``advance`` on a single state (its constants included), against
-  one scalar ``scipy.special.ellipj`` call and against building an ``EulerSolver`` and
-  evaluating its attitude and momentum once (what a splitting step cost before);
+- one state, one step: ``advance`` on a single state (its constants included), and
+  ``advance_floats`` (tuples in and out: what the torqued solver calls for one
+  spacecraft), against one scalar ``scipy.special.ellipj`` call and against building
+  an ``EulerSolver`` and evaluating its attitude and momentum once (what a splitting
+  step cost before);
 - batches of N states, one step each, N = 1, 10, 100, 1000 and 1e5: nanoseconds per
   state-step, against ``scipy.special.ellipj`` on N points.
 
@@ -34,7 +36,7 @@ from scipy import special
 from scipy.spatial.transform import Rotation
 
 from attitude import EulerSolver
-from attitude.free_flow import advance
+from attitude.free_flow import advance, advance_floats
 
 RESULTS = Path(__file__).parent / "results"
 
@@ -121,6 +123,7 @@ def main(argv=None) -> dict:
     load_before = os.getloadavg()
 
     report: dict = {
+        "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
         "machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores",
         "python": platform.python_version(),
         "numpy": np.__version__,
@@ -132,12 +135,17 @@ def main(argv=None) -> dict:
     ellipj = _best_per_call(lambda: special.ellipj(0.7, 0.3), repeats)
     report["scalar_ellipj_us"] = ellipj * 1e6
     print(f"one scalar scipy.special.ellipj call: {ellipj * 1e9:.0f} ns")
-    print(f"{'one state, one step':34s} {'advance':>10s} {'/ellipj':>8s} {'EulerSolver':>12s}")
+    print(
+        f"{'one state, one step':34s} {'advance':>10s} {'/ellipj':>8s} "
+        f"{'advance_floats':>15s} {'/ellipj':>8s} {'EulerSolver':>12s}"
+    )
     for kind in SCALAR_KINDS:
         inertia, m = _state(kind, rng)
         q = Rotation.random(random_state=3).as_quat(scalar_first=True)
         dt = 3.7
         step = _best_per_call(lambda: advance(inertia, m, q, dt), repeats)  # noqa: B023
+        floats = (tuple(inertia.tolist()), tuple(m.tolist()), tuple(q.tolist()), dt)
+        step_floats = _best_per_call(lambda: advance_floats(*floats), repeats)  # noqa: B023
         attitude0 = Rotation.from_quat(q, scalar_first=True)
 
         def solver_step():
@@ -148,11 +156,14 @@ def main(argv=None) -> dict:
         report["scalar"][kind] = {
             "advance_us": step * 1e6,
             "ratio_to_ellipj": step / ellipj,
+            "advance_floats_us": step_floats * 1e6,
+            "advance_floats_ratio_to_ellipj": step_floats / ellipj,
             "euler_solver_us": solver * 1e6,
             "ratio_euler_solver_to_advance": solver / step,
         }
         print(
             f"  {kind:32s} {step * 1e6:8.1f} µs {step / ellipj:7.1f}x "
+            f"{step_floats * 1e6:13.1f} µs {step_floats / ellipj:7.1f}x "
             f"{solver * 1e6:9.0f} µs ({solver / step:.0f}x advance)"
         )
 

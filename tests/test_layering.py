@@ -12,7 +12,7 @@ PACKAGE = Path(__file__).parents[1] / "attitude"
 # In order; a module may import modules of its own layer or of earlier ones.
 LAYERS = [
     ["version", "errors", "quantities", "quaternions", "vectors", "float_math"],  # shared base
-    ["elliptic"],  # elliptic kernels
+    ["elliptic", "phase_table"],  # elliptic kernels
     ["inertia", "invariants", "closed_form", "euler_solver", "free_flow"],  # the Euler solver
     ["torques", "splitting", "torqued_solver"],  # torques and splitting
     [  # scenario and events
