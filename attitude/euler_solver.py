@@ -71,7 +71,7 @@ _UNBUILT = object()
 try:  # numpy's array-API namespace as scipy's Rotation keeps it (see _one_rotation)
     from scipy._lib._array_api import array_namespace as _array_namespace
 
-    _NUMPY_NAMESPACE = _array_namespace(np.empty(0))
+    _NUMPY_NAMESPACE: Any = _array_namespace(np.empty(0))
 except ImportError:  # pragma: no cover
     _NUMPY_NAMESPACE = None
 
@@ -102,7 +102,8 @@ def _one_rotation(q_scalar_last: NDArray[np.float64]) -> Rotation:
     checks that it gives the public constructor's rotation.
     """
     try:
-        return Rotation._from_raw_quat(q_scalar_last, xp=_NUMPY_NAMESPACE)
+        from_raw_quat = Rotation._from_raw_quat  # private: not in the stubs
+        return from_raw_quat(q_scalar_last, xp=_NUMPY_NAMESPACE)
     except (AttributeError, TypeError):  # pragma: no cover  (another scipy)
         return Rotation(q_scalar_last, normalize=False, copy=False)
 
@@ -317,6 +318,7 @@ class EulerSolver:
             ψ *= 0.5
             half_ψ = ψ
         else:
+            assert isinstance(f, Elliptic)  # only Elliptic formulas get a table
             j, r, sn_r, cn_r, dn_r = f.phase(τ, np)
             a, b, c = f.momentum_of_phase(j, sn_r, cn_r, dn_r, np)
             del j, sn_r, cn_r, dn_r
@@ -373,7 +375,7 @@ class EulerSolver:
             self._table = None
             f = self._formula
             if isinstance(f, Elliptic) and not f.parameter.near_one and f.n != 0.0:
-                table = PiecewiseChebyshev.fit(f.periodic_angle, -f.K, f.K)
+                table = PiecewiseChebyshev.fit(f.periodic_angle, -float(f.K), float(f.K))
                 if table is not None:
                     _, r0, *_ = f.phase(np.zeros(1), np)
                     self._per_t0 = float(table(r0)[0])

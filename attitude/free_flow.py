@@ -249,7 +249,7 @@ def _checked_batch(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray) -> NDA
             fast = G / np.min(inertia, axis=1)
         bad = np.flatnonzero(~np.isfinite(fast))
     else:
-        bad = ()
+        bad = np.empty(0, np.intp)
     if len(bad):
         k = bad[0]
         raise InputError(
@@ -324,10 +324,10 @@ def _advance_many(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray, first: 
         for k, formula in states.groups:
             if isinstance(formula, Rest):
                 continue
-            k = slice(None) if k.size == n else k  # one case for every state: no gather
-            (a, b, c), s = _step_in_formula_frame(formula, states.G[k], τ[k], np)
-            m_frame[k] = np.stack([a, b, c], axis=-1)
-            step[k] = np.stack(s, axis=-1)
+            picked = slice(None) if k.size == n else k  # one case for every state: no gather
+            (a, b, c), s = _step_in_formula_frame(formula, states.G[picked], τ[picked], np)
+            m_frame[picked] = np.stack([a, b, c], axis=-1)
+            step[picked] = np.stack(s, axis=-1)
     rows = np.arange(n)[:, None]
     m_new = np.zeros((n, 3))
     m_new[rows, states.index] = states.sign * m_frame

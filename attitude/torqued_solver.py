@@ -91,7 +91,11 @@ class _Engine:
         self.torques = torques
         self.frame = frame
         self.moments = moments  # (3,) or (N, 3), for advance()
-        self.moment_floats = tuple(moments.tolist()) if moments.shape == (3,) else None
+        self.moment_floats: tuple[float, float, float] | None = (
+            (float(moments[0]), float(moments[1]), float(moments[2]))
+            if moments.shape == (3,)
+            else None
+        )
         self.rk4 = any(t.depends_on_angular_velocity for t in torques)
         self.clock = method.kick_clock
         self.kicks = [j for j, b in enumerate(method.kicks) if b != 0.0]
@@ -102,7 +106,7 @@ class _Engine:
     def flow(self, m, q, dt):
         """The exact free flow over dt (float, or array for a batch)."""
         self.flows += 1
-        if isinstance(m[0], float):  # one spacecraft: Python floats throughout
+        if self.moment_floats is not None and isinstance(m[0], float):  # one spacecraft
             return advance_floats(self.moment_floats, m, q, dt)
         m_array = np.stack(np.broadcast_arrays(*m), axis=-1)
         n = m_array.shape[0]
