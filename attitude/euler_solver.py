@@ -98,7 +98,7 @@ def _one_rotation(q_scalar_last: NDArray[np.float64]) -> Rotation:
     scipy's public constructors cost ~8 µs for a single quaternion (array-API
     dispatch and checks), five times the rest of a scalar ``attitude(t)``; its internal
     constructor, which skips them, ~2 µs.  That one is private, so it is used only
-    where it exists with the signature we know, and tests/test_solver_speed_paths.py
+    where it exists with the signature we know, and tests/test_fast_paths_against_the_general_ones.py
     checks that it gives the public constructor's rotation.
     """
     try:
