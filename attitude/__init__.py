@@ -9,7 +9,8 @@ The layers, each importing only the ones above it in this list (README "Layout")
 - ``attitude.spacecraft``, ``events``, ``scenario``, ``timescales``: the scenario layer
 - ``attitude.trajectory``, ``motion_analysis``: the propagated motion
 - ``attitude.ephemeris``, ``earth``, ``frames``, ``orbit``, ``keplerian``, ``oem``,
-  ``aem_input``, ``intervals``, ``extrema``, ``eclipse``, ``pointing``: pointing
+  ``aem_input``, ``intervals``, ``extrema``, ``eclipse``, ``pointing_spec``,
+  ``surroundings``, ``pointing_sampling``, ``pointing_search``, ``pointing``: pointing
 - ``attitude.exports``, ``aem``, ``plots``, ``report_page``, ``report``: reports and exports
 - ``attitude.scenario_file``, ``cli``: scenario files and the command line
 

@@ -160,10 +160,10 @@ def test_the_output_grid_alone_would_be_wrong(cubesat):
 def test_nothing_depends_on_the_chunks(cubesat, monkeypatch):
     # The search runs in chunks of CHUNK_POINTS grid points: with chunks of 1000 the
     # intervals are the same (joined at the chunks' ends), and so are the extrema.
-    import attitude.pointing as pointing
+    import attitude.pointing_search as pointing_search
 
     analysis, _, _, trajectory, spec = cubesat
-    monkeypatch.setattr(pointing, "CHUNK_POINTS", 1000)
+    monkeypatch.setattr(pointing_search, "CHUNK_POINTS", 1000)
     chunked = pointing_analysis(trajectory, spec)
     assert analysis.grid.count > 10_000  # so that there are a dozen chunks
     for one, other in zip(analysis.vectors, chunked.vectors, strict=True):

@@ -29,6 +29,10 @@ LAYERS = [
         "intervals",
         "extrema",
         "eclipse",
+        "pointing_spec",
+        "surroundings",
+        "pointing_sampling",
+        "pointing_search",
         "pointing",
     ],
     [  # reports and exports
