@@ -25,7 +25,7 @@ from numpy.typing import NDArray
 
 from attitude.intervals import Interval, total_duration
 from attitude.motion_analysis import LISTED_FLIPS, SegmentMotion
-from attitude.pointing import PointingAnalysis, PointingSamples
+from attitude.pointing import PointingAnalysis, PointingSamples, PointingSpec
 from attitude.trajectory import Trajectory
 
 __all__ = [
@@ -34,6 +34,7 @@ __all__ = [
     "Samples",
     "arrow_texts",
     "motion_summary",
+    "pointing_column_count",
     "pointing_columns",
     "pointing_summary",
     "right_ascension_deg",
@@ -330,6 +331,29 @@ def _degrees(name: str, values, description: str) -> list[Column]:
     return [] if values is None else [Column(name, np.degrees(values), description)]
 
 
+def pointing_column_count(spec: PointingSpec) -> int:
+    """How many columns :func:`pointing_columns` gives for ``spec``, known before
+    anything is sampled (for the size estimate of ``attitude.output_budget``):
+    the Sun's direction; on an orbit the lit fraction, the Earth's angular radius and
+    the LVLH quaternion (and Euler angles when asked); per vector its Sun, Moon, RA
+    and Dec columns and incidence, on an orbit its nadir and limb angles, and a flag
+    per constraint."""
+    columns = 3
+    if spec.on_orbit:
+        columns += 2 + 4 + (3 if spec.lvlh_euler_sequence is not None else 0)
+    for v in spec.body_vectors:
+        columns += 5 + (2 if spec.on_orbit else 0)
+        columns += sum(
+            angle is not None
+            for angle in (
+                v.sun_exclusion_half_angle_rad,
+                v.moon_exclusion_half_angle_rad,
+                v.earth_limb_exclusion_angle_rad,
+            )
+        )
+    return columns
+
+
 def pointing_columns(samples: PointingSamples) -> list[Column]:
     """The pointing columns of the time series, at the samples' times (any chunk of
     the output grid: the columns of consecutive chunks follow on)."""
@@ -421,37 +445,49 @@ def pointing_columns(samples: PointingSamples) -> list[Column]:
 _VECTOR_INTERVALS = ("sun_exclusion", "moon_exclusion", "earth_limb_exclusion", "sun_visible")
 
 
-def _interval_rows(analysis: PointingAnalysis) -> list[tuple[str, str, Interval]]:
-    rows = [("eclipse", "", i) for i in analysis.shadow]
-    rows += [("umbra", "", i) for i in analysis.umbra]
-    rows += [("moon_behind_earth", "", i) for i in analysis.moon_hidden]
+def _interval_kinds(analysis: PointingAnalysis) -> list[tuple[str, str, list[Interval]]]:
+    """Each kind of interval with its body vector and its intervals (in time order), in
+    the file's order: by kind, then by body vector name."""
+    kinds = [
+        ("eclipse", "", analysis.shadow),
+        ("umbra", "", analysis.umbra),
+        ("moon_behind_earth", "", analysis.moon_hidden),
+    ]
     for item in analysis.vectors:
-        for kind in _VECTOR_INTERVALS:
-            rows += [(kind, item.vector.name, i) for i in getattr(item, kind)]
-    return sorted(rows, key=lambda row: (row[0], row[1], row[2].start_s))
+        kinds += [(kind, item.vector.name, getattr(item, kind)) for kind in _VECTOR_INTERVALS]
+    return sorted(kinds, key=lambda entry: entry[:2])
+
+
+# intervals.csv is written this many rows at a time: its epoch texts are made in bulk,
+# and a month of a spinner's windows (a million rows) is never held as text at once.
+_INTERVAL_ROWS_AT_A_TIME = 16384
 
 
 def write_intervals_csv(
     path: Path, analysis: PointingAnalysis, iso, preamble: list[str]
 ) -> None:
-    """One row per interval: kind, body vector, start and end (ISO and TT s), duration.
+    """One row per interval: kind, body vector, start and end (ISO and TT s), duration;
+    sorted by kind, body vector and start.
 
     ``iso``: a function from TT seconds to ISO texts in the scenario's time scale.
     """
-    rows = _interval_rows(analysis)
-    starts = iso(np.array([r[2].start_s for r in rows])) if rows else []
-    ends = iso(np.array([r[2].end_s for r in rows])) if rows else []
     with open(path, "w", encoding="utf-8", newline="") as stream:
         for line in preamble:
             stream.write(f"# {line}\n")
         stream.write(
             "kind,body_vector,start,end,start_s,end_s,duration_s,starts_before_span,ends_after_span\n"
         )
-        for (kind, name, i), start, end in zip(rows, starts, ends, strict=True):
-            stream.write(
-                f"{kind},{name},{start},{end},{i.start_s:.9f},{i.end_s:.9f},{i.duration_s:.9f},"
-                f"{int(i.starts_before)},{int(i.ends_after)}\n"
-            )
+        for kind, name, intervals in _interval_kinds(analysis):
+            # Each list is in time order already (the search finds them so).
+            for first in range(0, len(intervals), _INTERVAL_ROWS_AT_A_TIME):
+                block = intervals[first : first + _INTERVAL_ROWS_AT_A_TIME]
+                starts = iso(np.array([i.start_s for i in block]))
+                ends = iso(np.array([i.end_s for i in block]))
+                stream.writelines(
+                    f"{kind},{name},{start},{end},{i.start_s:.9f},{i.end_s:.9f},"
+                    f"{i.duration_s:.9f},{int(i.starts_before)},{int(i.ends_after)}\n"
+                    for i, start, end in zip(block, starts, ends, strict=True)
+                )
 
 
 def _interval_totals(intervals: list[Interval], format_epoch=None) -> dict[str, Any]:
