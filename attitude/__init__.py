@@ -11,7 +11,8 @@ The layers, each importing only the ones above it in this list (README "Layout")
 - ``attitude.ephemeris``, ``earth``, ``frames``, ``orbit``, ``keplerian``, ``oem``,
   ``aem_input``, ``intervals``, ``extrema``, ``eclipse``, ``pointing_spec``,
   ``surroundings``, ``pointing_sampling``, ``pointing_search``, ``pointing``: pointing
-- ``attitude.exports``, ``aem``, ``plots``, ``report_page``, ``report``: reports and exports
+- ``attitude.exports``, ``aem``, ``summaries``, ``plots``, ``report_page``, ``report``: reports
+  and exports
 - ``attitude.scenario_file``, ``cli``: scenario files and the command line
 
 The names below are importable from ``attitude`` directly; all but the errors are

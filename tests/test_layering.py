@@ -40,6 +40,7 @@ LAYERS = [
         "timeseries_parquet",
         "aem",
         "aem_sampling",
+        "summaries",
         "plots",
         "report_figures",
         "report_page",
