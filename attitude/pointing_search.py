@@ -42,6 +42,7 @@ from attitude.earth import EARTH_EQUATORIAL_RADIUS_M, angular_radius
 from attitude.eclipse import SUN_RADIUS_M
 from attitude.ephemeris import skyfield_times
 from attitude.errors import InputError
+from attitude.euler_solver import EulerSolver
 from attitude.extrema import Extremum, Problem, least_of_each
 from attitude.intervals import Interval, difference, find_all_intervals, join
 from attitude.orbit import Orbit
@@ -86,6 +87,8 @@ MAX_SEARCH_POINTS = 100_000_000
 # this (radians for angles, or a cosine) is not refined.
 _EXTREMUM_PRECISION_S = 1e-6
 _EXTREMUM_TOLERANCE = 5e-9
+# A body vector's rate bound samples ω this many times over a body period.
+_RATE_SAMPLES = 16384
 
 
 @dataclass(frozen=True)
@@ -96,7 +99,9 @@ class SearchGrid:
     ``body_rate_rad_s``: a bound on the body's rotation rate (√(2T/I_min));
     ``orbit_rate_rad_s``: the
     fastest turn of the nadir (|r × v|/r²) plus the rate of the Earth's angular radius;
-    ``orbit_speed_m_s``: the greatest orbital speed.
+    ``orbit_speed_m_s``: the greatest orbital speed; ``vector_rates_rad_s``: for each
+    body vector by name, a bound on how fast it turns (:func:`_vector_rates`; never
+    above ``body_rate_rad_s``, which stands for a vector not listed).
     """
 
     start_s: float
@@ -106,17 +111,27 @@ class SearchGrid:
     body_rate_rad_s: float
     orbit_rate_rad_s: float
     orbit_speed_m_s: float
+    vector_rates_rad_s: dict[str, float] = field(default_factory=dict, compare=False)
 
     @property
     def angle_rate_bound(self) -> float:
         """A bound on how fast any angle between two of our directions changes, rad/s."""
+        return self.body_rate_rad_s + self._geometry_rate
+
+    @property
+    def _geometry_rate(self) -> float:
+        """How fast the Sun, the Moon and the Earth can move across the sky, rad/s."""
         return (
-            self.body_rate_rad_s
-            + self.orbit_rate_rad_s
+            self.orbit_rate_rad_s
             + _SUN_SKY_RATE
             + _MOON_SKY_RATE
             + 2.0 * self.orbit_speed_m_s / 3.56e8
         )
+
+    def vector_angle_rate_bound(self, name: str) -> float:
+        """A bound on how fast an angle between body vector ``name`` and the Sun, the
+        Moon, the nadir or the limb changes, rad/s: the vector's own rate plus theirs."""
+        return self.vector_rates_rad_s.get(name, self.body_rate_rad_s) + self._geometry_rate
 
     @property
     def fraction_rate_bound(self) -> float:
@@ -137,6 +152,50 @@ def _body_rate(trajectory: Trajectory, start_s: float, stop_s: float) -> float:
         if segment.end_s >= start_s and segment.start_s <= stop_s
     ]
     return max(rates, default=0.0)
+
+
+def _vector_rates(
+    trajectory: Trajectory, spec: PointingSpec, start_s: float, stop_s: float
+) -> dict[str, float]:
+    """For each body vector b, a bound on its inertial rate |ω × b| over [start_s,
+    stop_s], rad/s: the pointing's extrema are pruned with it (a vector near the spin
+    axis turns far slower than the body, and :func:`_body_rate` would keep every
+    bracket of its Sun angle).
+
+    Per segment, ω(t) (body axes) is sampled :data:`_RATE_SAMPLES` times over one body
+    period of its solver, in which it takes all its values (the torque-free ω repeats
+    in the body), or over the part of the segment in the span if that is shorter.
+    Within s ≤ Δ/2 of a sample t_k, |ω(t) − ω(t_k)| ≤ |ω̇(t_k)| s + ½ max|ω̈| s², with
+    ω̇ = I⁻¹(m × ω) (Euler's equations, m = Iω, ṁ = m × ω) at the sample, and
+    |ω̈| = |I⁻¹((m × ω) × ω + m × ω̇)| ≤ (G ω_max² + G² ω_max / I_min) / I_min
+    ≤ 2 G² ω_max / I_min² (as G ≥ I_min ω_max); ω_max = √(2T/I_min), the body's
+    bound, also caps the result.
+    """
+    vectors = [(v.name, v.vector) for v in spec.body_vectors]
+    rates = dict.fromkeys((name for name, _ in vectors), 0.0)
+    for segment in trajectory.segments:
+        a, b = max(segment.start_s, start_s), min(segment.end_s, stop_s)
+        if b < a:
+            continue
+        solver = segment.solver
+        least = float(np.min(solver.moments_of_inertia))
+        highest = math.sqrt(max(2.0 * solver.kinetic_energy, 0.0) / least)
+        window = min(b - a, solver.period) if isinstance(solver, EulerSolver) else math.nan
+        if not math.isfinite(window):  # under torques ω need not repeat; no period
+            for name, _ in vectors:
+                rates[name] = max(rates[name], highest)
+            continue
+        s = window / _RATE_SAMPLES / 2.0
+        ω = solver.angular_velocity(a + 2.0 * s * np.arange(_RATE_SAMPLES + 1.0))
+        tensor = solver.inertia_tensor
+        ω_dot = np.linalg.solve(tensor, np.cross(ω @ tensor.T, ω)[..., None])[..., 0]
+        G = solver.angular_momentum_norm
+        curvature = 0.5 * (2.0 * G * G * highest / (least * least)) * s * s
+        step = np.linalg.norm(ω_dot, axis=-1) * s + curvature
+        for name, vector in vectors:
+            found = float(np.max(np.linalg.norm(np.cross(ω, vector), axis=-1) + step))
+            rates[name] = max(rates[name], min(found, highest))
+    return rates
 
 
 def _orbit_samples(
@@ -180,7 +239,14 @@ def search_grid(
     step = min(longest, 2.0 * math.pi / (_SAMPLES_PER_TURN * rate))
     count = max(math.ceil((stop_s - start_s) / step) + 1, 2)
     return SearchGrid(
-        start_s, stop_s, (stop_s - start_s) / (count - 1), count, body, orbit_rate, speed
+        start_s,
+        stop_s,
+        (stop_s - start_s) / (count - 1),
+        count,
+        body,
+        orbit_rate,
+        speed,
+        _vector_rates(trajectory, spec, start_s, stop_s),
     )
 
 
@@ -380,11 +446,13 @@ class _Search:
             f"{v.name}.cos_incidence": 0.0 for v in spec.body_vectors
         }
 
-    def _rate(self, quantity: str) -> float:
-        """A bound on the quantity's rate of change (the incidence adds the lit fraction's)."""
+    def _rate(self, name: str, quantity: str) -> float:
+        """A bound on the rate of change of a vector's quantity (the incidence adds the
+        lit fraction's)."""
+        rate = self.grid.vector_angle_rate_bound(name)
         if quantity == "cos_incidence":
-            return self.grid.angle_rate_bound + self.grid.fraction_rate_bound
-        return self.grid.angle_rate_bound
+            return rate + self.grid.fraction_rate_bound
+        return rate
 
     def _condition_values(self, values: dict[str, NDArray]) -> dict[str, NDArray]:
         return {
@@ -431,10 +499,12 @@ class _Search:
                 # No light: 0 is the least incidence, placed from the intervals (result).
                 self.lows[(name, quantity)] = Extremum(float(τ[0]), 0.0)
             else:
-                problems[f"{key}.low"] = Problem(on_grid[f"{key}.low"], self._rate(quantity), low)
+                problems[f"{key}.low"] = Problem(
+                    on_grid[f"{key}.low"], self._rate(name, quantity), low
+                )
             problems[f"{key}.high"] = Problem(
                 on_grid[f"{key}.high"],
-                self._rate(quantity),
+                self._rate(name, quantity),
                 None if high is None else Extremum(high.time_s, -high.value),
             )
         if not problems:

@@ -178,3 +178,33 @@ def test_nothing_depends_on_the_chunks(cubesat, monkeypatch):
             assert abs(low.value - other_low.value) < 1e-8, quantity
             assert abs(high.value - other_high.value) < 1e-8, quantity
     assert len(analysis.shadow) == len(chunked.shadow) and len(analysis.umbra) == 1
+
+
+@pytest.mark.parametrize(
+    "name", ["spinner_thruster_pulse", "dzhanibekov_t_handle", "tumbling_defunct_satellite"]
+)
+def test_vector_rate_bounds_against_finite_differences(name):
+    # The search prunes brackets with each body vector's own rate bound (a vector on
+    # the spin axis turns far slower than the body): no chord of the vector's inertial
+    # direction, 1 ms apart over the first 20 min, may be faster than the bound, and the
+    # bound is within 5 % of the fastest chord (it is meant to prune).
+    from pathlib import Path
+
+    from attitude.pointing_search import search_grid
+    from attitude.scenario_file import load_scenario
+
+    file = load_scenario(Path(__file__).parents[1] / "scenarios" / f"{name}.toml")
+    vectors = file.pointing.body_vectors or [BodyVector("x", [1.0, 0.0, 0.0])]
+    spec = PointingSpec(vectors, file.pointing.orbit)
+    trajectory = propagate(file.scenario)
+    stop = min(1200.0, file.scenario.stop_s)
+    grid = search_grid(trajectory, spec, 0.0, stop)
+    τ = np.arange(0.0, stop, 1e-3)
+    attitude = trajectory.attitude(τ)
+    for vector in vectors:
+        u = attitude.apply(vector.vector)
+        chords = np.linalg.norm(np.diff(u, axis=0), axis=1) / np.diff(τ)
+        bound = grid.vector_rates_rad_s[vector.name]
+        assert np.max(chords) <= bound * (1.0 + 1e-9), vector.name
+        assert bound <= 1.05 * np.max(chords), vector.name
+        assert bound <= grid.body_rate_rad_s
