@@ -3,8 +3,8 @@
 A condition is a continuous function f(τ) of TT seconds since the epoch, true where
 f > 0 (for a Sun exclusion cone: cos(Sun angle) − cos(half angle)).  It is sampled
 on a search grid finer than the motion's fastest time scale, then every sign
-change is refined by bisection, all of them at once (vectorized), until the
-bracket is narrower than the stated precision: the ends do not depend on the
+change is refined (regula falsi, then bisection if needed), all of them at once
+(vectorized), until the bracket is narrower than the stated precision: the ends do not depend on the
 output step.  Conditions combine as interval sets (``difference``), e.g. "the Sun is
 in the tracker's cone and the spacecraft is not in umbra".  A long span is searched in
 chunks (bounded memory); ``join`` puts the pieces of an interval cut by a chunk's end
@@ -131,7 +131,7 @@ def find_all_intervals(
 ) -> dict[str, list[Interval]]:
     """:func:`find_intervals` for several conditions at once: ``evaluate(τ)`` gives
     every condition's function at τ (a dict by name; > 0 where it holds), and each
-    bisection step calls it once for the crossings of all of them.  ``grid_values``:
+    refinement step calls it once for the crossings of all of them.  ``grid_values``:
     each condition's function on the grid."""
     grid_s = np.asarray(grid_s, dtype=np.float64)
     names = list(grid_values)

@@ -18,11 +18,13 @@ rotation (bounded by √(2T/I_min) over the segments) plus the orbit's (the nadi
 angular rate, the rate of the Earth's angular radius, the Moon's parallax), and at
 most 30 s on an orbit (600 s at the Earth's centre).
 
-**Intervals**: a condition's sign changes on the grid are bisected on the exact
-motion (:func:`attitude.intervals.find_all_intervals`) to ``interval_precision``.
-**Extrema**: each grid minimum or maximum brackets an extremum, narrowed by
-golden-section search on the exact motion (:func:`attitude.extrema.least_of_each`) to
-1 µs, with brackets that cannot hold the answer dropped on the rate bound.
+**Intervals**: a condition's sign changes on the grid are refined on the exact
+motion (:func:`attitude.intervals.find_all_intervals`: regula falsi, then bisection
+where needed) to ``interval_precision``.  **Extrema**: each grid minimum or maximum
+brackets an extremum, narrowed by golden-section search on the exact motion
+(:func:`attitude.extrema.least_of_each`) to 1 µs, with brackets that cannot hold the
+answer dropped on a rate bound: each body vector's own (:func:`_vector_rates`) plus
+the sky's.
 ``tests/test_extrema_against_dense_sampling.py`` compares them with a sampling 100×
 denser than a 10 s output grid.
 
