@@ -89,8 +89,11 @@ MAX_SEARCH_POINTS = 100_000_000
 # this (radians for angles, or a cosine) is not refined.
 _EXTREMUM_PRECISION_S = 1e-6
 _EXTREMUM_TOLERANCE = 5e-9
-# A body vector's rate bound samples ω this many times over a body period.
+# A body vector's rate bound samples ω this many times over a body period of each
+# segment, and at most this many times in all (at least the last figure a segment).
 _RATE_SAMPLES = 16384
+_RATE_SAMPLES_IN_ALL = 2_000_000
+_RATE_SAMPLES_LEAST = 64
 
 
 @dataclass(frozen=True)
@@ -164,9 +167,10 @@ def _vector_rates(
     axis turns far slower than the body, and :func:`_body_rate` would keep every
     bracket of its Sun angle).
 
-    Per segment, ω(t) (body axes) is sampled :data:`_RATE_SAMPLES` times over one body
-    period of its solver, in which it takes all its values (the torque-free ω repeats
-    in the body), or over the part of the segment in the span if that is shorter.
+    Per segment, ω(t) (body axes) is sampled :data:`_RATE_SAMPLES` times (fewer when
+    many segments share :data:`_RATE_SAMPLES_IN_ALL`) over one body period of its
+    solver, in which it takes all its values (the torque-free ω repeats in the body),
+    or over the part of the segment in the span if that is shorter.
     Within s ≤ Δ/2 of a sample t_k, |ω(t) − ω(t_k)| ≤ |ω̇(t_k)| s + ½ max|ω̈| s², with
     ω̇ = I⁻¹(m × ω) (Euler's equations, m = Iω, ṁ = m × ω) at the sample, and
     |ω̈| = |I⁻¹((m × ω) × ω + m × ω̇)| ≤ (G ω_max² + G² ω_max / I_min) / I_min
@@ -175,10 +179,17 @@ def _vector_rates(
     """
     vectors = [(v.name, v.vector) for v in spec.body_vectors]
     rates = dict.fromkeys((name for name, _ in vectors), 0.0)
-    for segment in trajectory.segments:
+    segments = [
+        segment
+        for segment in trajectory.segments
+        if segment.end_s >= start_s and segment.start_s <= stop_s
+    ]
+    if not vectors or not segments:
+        return rates
+    # Thousands of events share the samples (the bound stays rigorous, only looser).
+    samples = min(_RATE_SAMPLES, max(_RATE_SAMPLES_LEAST, _RATE_SAMPLES_IN_ALL // len(segments)))
+    for segment in segments:
         a, b = max(segment.start_s, start_s), min(segment.end_s, stop_s)
-        if b < a:
-            continue
         solver = segment.solver
         least = float(np.min(solver.moments_of_inertia))
         highest = math.sqrt(max(2.0 * solver.kinetic_energy, 0.0) / least)
@@ -187,8 +198,8 @@ def _vector_rates(
             for name, _ in vectors:
                 rates[name] = max(rates[name], highest)
             continue
-        s = window / _RATE_SAMPLES / 2.0
-        ω = solver.angular_velocity(a + 2.0 * s * np.arange(_RATE_SAMPLES + 1.0))
+        s = window / samples / 2.0
+        ω = solver.angular_velocity(a + 2.0 * s * np.arange(samples + 1.0))
         tensor = solver.inertia_tensor
         ω_dot = np.linalg.solve(tensor, np.cross(ω @ tensor.T, ω)[..., None])[..., 0]
         G = solver.angular_momentum_norm
