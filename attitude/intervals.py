@@ -73,23 +73,29 @@ def _refine(
     kink, a flat end) goes on by bisection (Press et al., *Numerical Recipes*, 3rd
     ed., §9.2).  Each bracket's result depends on its own evaluations only."""
     a, b = a.copy(), b.copy()
-    everyone = np.arange(a.size)
     if fa is not None and fb is not None and a.size:
         fa, fb = np.asarray(fa, dtype=np.float64).copy(), np.asarray(fb, dtype=np.float64).copy()
         for _ in range(2):
+            which = np.flatnonzero(b - a > precision_s)
+            if which.size == 0:
+                break
             with np.errstate(divide="ignore", invalid="ignore"):
                 x = (a * fb - b * fa) / (fb - fa)
-            x = np.where(np.isfinite(x) & (x > a) & (x < b), x, 0.5 * (a + b))
-            fx = f(x, everyone)
-            same_as_a = (fx > 0.0) == inside_at_a
-            a, fa = np.where(same_as_a, x, a), np.where(same_as_a, fx, fa)
-            b, fb = np.where(same_as_a, b, x), np.where(same_as_a, fb, fx)
+            x = np.where(np.isfinite(x) & (x > a) & (x < b), x, 0.5 * (a + b))[which]
+            fx = f(x, which)
+            same_as_a = (fx > 0.0) == inside_at_a[which]
+            a[which] = np.where(same_as_a, x, a[which])
+            fa[which] = np.where(same_as_a, fx, fa[which])
+            b[which] = np.where(same_as_a, b[which], x)
+            fb[which] = np.where(same_as_a, fb[which], fx)
         with np.errstate(divide="ignore", invalid="ignore"):
             x = (a * fb - b * fa) / (fb - fa)
         x = np.where(np.isfinite(x), x, 0.5 * (a + b))
         for probe in (x - 0.49 * precision_s, x + 0.49 * precision_s):
             probe = np.clip(probe, a, b)
             which = np.flatnonzero((b - a > precision_s) & (probe > a) & (probe < b))
+            if which.size == 0:
+                continue
             same_as_a = (f(probe[which], which) > 0.0) == inside_at_a[which]
             a[which] = np.where(same_as_a, probe[which], a[which])
             b[which] = np.where(same_as_a, b[which], probe[which])
