@@ -208,3 +208,32 @@ def test_vector_rate_bounds_against_finite_differences(name):
         assert np.max(chords) <= bound * (1.0 + 1e-9), vector.name
         assert bound <= 1.05 * np.max(chords), vector.name
         assert bound <= grid.body_rate_rad_s
+
+
+@pytest.mark.parametrize("lipschitz", [3.95, math.inf])
+def test_least_against_scipy_bounded_minimization(lipschitz):
+    # f = cos 3t + 0.1 t + 0.05 sin 17t on [0, 10], |f'| ≤ 3 + 0.1 + 0.85 < 4: the
+    # least of its many local minima, against scipy's bounded Brent search started in
+    # each of them (found on a grid 100x finer); with a rate bound that prunes brackets
+    # (3.95) and with none (inf: every bracket refined).
+    from scipy.optimize import minimize_scalar
+
+    from attitude.extrema import least
+
+    def f(t):
+        return np.cos(3.0 * t) + 0.1 * t + 0.05 * np.sin(17.0 * t)
+
+    grid = np.linspace(0.0, 10.0, 1001)
+    found = least(f, grid, f(grid), lipschitz, 1e-12, 1e-9)
+    fine = np.linspace(0.0, 10.0, 100_001)
+    values = f(fine)
+    local = np.flatnonzero((values[1:-1] < values[:-2]) & (values[1:-1] <= values[2:])) + 1
+    reference = min(
+        minimize_scalar(
+            f, bounds=(fine[k - 1], fine[k + 1]), method="bounded", options={"xatol": 1e-12}
+        ).fun
+        for k in local
+    )
+    assert found.value <= reference + 1e-12
+    assert abs(found.value - reference) < 1e-10
+    assert abs(f(found.time_s) - found.value) == 0.0
