@@ -11,8 +11,10 @@ The layers, each importing only the ones above it in this list (README "Layout")
 - ``attitude.torqued_segment``, ``trajectory``, ``horizon``, ``motion_analysis``:
   the propagated motion
 - ``attitude.ephemeris``, ``earth``, ``frames``, ``orbit``, ``keplerian``, ``oem``,
-  ``aem_input``, ``intervals``, ``extrema``, ``eclipse``, ``pointing``: pointing
-- ``attitude.exports``, ``aem``, ``plots``, ``report_page``, ``report``: reports and exports
+  ``aem_input``, ``intervals``, ``extrema``, ``eclipse``, ``pointing_spec``,
+  ``surroundings``, ``pointing_sampling``, ``pointing_search``, ``pointing``: pointing
+- ``attitude.exports``, ``aem``, ``summaries``, ``plots``, ``report_page``, ``report``: reports
+  and exports
 - ``attitude.scenario_file``, ``cli``: scenario files and the command line
 
 The names below are importable from ``attitude`` directly; all but the errors are

@@ -278,6 +278,16 @@ def write_aem(
     return _write_atomically(Path(path), buffer.getvalue())
 
 
+def aem_text(value: str, upper: bool = True, width: int = 60) -> str:
+    """A free text (a spacecraft's or a scenario's name) made a value the AEM accepts:
+    printable ASCII (any other character, such as the en dash of "T-handle – flip",
+    becomes a blank), single blanks, at most ``width`` characters, in upper case for a
+    keyword value; "UNKNOWN" when nothing is left."""
+    text = "".join(c if c.isascii() and c.isprintable() else " " for c in value)
+    text = " ".join(text.split())[:width].rstrip()
+    return (text.upper() if upper else text) or "UNKNOWN"
+
+
 class AemWriter:
     """An AEM 2.0 KVN message written as it is produced, into a binary ``stream``.
 

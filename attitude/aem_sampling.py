@@ -42,10 +42,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import BinaryIO
 
 import numpy as np
 from numpy.typing import NDArray
 
+from attitude.aem import AemWriter
+from attitude.epoch_texts import EpochTexts
 from attitude.errors import InputError
 from attitude.motion_analysis import SegmentMotion
 from attitude.timescales import SAME_INSTANT_S
@@ -59,6 +62,7 @@ __all__ = [
     "AemSegmentPlan",
     "lagrange_quaternions",
     "plan_aem",
+    "write_planned_aem",
 ]
 
 DEFAULT_TOLERANCE_RAD = 1e-6
@@ -316,3 +320,61 @@ def plan_aem(
         except InputError as exc:
             raise InputError(f"{name}: {exc}") from None
     return AemPlan(tolerance_rad, plans)
+
+
+def write_planned_aem(
+    stream: BinaryIO,
+    trajectory: Trajectory,
+    plan: AemPlan,
+    texts: EpochTexts,
+    *,
+    object_name: str,
+    object_id: str,
+    comments: tuple[str, ...] = (),
+    chunk_records: int = 16384,
+) -> None:
+    """The AEM of ``plan`` into the binary ``stream``, written as it is computed: a
+    segment per stretch of motion, its records ``chunk_records`` at a time, each
+    declaring the interpolation it was sampled for (:data:`INTERPOLATION_METHOD`).
+
+    ``texts``: the epoch texts of the scenario's time scale; ``comments``: the
+    header's first comment lines (a statement of the sampling's accuracy follows them).
+    """
+    scenario = trajectory.scenario
+    writer = AemWriter(
+        stream,
+        object_name=object_name,
+        object_id=object_id,
+        time_scale=scenario.time_scale,
+        comments=(
+            *comments,
+            f"sampled so that {INTERPOLATION_METHOD} interpolation as declared (each of "
+            "Q1..QC over the degree + 1 records",
+            f"centred on the interval, normalized) stays within {plan.tolerance_rad:g} "
+            "rad of the exact attitude",
+        ),
+    )
+    for item in plan.segments:
+        segment = trajectory.segments[item.segment]
+        ends = texts(np.array([item.start_s, item.end_s]))
+        writer.begin_segment(
+            ends[0].decode("ascii"),
+            ends[1].decode("ascii"),
+            interpolation=None if item.degree is None else (INTERPOLATION_METHOD, item.degree),
+            comments=(
+                f"motion segment {item.segment}",
+                *((f"started by {segment.event.kind}",) if segment.event else ()),
+                f"a record every {item.step_s:.6g} s",
+            ),
+        )
+        for first in range(0, item.count, chunk_records):
+            τ = item.seconds(first, first + chunk_records)
+            # One record is evaluated as a pair (see attitude.exports.sample).
+            pair = np.repeat(τ, 2) if τ.size == 1 else τ
+            writer.write_records(
+                texts(τ),
+                segment.solver.attitude_quaternion(pair)[: τ.size],
+                segment.solver.angular_velocity(pair)[: τ.size],
+            )
+        writer.end_segment()
+    writer.close()

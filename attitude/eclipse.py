@@ -229,7 +229,7 @@ def eclipse_intervals(
     ``orbit``: an :class:`attitude.orbit.Orbit` (anything with
     ``position_velocity(times)``).  The edges are the roots of the continuous functions
     c − (a + b) (shadow) and c − (b − a) (umbra), sampled every ``step_s`` seconds;
-    each sign change is bisected on the orbit and the ephemeris themselves
+    each sign change is refined on the orbit and the ephemeris themselves
     (:func:`attitude.intervals.find_intervals`) to ``precision_s``.  Measured on an
     ISS orbit over a day: the edges agree with a root search on direct skyfield
     positions (``tests/test_eclipse_against_direct_geometry.py``) to the precision

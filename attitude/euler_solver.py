@@ -98,12 +98,13 @@ def _one_rotation(q_scalar_last: NDArray[np.float64]) -> Rotation:
     scipy's public constructors cost ~8 µs for a single quaternion (array-API
     dispatch and checks), five times the rest of a scalar ``attitude(t)``; its internal
     constructor, which skips them, ~2 µs.  That one is private, so it is used only
-    where it exists with the signature we know, and tests/test_fast_paths_against_the_general_ones.py
-    checks that it gives the public constructor's rotation.
+    where it exists with the signature we know, and
+    tests/test_fast_paths_against_the_general_ones.py checks that it gives the public
+    constructor's rotation.
     """
     try:
-        from_raw_quat = Rotation._from_raw_quat  # private: not in the stubs
-        return from_raw_quat(q_scalar_last, xp=_NUMPY_NAMESPACE)
+        # Private, so scipy-stubs does not declare it.
+        return Rotation._from_raw_quat(q_scalar_last, xp=_NUMPY_NAMESPACE)  # type: ignore[attr-defined]
     except (AttributeError, TypeError):  # pragma: no cover  (another scipy)
         return Rotation(q_scalar_last, normalize=False, copy=False)
 

@@ -1,7 +1,8 @@
-"""Time series (CSV) and summary (JSON) files of a propagated scenario.
+"""The time series of a propagated scenario (its columns, the CSV), intervals.csv and
+the JSON writer (what the summary says is :mod:`attitude.summaries`).
 
-The CSV opens with ``#`` lines that state the epoch and time scale, the frames,
-the units and the quaternion convention; each column's name carries its frame and
+The CSV opens with ``#`` lines that state the epoch and time scale, the frames, the
+units and the quaternion convention; each column's name carries its frame and
 unit (``omega_body_x_rad_s``, ``q_body_to_icrf_w``).  Each number is written as the
 shortest text that reads back as the same double (17 significant digits at most:
 ``0.1``, not ``0.10000000000000001``), so a file read back gives the same doubles.
@@ -23,9 +24,12 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from attitude.intervals import Interval, total_duration
-from attitude.motion_analysis import LISTED_FLIPS, SegmentMotion
-from attitude.pointing import PointingAnalysis, PointingSamples
+from attitude.intervals import Interval
+from attitude.pointing import PointingAnalysis, PointingSamples, PointingSpec
+
+# The summaries moved to attitude.summaries; importable from here too, as callers of
+# this module (attitude.montecarlo) import them.
+from attitude.summaries import motion_summary, pointing_summary
 from attitude.trajectory import Trajectory
 
 __all__ = [
@@ -34,6 +38,7 @@ __all__ = [
     "Samples",
     "arrow_texts",
     "motion_summary",
+    "pointing_column_count",
     "pointing_columns",
     "pointing_summary",
     "right_ascension_deg",
@@ -248,75 +253,6 @@ def write_json(path: Path, data: dict[str, Any]) -> None:
     )
 
 
-_MOTION_TEXT = {
-    "periodic": "periodic: m(t) repeats every body period",
-    "steady spin": "steady spin: m is fixed in the body and the body turns about it; "
-    "no period of m, no flips, no nutation",
-    "separatrix": "separatrix: no period; m leaves the intermediate axis and returns to it "
-    "asymptotically, so the body turns over at most once",
-    "rest": "at rest: no motion",
-    "torqued": "under torques (propagated by splitting with the exact free flow): no "
-    "period, flips not located; the kinetic energy and momentum are those at its start",
-}
-
-
-def _flips_summary(scenario, motion: list[SegmentMotion]) -> dict[str, Any]:
-    """All flips: their count, and their times up to LISTED_FLIPS (an event's epoch can
-    end one segment and start the next with the same flip: it counts once)."""
-    listed = np.concatenate([item.flip_times_s for item in motion]) if motion else np.empty(0)
-    listed, repeated = np.unique(listed, return_counts=True)
-    count = sum(item.flip_count for item in motion) - int(np.sum(repeated - 1))
-    listed = listed[:LISTED_FLIPS]
-    complete = listed.size == count
-    return {
-        "count": count,
-        "times_s": listed,
-        "times": [scenario.format_epoch(t) for t in listed[:1000]],
-        "note": None
-        if complete
-        else f"times_s lists the first {listed.size} of {count} flips (closed form)",
-    }
-
-
-def motion_summary(trajectory: Trajectory, motion: list[SegmentMotion]) -> dict[str, Any]:
-    """The JSON summary of the motion: segments, events, flips, precession, nutation."""
-    scenario = trajectory.scenario
-    segments = []
-    for k, (segment, item) in enumerate(zip(trajectory.segments, motion, strict=True)):
-        event = segment.event
-        segments.append(
-            {
-                "index": k,
-                "start": scenario.format_epoch(item.start_s),
-                "start_s": item.start_s,
-                "end_s": item.end_s,
-                "started_by": None
-                if event is None
-                else {"type": event.kind, "label": event.label or None},
-                "formula": item.formula,
-                "motion": item.motion,
-                "motion_description": _MOTION_TEXT[item.motion],
-                "body_period_s": item.period_s,
-                "flip_period_s": item.flip_period_s,
-                "flip_count": item.flip_count,
-                "spin_axis_body": item.spin_axis_body,
-                "nutation_angle_min_deg": None
-                if item.nutation_min_rad is None
-                else math.degrees(item.nutation_min_rad),
-                "nutation_angle_max_deg": None
-                if item.nutation_max_rad is None
-                else math.degrees(item.nutation_max_rad),
-                "nutation_period_s": item.nutation_period_s,
-                "spin_period_s": item.spin_period_s,
-                "precession_period_s": item.precession_period_s,
-                "kinetic_energy_J": item.kinetic_energy_J,
-                "angular_momentum_icrf_N_m_s": item.inertial_angular_momentum_N_m_s,
-                "angular_momentum_norm_N_m_s": item.angular_momentum_norm_N_m_s,
-            }
-        )
-    return {"segments": segments, "flips": _flips_summary(scenario, motion)}
-
-
 def right_ascension_deg(radians: NDArray[np.float64]) -> NDArray[np.float64]:
     """Right ascensions in degrees, in [0, 360): an angle a hair below 2π rounds to
     360.0 in degrees, which is written as 0."""
@@ -330,6 +266,29 @@ def _flag(name: str, values, description: str) -> list[Column]:
 
 def _degrees(name: str, values, description: str) -> list[Column]:
     return [] if values is None else [Column(name, np.degrees(values), description)]
+
+
+def pointing_column_count(spec: PointingSpec) -> int:
+    """How many columns :func:`pointing_columns` gives for ``spec``, known before
+    anything is sampled (for the size estimate of ``attitude.output_budget``):
+    the Sun's direction; on an orbit the lit fraction, the Earth's angular radius and
+    the LVLH quaternion (and Euler angles when asked); per vector its Sun, Moon, RA
+    and Dec columns and incidence, on an orbit its nadir and limb angles, and a flag
+    per constraint."""
+    columns = 3
+    if spec.on_orbit:
+        columns += 2 + 4 + (3 if spec.lvlh_euler_sequence is not None else 0)
+    for v in spec.body_vectors:
+        columns += 5 + (2 if spec.on_orbit else 0)
+        columns += sum(
+            angle is not None
+            for angle in (
+                v.sun_exclusion_half_angle_rad,
+                v.moon_exclusion_half_angle_rad,
+                v.earth_limb_exclusion_angle_rad,
+            )
+        )
+    return columns
 
 
 def pointing_columns(samples: PointingSamples) -> list[Column]:
@@ -423,108 +382,46 @@ def pointing_columns(samples: PointingSamples) -> list[Column]:
 _VECTOR_INTERVALS = ("sun_exclusion", "moon_exclusion", "earth_limb_exclusion", "sun_visible")
 
 
-def _interval_rows(analysis: PointingAnalysis) -> list[tuple[str, str, Interval]]:
-    rows = [("eclipse", "", i) for i in analysis.shadow]
-    rows += [("umbra", "", i) for i in analysis.umbra]
-    rows += [("moon_behind_earth", "", i) for i in analysis.moon_hidden]
+def _interval_kinds(analysis: PointingAnalysis) -> list[tuple[str, str, list[Interval]]]:
+    """Each kind of interval with its body vector and its intervals (in time order), in
+    the file's order: by kind, then by body vector name."""
+    kinds = [
+        ("eclipse", "", analysis.shadow),
+        ("umbra", "", analysis.umbra),
+        ("moon_behind_earth", "", analysis.moon_hidden),
+    ]
     for item in analysis.vectors:
-        for kind in _VECTOR_INTERVALS:
-            rows += [(kind, item.vector.name, i) for i in getattr(item, kind)]
-    return sorted(rows, key=lambda row: (row[0], row[1], row[2].start_s))
+        kinds += [(kind, item.vector.name, getattr(item, kind)) for kind in _VECTOR_INTERVALS]
+    return sorted(kinds, key=lambda entry: entry[:2])
+
+
+# intervals.csv is written this many rows at a time: its epoch texts are made in bulk,
+# and a month of a spinner's windows (a million rows) is never held as text at once.
+_INTERVAL_ROWS_AT_A_TIME = 16384
 
 
 def write_intervals_csv(
     path: Path, analysis: PointingAnalysis, iso, preamble: list[str]
 ) -> None:
-    """One row per interval: kind, body vector, start and end (ISO and TT s), duration.
+    """One row per interval: kind, body vector, start and end (ISO and TT s), duration;
+    sorted by kind, body vector and start.
 
     ``iso``: a function from TT seconds to ISO texts in the scenario's time scale.
     """
-    rows = _interval_rows(analysis)
-    starts = iso(np.array([r[2].start_s for r in rows])) if rows else []
-    ends = iso(np.array([r[2].end_s for r in rows])) if rows else []
     with open(path, "w", encoding="utf-8", newline="") as stream:
         for line in preamble:
             stream.write(f"# {line}\n")
         stream.write(
             "kind,body_vector,start,end,start_s,end_s,duration_s,starts_before_span,ends_after_span\n"
         )
-        for (kind, name, i), start, end in zip(rows, starts, ends, strict=True):
-            stream.write(
-                f"{kind},{name},{start},{end},{i.start_s:.9f},{i.end_s:.9f},{i.duration_s:.9f},"
-                f"{int(i.starts_before)},{int(i.ends_after)}\n"
-            )
-
-
-def _interval_totals(intervals: list[Interval], format_epoch=None) -> dict[str, Any]:
-    totals: dict[str, Any] = {
-        "count": len(intervals),
-        "total_s": total_duration(intervals),
-        "longest_s": max((i.duration_s for i in intervals), default=0.0),
-    }
-    if format_epoch is not None:
-        totals["first"] = [
-            {
-                "start": format_epoch(i.start_s),
-                "end": format_epoch(i.end_s),
-                "duration_s": i.duration_s,
-            }
-            for i in intervals[:20]
-        ]
-    return totals
-
-
-# The extrema in the summary: (key in VectorAnalysis.extrema, summary name, in degrees).
-_EXTREMA = (
-    ("sun_angle", "sun_angle", True),
-    ("moon_angle", "moon_angle", True),
-    ("nadir_angle", "nadir_angle", True),
-    ("earth_limb_angle", "earth_limb_angle", True),
-    ("cos_incidence", "cos_incidence", False),
-)
-
-
-def pointing_summary(analysis: PointingAnalysis, format_epoch) -> dict[str, Any]:
-    """Extrema with their times, constraint and visibility totals, eclipses: all found
-    on the exact motion over the analysed span (``attitude.pointing.pointing_analysis``),
-    none from the output grid."""
-    vectors = {}
-    for item in analysis.vectors:
-        v = item.vector
-        entry: dict[str, Any] = {"kind": v.kind, "vector_body": v.vector}
-        for key, name, degrees in _EXTREMA:
-            if key not in item.extrema:
-                continue
-            low, high = item.extrema[key]
-            unit = "_deg" if degrees else ""
-            convert = math.degrees if degrees else float
-            entry[f"{name}_min{unit}"] = convert(low.value)
-            entry[f"{name}_min_at"] = format_epoch(low.time_s)
-            entry[f"{name}_max{unit}"] = convert(high.value)
-            entry[f"{name}_max_at"] = format_epoch(high.time_s)
-        entry["mean_cos_incidence"] = item.mean_cos_incidence
-        entry["sun_visible"] = _interval_totals(item.sun_visible)
-        for constraint, angle in (
-            ("sun_exclusion", "sun_exclusion_half_angle_deg"),
-            ("moon_exclusion", "moon_exclusion_half_angle_deg"),
-            ("earth_limb_exclusion", "earth_limb_exclusion_angle_deg"),
-        ):
-            if getattr(v, angle) is not None:
-                entry[angle] = getattr(v, angle)
-                entry[constraint] = _interval_totals(getattr(item, constraint), format_epoch)
-        vectors[v.name] = entry
-    summary: dict[str, Any] = {
-        "position": analysis.orbit,
-        "span": {"start": format_epoch(analysis.start_s), "stop": format_epoch(analysis.stop_s)},
-        "interval_precision_s": analysis.precision_s,
-        "search_step_s": analysis.grid.step_s,
-        "body_vectors": vectors,
-    }
-    if analysis.on_orbit:
-        summary["eclipses"] = {
-            "shadow": _interval_totals(analysis.shadow),
-            "umbra": _interval_totals(analysis.umbra),
-            "sunlit_fraction_of_span": analysis.sunlit_fraction_mean,
-        }
-        summary["moon_behind_earth"] = _interval_totals(analysis.moon_hidden)
-    return summary
+        for kind, name, intervals in _interval_kinds(analysis):
+            # Each list is in time order already (the search finds them so).
+            for first in range(0, len(intervals), _INTERVAL_ROWS_AT_A_TIME):
+                block = intervals[first : first + _INTERVAL_ROWS_AT_A_TIME]
+                starts = iso(np.array([i.start_s for i in block]))
+                ends = iso(np.array([i.end_s for i in block]))
+                stream.writelines(
+                    f"{kind},{name},{start},{end},{i.start_s:.9f},{i.end_s:.9f},"
+                    f"{i.duration_s:.9f},{int(i.starts_before)},{int(i.ends_after)}\n"
+                    for i, start, end in zip(block, starts, ends, strict=True)
+                )

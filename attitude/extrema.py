@@ -10,14 +10,14 @@ derivatives, through kinks too (the angle between two directions has one where t
 meet, at 0).  All brackets are narrowed at once, one vectorized call of f per step.
 
 Most brackets cannot hold the answer, and are dropped as soon as that is proven: f
-changes at most at a rate ``lipschitz`` (rad/s for an angle: the body's fastest
-rotation plus the geometry's), so inside a bracket whose evaluated points are at most
-g apart f is at least (the least of them) − lipschitz·g/2.  A bracket whose bound is
-above the best value found so far, or within ``tolerance`` of it (it could improve it
-by less than that), is dropped.  Brackets whose minima tie to within ``tolerance`` (a
-spinner in a fixed Sun) stop there: any of them is the answer.  The result does not
-depend on the output step; it depends on the search grid only through which brackets
-exist.
+changes at most at a rate ``lipschitz`` (rad/s for an angle: the vector's fastest
+turn plus the geometry's), so between two evaluated points g apart where f is fp and
+fq, f is at least (fp + fq − lipschitz·g)/2, where the two steepest descents meet.
+A bracket whose bound is above the best value found so far, or within ``tolerance``
+of it (it could improve it by less than that), is dropped.  Brackets whose minima
+tie to within ``tolerance`` (a spinner in a fixed Sun) stop there: any of them is the
+answer.  The result does not depend on the output step; it depends on the search grid
+only through which brackets exist.
 """
 
 from __future__ import annotations
@@ -79,6 +79,16 @@ def least(
     return found["f"]
 
 
+def _lowest(fp, fq, width, lipschitz: float):
+    """The least value a function of rate at most ``lipschitz`` can take between two
+    points ``width`` apart where it is fp and fq: its two slopes meet at
+    (fp + fq − lipschitz · width) / 2 (no lower than the lesser of them when the
+    points are one; −inf for an unbounded rate)."""
+    with np.errstate(invalid="ignore"):
+        meet = 0.5 * (fp + fq - lipschitz * width)
+    return np.where(width > 0.0, meet, np.minimum(fp, fq))
+
+
 class _Brackets:
     """The golden-section brackets of one problem: a < x1 < x2 < b and f there."""
 
@@ -130,8 +140,13 @@ class _Brackets:
     def keep(self, best: float, lipschitz: float, tolerance: float, precision_s: float) -> bool:
         """Drop the brackets that cannot beat ``best`` by more than ``tolerance`` and those
         narrower than ``precision_s``; True while any is left."""
-        widest = np.maximum.reduce([self.x1 - self.a, self.x2 - self.x1, self.b - self.x2])
-        bound = np.minimum.reduce([self.fa, self.f1, self.f2, self.fb]) - lipschitz * widest / 2
+        bound = np.minimum.reduce(
+            [
+                _lowest(self.fa, self.f1, self.x1 - self.a, lipschitz),
+                _lowest(self.f1, self.f2, self.x2 - self.x1, lipschitz),
+                _lowest(self.f2, self.fb, self.b - self.x2, lipschitz),
+            ]
+        )
         alive = (bound < best - tolerance) & (self.b - self.a > precision_s)
         for name in ("a", "b", "fa", "fb", "x1", "x2", "f1", "f2"):
             setattr(self, name, getattr(self, name)[alive])
@@ -150,7 +165,6 @@ def least_of_each(
     once for the brackets of all of them."""
     grid_s = np.asarray(grid_s, dtype=np.float64)
     n = grid_s.size
-    steps = np.diff(grid_s)
     best: dict[str, Extremum] = {}
     brackets: dict[str, _Brackets] = {}
     for name, problem in problems.items():
@@ -166,8 +180,12 @@ def least_of_each(
         left = np.concatenate([[np.inf], values[:-1]])
         right = np.concatenate([values[1:], [np.inf]])
         k = np.flatnonzero((values < left) & (values <= right))
-        gap = np.maximum(np.concatenate([[0.0], steps])[k], np.concatenate([steps, [0.0]])[k])
-        keep = values[k] - problem.lipschitz * gap / 2.0 < best[name].value - tolerance
+        lo, hi = np.maximum(k - 1, 0), np.minimum(k + 1, n - 1)
+        bound = np.minimum(
+            _lowest(values[lo], values[k], grid_s[k] - grid_s[lo], problem.lipschitz),
+            _lowest(values[k], values[hi], grid_s[hi] - grid_s[k], problem.lipschitz),
+        )
+        keep = bound < best[name].value - tolerance
         keep |= k == i  # the grid's own best is always refined
         k = k[keep]
         if k.size == 0:

@@ -178,6 +178,16 @@ class TleOrbit(Orbit):
             epoch = self.epoch.isot
         return f"TLE {self.lines[0][2:7]} (SGP4, element epoch {epoch} UTC)"
 
+    @property
+    def international_designator(self) -> str | None:
+        """The COSPAR designator from line 1 (columns 10–17: launch year, launch number,
+        piece), written as 1998-067A; None when the TLE leaves it blank or malformed."""
+        designator = self.lines[0][9:17].strip()
+        if len(designator) < 5 or not designator[:5].isdigit():
+            return None
+        year = int(designator[:2])  # two digits: 57-99 are 1957-1999
+        return f"{1900 + year if year >= 57 else 2000 + year}-{designator[2:]}"
+
     def state_tt(self, jd1, jd2):
         """SGP4 at every epoch (TEME), rotated to the GCRS as skyfield rotates it."""
         t = timescale().tt_jd(jd1, jd2)

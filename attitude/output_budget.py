@@ -103,19 +103,24 @@ def estimate(
     formats: tuple[str, ...] = ("csv", "aem", "plots", "report"),
     aem_records: int | None = None,
     chunk_samples: int = 16384,
+    pointing_columns: int | None = None,
 ) -> OutputBudget:
     """The memory and file sizes of a run with ``samples`` output epochs.
 
     ``search_grid_points``: the interval search grid of the pointing (0 without one),
     ``body_vectors`` and ``on_orbit``: the pointing columns; ``formats``: the chosen
     outputs; ``aem_records``: the AEM's records (``attitude.aem_sampling``; the
-    output epochs when None).  Python ints: a hostile span of 1e9 s every 1e-3 s is
-    1e12 samples, and is counted, not allocated.
+    output epochs when None); ``pointing_columns``: the time series' pointing columns
+    (``attitude.exports.pointing_column_count``; without it, the fewest a pointing
+    with these vectors can have: 3, and 5 a vector).  Python ints: a hostile span of
+    1e9 s every 1e-3 s is 1e12 samples, and is counted, not allocated.
     """
     columns = _TRAJECTORY_COLUMNS
     pointing = bool(body_vectors or on_orbit)
-    if pointing:
-        columns += 3 + (2 if on_orbit else 0) + 6 * body_vectors
+    if pointing_columns is not None:
+        columns += pointing_columns
+    elif pointing:
+        columns += 3 + 5 * body_vectors
     chunk = min(samples, chunk_samples)
     memory = _BASE_MEMORY + chunk * (
         _MEMORY_PER_CHUNK_SAMPLE + _MEMORY_PER_CHUNK_SAMPLE_PER_VECTOR * body_vectors

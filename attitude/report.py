@@ -40,20 +40,19 @@ from typing import Any
 
 import numpy as np
 
-from attitude.aem import AemWriter
-from attitude.aem_sampling import INTERPOLATION_METHOD
+from attitude.aem import aem_text
+from attitude.aem_sampling import INTERPOLATION_METHOD, write_planned_aem
 from attitude.epoch_texts import EpochTexts
 from attitude.exports import (
     QUATERNION_CONVENTION,
     CsvWriter,
-    motion_summary,
     pointing_columns,
-    pointing_summary,
     sample,
     trajectory_columns,
     write_intervals_csv,
     write_json,
 )
+from attitude.orbit import TleOrbit
 from attitude.output_budget import check_fits
 from attitude.output_folder import claim
 from attitude.output_formats import OUTPUT_NAMES, OutputChoice
@@ -81,6 +80,7 @@ from attitude.report_figures import (
 from attitude.report_page import render_page
 from attitude.run_plan import RunPlan, plan_run
 from attitude.scenario import Scenario
+from attitude.summaries import motion_summary, outputs_summary, pointing_summary, scenario_summary
 from attitude.timeseries_parquet import ParquetWriter
 from attitude.torques_summary import torques_summary
 from attitude.version import __version__
@@ -104,73 +104,6 @@ class Progress:
     def __call__(self, message: str) -> None:
         if self._write is not None:
             self._write(f"[{time.perf_counter() - self._start:7.1f} s] {message}")
-
-
-def _scenario_summary(scenario: Scenario, source: str) -> dict[str, Any]:
-    craft = scenario.spacecraft
-    return {
-        "name": scenario.name,
-        "file": source,
-        "epoch": scenario.format_epoch(0.0),
-        "time_scale": scenario.time_scale.upper(),
-        "stop": scenario.format_epoch(scenario.stop_s),
-        "duration_s": scenario.stop_s,
-        "output": {
-            "start": scenario.format_epoch(scenario.start_s),
-            "step_s": scenario.step_s,
-            "samples": scenario.output_count(),
-        },
-        "spacecraft": {
-            "name": craft.name,
-            "inertia_tensor_body_kg_m2": craft.inertia_tensor,
-            "principal_moments_kg_m2": craft.principal_moments,
-        },
-        "events": [_event_summary(scenario, t, event) for t, event in scenario.events],
-    }
-
-
-def _event_summary(scenario: Scenario, offset_s: float, event) -> dict[str, Any]:
-    """An event as the user gave it: its epoch, and what it changes."""
-    entry: dict[str, Any] = {
-        "type": event.kind,
-        "label": event.label or None,
-        "epoch": scenario.format_epoch(offset_s),
-        "offset_s": offset_s,
-    }
-    if event.kind == "angular_impulse":
-        entry["impulse_N_m_s"] = event.impulse
-        entry["frame"] = event.frame  # body axes, or inertial (ICRF) axes
-    elif event.kind == "inertia_change":
-        entry["inertia_tensor_body_kg_m2"] = event.inertia.tensor
-        entry["principal_moments_kg_m2"] = event.inertia.moments
-    else:
-        if event.attitude is not None:
-            entry["q_body_to_icrf_wxyz"] = event.attitude.as_quat(scalar_first=True)
-        if event.angular_velocity is not None:
-            entry["angular_velocity_body_rad_s"] = event.angular_velocity
-        if event.angular_momentum is not None:
-            entry["angular_momentum_body_N_m_s"] = event.angular_momentum
-    return entry
-
-
-def _aem_text(value: str, upper: bool = True, width: int = 60) -> str:
-    """A text value the AEM accepts: printable ASCII (any other character, such as the
-    en dash of "T-handle – flip", becomes a blank), single blanks, at most ``width``
-    characters, in upper case for a keyword value."""
-    text = "".join(c if c.isascii() and c.isprintable() else " " for c in value)
-    text = " ".join(text.split())[:width].rstrip()
-    return (text.upper() if upper else text) or "UNKNOWN"
-
-
-def _object_id(tle: tuple[str, str] | None) -> str:
-    """The international designator from a TLE (line 1, columns 10–17), e.g. 1998-067A."""
-    if tle is None:
-        return "UNKNOWN"
-    designator = tle[0][9:17].strip()
-    if len(designator) < 5 or not designator[:5].isdigit():
-        return "UNKNOWN"
-    year = int(designator[:2])
-    return f"{1900 + year if year >= 57 else 2000 + year}-{designator[2:]}"
 
 
 def output_grid(scenario: Scenario, first: int, stop: int) -> np.ndarray:
@@ -343,79 +276,30 @@ class _Stream:
 def _build(
     plan: RunPlan, tmp: Path, source: str, progress: Progress, chunk_samples: int = CHUNK_SAMPLES
 ) -> tuple[dict[str, Any], list[str]]:
-    """Stream ``plan``'s outputs into ``tmp``: (summary, file names)."""
-    scenario, spec, outputs = plan.scenario, plan.pointing, plan.outputs
-    trajectory, motion = plan.trajectory, plan.motion
-    count = scenario.output_count()
-    texts = EpochTexts(scenario.epoch)
-    source_of_pointing = None if spec.is_empty else _Pointing(plan)
-    chunk = max(1, int(chunk_samples))
-    series = [name for name in ("timeseries.csv", "timeseries.parquet") if name[11:] in outputs]
-    progress(
-        f"sampling {count} epochs over {scenario.stop_s:g} s, {min(chunk, count)} at a time"
-        + (f": writing {', '.join(series)}" if series else "")
-        + (
-            f"; pointing: {len(spec.body_vectors)} body vectors, "
-            f"{'Earth centre' if spec.orbit is None else spec.orbit.describe()}"
-            if source_of_pointing
-            else ""
-        )
-    )
-    stream = _Stream(plan, tmp, source, texts)
-    with stream.stack:
-        shown = time.perf_counter()
-        for first in range(0, count, chunk):
-            τ = output_grid(scenario, first, first + chunk)
-            samples = sample(trajectory, τ)
-            pointing = None if source_of_pointing is None else source_of_pointing.samples(τ)
-            stream.add(τ, samples, pointing)
-            # After the first chunk (a stream has started), then every few seconds.
-            late = first == 0 or time.perf_counter() - shown > _PROGRESS_EVERY_S
-            if late and first + chunk < count:
-                shown = time.perf_counter()
-                progress(f"  {100.0 * (first + chunk) / count:.0f}% ({first + chunk} epochs)")
+    """Stream ``plan``'s outputs into ``tmp``: (summary, file names).
+
+    In order: the output grid streamed into the time series and the figures'
+    envelopes; the pointing's exact search (intervals.csv, the summary's pointing); the
+    AEM over its own records; the figures; summary.json and the page."""
+    outputs = plan.outputs
+    texts = EpochTexts(plan.scenario.epoch)
+    pointing = None if plan.pointing.is_empty else _Pointing(plan)
+    stream = _stream_output_grid(plan, tmp, source, texts, pointing, progress, chunk_samples)
     files = list(stream.files)
-    summary: dict[str, Any] = {
-        "attitude_version": __version__,
-        "scenario": _scenario_summary(scenario, source),
-        "motion": motion_summary(trajectory, motion),
-        "torques": torques_summary(plan),
-        "extrema": {
-            "max_rate_deg_s": math.degrees(stream.peak_rate[0]),
-            "max_rate_at": scenario.format_epoch(stream.peak_rate[1]),
-        },
-    }
+    summary = _summary_of_the_stream(plan, source, stream)
     analysis = None
-    if source_of_pointing is not None:
-        progress(
-            f"pointing: intervals and extrema on the exact motion ({plan.search.count} "
-            f"search points, every {plan.search.step_s:.3g} s); writing intervals.csv"
-        )
-        analysis = source_of_pointing.analysis()
-        summary["pointing"] = pointing_summary(analysis, scenario.format_epoch)
-        write_intervals_csv(
-            tmp / "intervals.csv",
-            analysis,
-            texts.strings,
-            [
-                *_preamble(scenario, source)[:3],
-                f"interval ends refined to {spec.interval_precision_s:g} s",
-            ],
-        )
+    if pointing is not None:
+        analysis = _search_pointing(plan, tmp, source, texts, pointing, progress)
+        summary["pointing"] = pointing_summary(analysis, plan.scenario.format_epoch)
         files.append("intervals.csv")
-    summary["outputs"] = _outputs_summary(plan)
+    summary["outputs"] = outputs_summary(plan)
     if "aem" in outputs:
-        aem = plan.aem
-        progress(
-            f"writing attitude.aem (CCSDS AEM 2.0): {aem.records} records, "
-            f"{INTERPOLATION_METHOD} to {aem.tolerance_rad:g} rad"
-        )
-        _write_aem(tmp / "attitude.aem", plan, texts, chunk_samples)
+        _write_aem(tmp / "attitude.aem", plan, texts, chunk_samples, progress)
         files.append("attitude.aem")
     images: dict[str, str] = {}
     if "plots" in outputs:
         progress("plotting")
-        images = _plots(plan, tmp, stream, source_of_pointing, analysis)
+        images = _plots(plan, tmp, stream, pointing, analysis)
     progress("writing summary.json" + (" and report.html" if "report" in outputs else ""))
     write_json(tmp / "summary.json", summary)
     files.append("summary.json")
@@ -426,72 +310,110 @@ def _build(
     return summary, files
 
 
-def _outputs_summary(plan: RunPlan) -> dict[str, Any]:
-    """The formats written, and the AEM's sampling and stated accuracy."""
-    entry: dict[str, Any] = {"formats": list(plan.outputs.formats)}
-    if "aem" in plan.outputs:
-        entry["aem"] = {
-            "tolerance_rad": plan.aem.tolerance_rad,
-            "interpolation": f"{INTERPOLATION_METHOD}, degree as declared per segment: "
-            "each of Q1..QC interpolated over the degree + 1 records centred on the "
-            "interval, then normalized",
-            "records": plan.aem.records,
-            "segments": [
-                {
-                    "segment": item.segment,
-                    "records": item.count,
-                    "step_s": item.step_s,
-                    "interpolation_degree": item.degree,
-                    "largest_error_found_rad": item.tested_error_rad,
-                }
-                for item in plan.aem.segments
-            ],
-        }
-    return entry
-
-
-def _write_aem(path: Path, plan: RunPlan, texts: EpochTexts, chunk_samples: int) -> None:
-    """The AEM, streamed: one segment per stretch of motion, records in chunks."""
-    scenario, trajectory = plan.scenario, plan.trajectory
-    with open(path, "wb") as stream:
-        writer = AemWriter(
-            stream,
-            object_name=_aem_text(scenario.spacecraft.name),
-            object_id=_object_id(plan.pointing.tle),
-            time_scale=scenario.time_scale,
-            comments=(
-                _aem_text(scenario.name, upper=False),
-                f"computed by attitude {__version__}",
-                f"sampled so that {INTERPOLATION_METHOD} interpolation as declared (each of "
-                "Q1..QC over the degree + 1 records",
-                f"centred on the interval, normalized) stays within {plan.aem.tolerance_rad:g} "
-                "rad of the exact attitude",
-            ),
+def _stream_output_grid(
+    plan: RunPlan,
+    tmp: Path,
+    source: str,
+    texts: EpochTexts,
+    pointing: _Pointing | None,
+    progress: Progress,
+    chunk_samples: int,
+) -> _Stream:
+    """The output grid, a chunk at a time, into the time series files and the figures'
+    envelopes; returns the finished stream (its files, envelopes and peak rate)."""
+    scenario, spec, outputs = plan.scenario, plan.pointing, plan.outputs
+    count = scenario.output_count()
+    chunk = max(1, int(chunk_samples))
+    series = [name for name in ("timeseries.csv", "timeseries.parquet") if name[11:] in outputs]
+    progress(
+        f"sampling {count} epochs over {scenario.stop_s:g} s, {min(chunk, count)} at a time"
+        + (f": writing {', '.join(series)}" if series else "")
+        + (
+            f"; pointing: {len(spec.body_vectors)} body vectors, "
+            f"{'Earth centre' if spec.orbit is None else spec.orbit.describe()}"
+            if pointing
+            else ""
         )
-        for item in plan.aem.segments:
-            segment = trajectory.segments[item.segment]
-            ends = texts(np.array([item.start_s, item.end_s]))
-            writer.begin_segment(
-                ends[0].decode("ascii"),
-                ends[1].decode("ascii"),
-                interpolation=None if item.degree is None else (INTERPOLATION_METHOD, item.degree),
-                comments=(
-                    f"motion segment {item.segment}",
-                    *((f"started by {segment.event.kind}",) if segment.event else ()),
-                    f"a record every {item.step_s:.6g} s",
-                ),
-            )
-            for first in range(0, item.count, chunk_samples):
-                τ = item.seconds(first, first + chunk_samples)
-                # One record is evaluated as a pair (see attitude.exports.sample).
-                pair = np.repeat(τ, 2) if τ.size == 1 else τ
-                writer.write_records(
-                    texts(τ),
-                    segment.solver.attitude_quaternion(pair)[: τ.size],
-                    segment.solver.angular_velocity(pair)[: τ.size],
-                )
-            writer.end_segment()
-        writer.close()
+    )
+    stream = _Stream(plan, tmp, source, texts)
+    with stream.stack:
+        shown = time.perf_counter()
+        for first in range(0, count, chunk):
+            τ = output_grid(scenario, first, first + chunk)
+            samples = sample(plan.trajectory, τ)
+            stream.add(τ, samples, None if pointing is None else pointing.samples(τ))
+            # After the first chunk (a stream has started), then every few seconds.
+            late = first == 0 or time.perf_counter() - shown > _PROGRESS_EVERY_S
+            if late and first + chunk < count:
+                shown = time.perf_counter()
+                progress(f"  {100.0 * (first + chunk) / count:.0f}% ({first + chunk} epochs)")
+    return stream
+
+
+def _summary_of_the_stream(plan: RunPlan, source: str, stream: _Stream) -> dict[str, Any]:
+    """The summary's scenario, motion, torques and the extremum found on the output grid."""
+    scenario = plan.scenario
+    return {
+        "attitude_version": __version__,
+        "scenario": scenario_summary(scenario, source),
+        "motion": motion_summary(plan.trajectory, plan.motion),
+        "torques": torques_summary(plan),
+        "extrema": {
+            "max_rate_deg_s": math.degrees(stream.peak_rate[0]),
+            "max_rate_at": scenario.format_epoch(stream.peak_rate[1]),
+        },
+    }
+
+
+def _search_pointing(
+    plan: RunPlan,
+    tmp: Path,
+    source: str,
+    texts: EpochTexts,
+    pointing: _Pointing,
+    progress: Progress,
+) -> PointingAnalysis:
+    """The pointing's intervals and extrema over the span, on the exact motion; the
+    intervals written to intervals.csv."""
+    progress(
+        f"pointing: intervals and extrema on the exact motion ({plan.search.count} "
+        f"search points, every {plan.search.step_s:.3g} s); writing intervals.csv"
+    )
+    analysis = pointing.analysis()
+    write_intervals_csv(
+        tmp / "intervals.csv",
+        analysis,
+        texts.strings,
+        [
+            *_preamble(plan.scenario, source)[:3],
+            f"interval ends refined to {plan.pointing.interval_precision_s:g} s",
+        ],
+    )
+    return analysis
+
+
+def _write_aem(
+    path: Path, plan: RunPlan, texts: EpochTexts, chunk_samples: int, progress: Progress
+) -> None:
+    """attitude.aem over the records the plan chose for its tolerance."""
+    scenario, aem = plan.scenario, plan.aem
+    progress(
+        f"writing attitude.aem (CCSDS AEM 2.0): {aem.records} records, "
+        f"{INTERPOLATION_METHOD} to {aem.tolerance_rad:g} rad"
+    )
+    orbit = plan.pointing.orbit
+    designator = orbit.international_designator if isinstance(orbit, TleOrbit) else None
+    with open(path, "wb") as stream:
+        write_planned_aem(
+            stream,
+            plan.trajectory,
+            aem,
+            texts,
+            object_name=aem_text(scenario.spacecraft.name),
+            object_id=designator or "UNKNOWN",
+            comments=(aem_text(scenario.name, upper=False), f"computed by attitude {__version__}"),
+            chunk_records=chunk_samples,
+        )
 
 
 def _plots(

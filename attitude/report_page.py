@@ -152,9 +152,23 @@ def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str
     ``summary``: the dictionary written to summary.json; ``images``: caption → PNG
     file name; ``files``: the data files of the folder, linked.
     """
-    scenario = summary["scenario"]
-    motion = summary["motion"]
     parts = [
+        *_heading(summary),
+        *_events_section(summary["scenario"]["events"]),
+        *_motion_section(summary["motion"]),
+        *_torques_section(summary.get("torques")),
+        *_pointing_section(summary.get("pointing")),
+        *_plots_section(images),
+        *_files_section(files, summary.get("outputs", {}).get("aem")),
+        "</body></html>\n",
+    ]
+    return "\n".join(parts)
+
+
+def _heading(summary: dict[str, Any]) -> list[str]:
+    """The page's head, its title, and the scenario in one table."""
+    scenario = summary["scenario"]
+    return [
         "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
         f"<title>{escape(scenario['name'])}</title><style>{_STYLE}</style></head><body>",
         f"<h1>{escape(scenario['name'])}</h1>",
@@ -183,16 +197,21 @@ def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str
             ],
         ),
     ]
-    if scenario["events"]:
-        parts.append("<h2>Events</h2>")
-        parts.append(
-            _table(
-                ["epoch", "type", "label"],
-                [[e["epoch"], e["type"], e["label"]] for e in scenario["events"]],
-            )
-        )
-    parts.append("<h2>Motion</h2>")
-    parts.append(
+
+
+def _events_section(events: list[dict[str, Any]]) -> list[str]:
+    if not events:
+        return []
+    return [
+        "<h2>Events</h2>",
+        _table(["epoch", "type", "label"], [[e["epoch"], e["type"], e["label"]] for e in events]),
+    ]
+
+
+def _motion_section(motion: dict[str, Any]) -> list[str]:
+    """Each segment of the motion in a table, and the flips."""
+    parts = [
+        "<h2>Motion</h2>",
         _table(
             [
                 "segment",
@@ -227,58 +246,69 @@ def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str
                 ]
                 for s in motion["segments"]
             ],
-        )
-    )
-    parts += _torques_section(summary.get("torques"))
+        ),
+    ]
     flips = motion["flips"]
     if flips["count"]:
         shown = ", ".join(escape(t) for t in flips["times"][:12])
         more = f" … ({flips['count']} in all)" if flips["count"] > 12 else ""
         parts.append(f"<p>Flips (the Джанибеков effect): {shown}{more}</p>")
-    pointing = summary.get("pointing")
-    if pointing:
-        parts.append("<h2>Pointing</h2>")
+    return parts
+
+
+def _pointing_section(pointing: dict[str, Any] | None) -> list[str]:
+    """The body vectors' extrema and exclusions, and the eclipses."""
+    if not pointing:
+        return []
+    parts = [
+        "<h2>Pointing</h2>",
+        f"<p class='note'>Spacecraft at: {escape(pointing['position'])}. Extrema and "
+        "interval ends found on the exact motion (search step "
+        f"{pointing['search_step_s']:.3g} s), interval ends to "
+        f"{pointing['interval_precision_s']:g} s. Angles are geometric: an extremum may "
+        "fall in an eclipse; exclusions leave out a hidden Sun or Moon.</p>",
+        _pointing_table(pointing["body_vectors"]),
+    ]
+    eclipses = pointing.get("eclipses")
+    if eclipses:
         parts.append(
-            f"<p class='note'>Spacecraft at: {escape(pointing['position'])}. Extrema and "
-            "interval ends found on the exact motion (search step "
-            f"{pointing['search_step_s']:.3g} s), interval ends to "
-            f"{pointing['interval_precision_s']:g} s. Angles are geometric: an extremum may "
-            "fall in an eclipse; exclusions leave out a hidden Sun or Moon.</p>"
-        )
-        parts.append(_pointing_table(pointing["body_vectors"]))
-        eclipses = pointing.get("eclipses")
-        if eclipses:
-            parts.append(
-                _table(
+            _table(
+                [
+                    "eclipses (shadow)",
+                    "in shadow (s)",
+                    "umbra passes",
+                    "in umbra (s)",
+                    "sunlit fraction",
+                ],
+                [
                     [
-                        "eclipses (shadow)",
-                        "in shadow (s)",
-                        "umbra passes",
-                        "in umbra (s)",
-                        "sunlit fraction",
-                    ],
-                    [
-                        [
-                            eclipses["shadow"]["count"],
-                            eclipses["shadow"]["total_s"],
-                            eclipses["umbra"]["count"],
-                            eclipses["umbra"]["total_s"],
-                            eclipses["sunlit_fraction_of_span"],
-                        ]
-                    ],
-                )
+                        eclipses["shadow"]["count"],
+                        eclipses["shadow"]["total_s"],
+                        eclipses["umbra"]["count"],
+                        eclipses["umbra"]["total_s"],
+                        eclipses["sunlit_fraction_of_span"],
+                    ]
+                ],
             )
-    if images:
-        parts.append("<h2>Plots</h2>")
-    for caption, name in images.items():
-        parts.append(
-            f"<figure><img src='{escape(name)}' alt='{escape(caption)}'>"
-            f"<figcaption class='note'>{escape(caption)}</figcaption></figure>"
         )
-    parts.append("<h2>Files</h2><ul>")
+    return parts
+
+
+def _plots_section(images: dict[str, str]) -> list[str]:
+    if not images:
+        return []
+    return ["<h2>Plots</h2>"] + [
+        f"<figure><img src='{escape(name)}' alt='{escape(caption)}'>"
+        f"<figcaption class='note'>{escape(caption)}</figcaption></figure>"
+        for caption, name in images.items()
+    ]
+
+
+def _files_section(files: list[str], aem: dict[str, Any] | None) -> list[str]:
+    """Links to the data files, the AEM's stated accuracy, and the conventions."""
+    parts = ["<h2>Files</h2><ul>"]
     parts += [f"<li><a href='{escape(f)}'>{escape(f)}</a></li>" for f in files]
     parts.append("</ul>")
-    aem = summary.get("outputs", {}).get("aem")
     if aem:
         parts.append(
             f"<p class='note'>attitude.aem: {aem['records']} records, sampled so that "
@@ -291,5 +321,4 @@ def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str
         "Quaternions are scalar first and rotate body coordinates into ICRF "
         "(attitude.aem: CCSDS AEM 2.0, ICRF → SC_BODY_1, scalar last, as the standard says).</p>"
     )
-    parts.append("</body></html>\n")
-    return "\n".join(parts)
+    return parts

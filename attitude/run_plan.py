@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 from attitude.aem_sampling import AemPlan, plan_aem
 from attitude.errors import InputError
+from attitude.exports import pointing_column_count
 from attitude.horizon import ValidityHorizon, validity_horizon
 from attitude.motion_analysis import SegmentMotion, analyze
 from attitude.output_budget import OutputBudget, check_fits, estimate
@@ -62,7 +63,10 @@ def plan_run(
     # The size and memory checks come before the analysis and the pointing checks,
     # which do not depend on the output grid but can take a while on a long span.
     vectors, on_orbit = len(pointing.body_vectors), pointing.on_orbit
-    budget = estimate(samples, 0, vectors, on_orbit, outputs.formats, aem_records=0)
+    columns = pointing_column_count(pointing) if not pointing.is_empty else 0
+    budget = estimate(
+        samples, 0, vectors, on_orbit, outputs.formats, aem_records=0, pointing_columns=columns
+    )
     check_fits(budget)
     motion = analyze(trajectory)
     notes, search = check_pointing(trajectory, pointing)
@@ -97,6 +101,7 @@ def plan_run(
         on_orbit,
         outputs.formats,
         0 if aem is None else aem.records,
+        pointing_columns=columns,
     )
     return RunPlan(
         scenario, pointing, trajectory, motion, budget, notes, outputs, aem, search, horizon

@@ -14,7 +14,6 @@ shares the machine).  Peak RSS is each child's own (``os.wait4``).
     python -m benchmarks.report_one_day --days 30 --no-peer   # this tree only
     python -m benchmarks.report_one_day --formats parquet,aem # passed to this tree's run
     python -m benchmarks.report_one_day --days 30 --no-pointing  # the trajectory alone
-    python -m benchmarks.report_one_day --days 30 --no-peer --blocked-orbit
 
 A peer that refuses the run (main before streaming refuses 30 days with pointing: its
 memory estimate is 19.5 GB) is reported as refused, with its message.
@@ -94,11 +93,6 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--no-peer", action="store_true")
     parser.add_argument("--formats", help="--formats for this tree's runs")
     parser.add_argument("--no-pointing", action="store_true", help="without [pointing]")
-    parser.add_argument(
-        "--blocked-orbit",
-        action="store_true",
-        help="this tree with the TLE orbit sampled in blocks (benchmarks/blocked_orbit_run.py)",
-    )
     args = parser.parse_args(argv)
     extra = ["--formats", args.formats] if args.formats else []
     load_before = os.getloadavg()
@@ -119,11 +113,8 @@ def main(argv: list[str] | None = None) -> dict:
                     continue
                 out = folder / f"out-{name}-{repeat}"
                 try:
-                    module = "attitude.cli"
-                    if name == "this" and args.blocked_orbit:
-                        module = "benchmarks.blocked_orbit_run"
                     runs[name].append(
-                        run_once(tree, scenario, out, extra if name == "this" else [], module)
+                        run_once(tree, scenario, out, extra if name == "this" else [])
                     )
                 except RuntimeError as exc:
                     refused[name] = str(exc)
@@ -149,7 +140,6 @@ def main(argv: list[str] | None = None) -> dict:
         "load_average_1min": {"before": load_before[0], "after": load_after[0]},
         "peer_commit": None if args.no_peer else args.peer_commit,
         "formats": args.formats or "default",
-        "blocked_orbit": args.blocked_orbit,
         "runs": runs,
         "median_wall_s": {name: median(name, "wall_s") for name in runs},
         "median_cpu_s": {name: median(name, "cpu_s") for name in runs},
@@ -162,9 +152,7 @@ def main(argv: list[str] | None = None) -> dict:
         report["cpu_ratio_this_to_peer"] = median("this", "cpu_s") / median("peer", "cpu_s")
     report["wall_s_per_day"] = median("this", "wall_s") / args.days
     RESULTS.mkdir(exist_ok=True)
-    suffix = ("_no_pointing" if args.no_pointing else "") + (
-        "_blocked_orbit" if args.blocked_orbit else ""
-    )
+    suffix = "_no_pointing" if args.no_pointing else ""
     path = RESULTS / f"report_{args.days:g}d{suffix}.json"
     path.write_text(json.dumps(report, indent=2) + "\n")
     print(f"case: {report['case']}; load {load_before[0]:.2f} -> {load_after[0]:.2f}")

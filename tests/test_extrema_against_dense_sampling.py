@@ -160,10 +160,10 @@ def test_the_output_grid_alone_would_be_wrong(cubesat):
 def test_nothing_depends_on_the_chunks(cubesat, monkeypatch):
     # The search runs in chunks of CHUNK_POINTS grid points: with chunks of 1000 the
     # intervals are the same (joined at the chunks' ends), and so are the extrema.
-    import attitude.pointing as pointing
+    import attitude.pointing_search as pointing_search
 
     analysis, _, _, trajectory, spec = cubesat
-    monkeypatch.setattr(pointing, "CHUNK_POINTS", 1000)
+    monkeypatch.setattr(pointing_search, "CHUNK_POINTS", 1000)
     chunked = pointing_analysis(trajectory, spec)
     assert analysis.grid.count > 10_000  # so that there are a dozen chunks
     for one, other in zip(analysis.vectors, chunked.vectors, strict=True):
@@ -178,3 +178,62 @@ def test_nothing_depends_on_the_chunks(cubesat, monkeypatch):
             assert abs(low.value - other_low.value) < 1e-8, quantity
             assert abs(high.value - other_high.value) < 1e-8, quantity
     assert len(analysis.shadow) == len(chunked.shadow) and len(analysis.umbra) == 1
+
+
+@pytest.mark.parametrize(
+    "name", ["spinner_thruster_pulse", "dzhanibekov_t_handle", "tumbling_defunct_satellite"]
+)
+def test_vector_rate_bounds_against_finite_differences(name):
+    # The search prunes brackets with each body vector's own rate bound (a vector on
+    # the spin axis turns far slower than the body): no chord of the vector's inertial
+    # direction, 1 ms apart over the first 20 min, may be faster than the bound, and the
+    # bound is within 5 % of the fastest chord (it is meant to prune).
+    from pathlib import Path
+
+    from attitude.pointing_search import search_grid
+    from attitude.scenario_file import load_scenario
+
+    file = load_scenario(Path(__file__).parents[1] / "scenarios" / f"{name}.toml")
+    vectors = file.pointing.body_vectors or [BodyVector("x", [1.0, 0.0, 0.0])]
+    spec = PointingSpec(vectors, file.pointing.orbit)
+    trajectory = propagate(file.scenario)
+    stop = min(1200.0, file.scenario.stop_s)
+    grid = search_grid(trajectory, spec, 0.0, stop)
+    τ = np.arange(0.0, stop, 1e-3)
+    attitude = trajectory.attitude(τ)
+    for vector in vectors:
+        u = attitude.apply(vector.vector)
+        chords = np.linalg.norm(np.diff(u, axis=0), axis=1) / np.diff(τ)
+        bound = grid.vector_rates_rad_s[vector.name]
+        assert np.max(chords) <= bound * (1.0 + 1e-9), vector.name
+        assert bound <= 1.05 * np.max(chords), vector.name
+        assert bound <= grid.body_rate_rad_s
+
+
+@pytest.mark.parametrize("lipschitz", [3.95, math.inf])
+def test_least_against_scipy_bounded_minimization(lipschitz):
+    # f = cos 3t + 0.1 t + 0.05 sin 17t on [0, 10], |f'| ≤ 3 + 0.1 + 0.85 < 4: the
+    # least of its many local minima, against scipy's bounded Brent search started in
+    # each of them (found on a grid 100x finer); with a rate bound that prunes brackets
+    # (3.95) and with none (inf: every bracket refined).
+    from scipy.optimize import minimize_scalar
+
+    from attitude.extrema import least
+
+    def f(t):
+        return np.cos(3.0 * t) + 0.1 * t + 0.05 * np.sin(17.0 * t)
+
+    grid = np.linspace(0.0, 10.0, 1001)
+    found = least(f, grid, f(grid), lipschitz, 1e-12, 1e-9)
+    fine = np.linspace(0.0, 10.0, 100_001)
+    values = f(fine)
+    local = np.flatnonzero((values[1:-1] < values[:-2]) & (values[1:-1] <= values[2:])) + 1
+    reference = min(
+        minimize_scalar(
+            f, bounds=(fine[k - 1], fine[k + 1]), method="bounded", options={"xatol": 1e-12}
+        ).fun
+        for k in local
+    )
+    assert found.value <= reference + 1e-12
+    assert abs(found.value - reference) < 1e-10
+    assert abs(f(found.time_s) - found.value) == 0.0

@@ -36,6 +36,10 @@ LAYERS = [
         "intervals",
         "extrema",
         "eclipse",
+        "pointing_spec",
+        "surroundings",
+        "pointing_sampling",
+        "pointing_search",
         "pointing",
     ],
     [  # reports and exports
@@ -43,6 +47,7 @@ LAYERS = [
         "timeseries_parquet",
         "aem",
         "aem_sampling",
+        "summaries",
         "plots",
         "report_figures",
         "report_page",

@@ -157,3 +157,18 @@ def test_a_closed_pipe_ends_check_quietly():
     process.stdout.close()  # `attitude check x | head -0`
     _, err = process.communicate(timeout=120)
     assert process.returncode == 0 and err == b""
+
+
+def test_the_aem_names_the_tles_international_designator():
+    # The ISS TLE's columns 10-17 ("98067A") are its published COSPAR designator,
+    # 1998-067A; a TLE that leaves them blank has none (the AEM then says UNKNOWN).
+    from sgp4.io import compute_checksum
+
+    from attitude.orbit import TleOrbit
+
+    line1 = "1 25544U 98067A   14020.93268519  .00009878  00000-0  18200-3 0  5082"
+    line2 = "2 25544  51.6498 109.4756 0003572  55.9686 274.8005 15.49815350868473"
+    assert TleOrbit(line1, line2).international_designator == "1998-067A"
+    blank = line1[:9] + " " * 8 + line1[17:68]
+    blank += str(compute_checksum(blank + "0"))
+    assert TleOrbit(blank, line2).international_designator is None
