@@ -8,11 +8,13 @@ The layers, each importing only the ones above it in this list (README "Layout")
 - ``attitude.trajectory``, ``motion_analysis``: the propagated motion
 - ``attitude.ephemeris``, ``orbit``, ``eclipse``, ``pointing``, ``intervals``: pointing
 - ``attitude.exports``, ``aem``, ``plots``, ``report_page``, ``report``: reports and exports
-- ``attitude.scenario_file``, ``cli``: scenario files and the command line
+- ``attitude.scenario_file``, ``cli``: scenario files and the command line; beside them,
+  ``dispersions``, ``scenario_writer`` and ``montecarlo`` (``run_montecarlo``): Monte
+  Carlo jobs on Dask, which drive the scenario layer from above
 
 The names below are importable from ``attitude`` directly; all but the errors are
 loaded on first use, so that ``import attitude`` stays light (numpy, scipy, astropy,
-skyfield and matplotlib load only when needed), and the command line can install its
+skyfield, matplotlib, dask and pandas load only when needed), and the command line can install its
 signal handlers before anything heavy loads.
 
 Conventions: SI units (s, kg m², N m s, rad/s; astropy Quantities accepted at the
@@ -31,6 +33,7 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.aem import write_aem
     from attitude.euler_solver import EulerSolver
     from attitude.events import AngularImpulse, AttitudeReset, InertiaChange
+    from attitude.montecarlo import run_montecarlo
     from attitude.motion_analysis import analyze
     from attitude.orbit import TleOrbit
     from attitude.pointing import BodyVector, PointingSpec, compute_pointing
@@ -58,6 +61,7 @@ _LAZY = {
     "write_aem": "attitude.aem",
     "load_scenario": "attitude.scenario_file",
     "produce": "attitude.report",
+    "run_montecarlo": "attitude.montecarlo",
 }
 
 # Spelled out (not built from _LAZY) so that linters and IDEs read it statically;
@@ -83,6 +87,7 @@ __all__ = [
     "load_scenario",
     "produce",
     "propagate",
+    "run_montecarlo",
     "write_aem",
 ]
 

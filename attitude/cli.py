@@ -2,6 +2,7 @@
 
     attitude run SCENARIO.toml --out DIR   propagate, write the outputs into DIR
     attitude check SCENARIO.toml           validate the file and describe the run
+    attitude montecarlo SCENARIO.toml --out DIR   the [dispersions] samples, on Dask
 
 ``check`` goes through the same checks as ``run`` up to the sampling
 (``attitude.run_plan``): what ``check`` accepts, ``run`` computes.  ``--out`` given to
@@ -80,7 +81,32 @@ def _parser() -> argparse.ArgumentParser:
     check = commands.add_parser("check", help="validate a scenario file and describe the run")
     check.add_argument("scenario", type=Path, help="scenario file (TOML)")
     check.add_argument("--out", type=Path, help="also check this output folder and its free space")
+    _montecarlo_parser(commands)
     return parser
+
+
+def _montecarlo_parser(commands) -> None:
+    """``attitude montecarlo``: the dispersed samples of a scenario on Dask."""
+    mc = commands.add_parser(
+        "montecarlo",
+        help="run the [dispersions] samples of a scenario on Dask (docs/montecarlo.md)",
+    )
+    mc.add_argument("scenario", type=Path, help="scenario file (TOML) with [dispersions]")
+    mc.add_argument("--out", type=Path, help="output folder (the rules of run --out)")
+    mc.add_argument("--samples", type=int, help="sample count (replaces the file's)")
+    mc.add_argument("--seed", type=int, help="seed (replaces the file's)")
+    where = mc.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", help="address of a Dask scheduler (default: local)")
+    where.add_argument("--workers", type=int, help="local worker processes (default: all cores)")
+    mc.add_argument("--batch-size", type=int, help="samples per task (default: from costs)")
+    mc.add_argument("--sample", type=int, nargs="+", help="with --emit-scenario: sample(s) K")
+    mc.add_argument(
+        "--emit-scenario",
+        type=Path,
+        metavar="DIR",
+        help="write sample K as DIR/sample_K.toml, an ordinary scenario, instead of running",
+    )
+    mc.add_argument("--quiet", action="store_true", help="no progress bar or messages")
 
 
 def _describe(loaded, plan) -> str:
@@ -165,11 +191,22 @@ def _checked_run(args, state: dict) -> int:
         loaded = load_scenario(args.scenario)
         state["file"] = loaded.path.name
         plan = plan_run(loaded.scenario, loaded.pointing)
+        if args.command == "montecarlo":
+            from attitude.montecarlo import command
+
+            return command(args, loaded, plan)
+        montecarlo = None
+        if "dispersions" in loaded.document:  # checked by run too: one reading of the file
+            from attitude.montecarlo import plan_montecarlo
+
+            montecarlo = plan_montecarlo(loaded, plan)
         if args.command == "check":
             if args.out is not None:
                 check_fits(plan.budget, args.out)
                 claim(args.out, OUTPUT_NAMES, dry_run=True)
             print(_describe(loaded, plan), flush=True)
+            if montecarlo is not None:
+                print("\n".join(montecarlo.describe()), flush=True)
             return 0
         claim(args.out, OUTPUT_NAMES, dry_run=True)  # a folder that is not ours: say so first
         for note in plan.notes:
