@@ -99,7 +99,9 @@ def _montecarlo_parser(commands) -> None:
     where.add_argument("--scheduler", help="address of a Dask scheduler (default: local)")
     where.add_argument("--workers", type=int, help="local worker processes (default: all cores)")
     mc.add_argument("--batch-size", type=int, help="samples per task (default: from costs)")
-    mc.add_argument("--sample", type=int, nargs="+", help="with --emit-scenario: sample(s) K")
+    mc.add_argument(
+        "--sample", type=int, action="append", help="with --emit-scenario: sample K (repeatable)"
+    )
     mc.add_argument(
         "--emit-scenario",
         type=Path,

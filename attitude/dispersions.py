@@ -215,8 +215,11 @@ class Dispersions:
         if self.attitude is not None:
             lines.append(f"initial_state.attitude: {_angle_text(self.attitude)}")
         if self.rate is not None:
-            unit = {"angular_velocity": "rad/s", "angular_momentum": "N m s"}[self.rate_key]
-            lines.append(f"initial_state.{self.rate_key}: {self.rate.describe(unit)}")
+            rate, unit = self.rate, "N m s"
+            if self.rate_key == "angular_velocity":  # in deg/s, as check shows rates
+                rate = Distribution(rate.kind, np.degrees(rate.scale), rate.truncation)
+                unit = "deg/s"
+            lines.append(f"initial_state.{self.rate_key}: {rate.describe(unit)}")
         for item in self.events:
             key = f"events[{item.index}]"
             if item.time is not None:
