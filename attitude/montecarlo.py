@@ -518,6 +518,25 @@ def _ignore_interrupts_plugin():
     return IgnoreInterrupts()
 
 
+def _check_where(scheduler: str | None, workers: int | None) -> int:
+    """The local cluster's worker count (0 with a scheduler), after checking the options;
+    a malformed address is refused before a Client exists (a half-made one hangs at exit)."""
+    if scheduler is not None:
+        if workers is not None:
+            raise InputError("--workers: sets the size of the local cluster; not with --scheduler")
+        from distributed.comm.addressing import get_address_host_port
+
+        try:
+            get_address_host_port(scheduler)
+        except (ValueError, TypeError) as exc:
+            raise InputError(f"--scheduler {scheduler!r}: not a scheduler address: {exc}") from None
+        return 0
+    count = workers if workers is not None else len(os.sched_getaffinity(0))
+    if not 1 <= count <= 4 * (os.cpu_count() or 1):
+        raise InputError(f"--workers: expected 1 to {4 * (os.cpu_count() or 1)}, got {count}")
+    return count
+
+
 @contextlib.contextmanager
 def connect(scheduler: str | None = None, workers: int | None = None) -> Iterator[Any]:
     """A ``distributed.Client``: to the scheduler at ``scheduler``, or to a local cluster
@@ -527,9 +546,8 @@ def connect(scheduler: str | None = None, workers: int | None = None) -> Iterato
 
     from distributed import Client, LocalCluster
 
+    count = _check_where(scheduler, workers)
     if scheduler is not None:
-        if workers is not None:
-            raise InputError("--workers: sets the size of the local cluster; not with --scheduler")
         try:
             client = Client(scheduler, timeout=_CONNECT_TIMEOUT_S, set_as_default=False)
         except (OSError, TimeoutError, ValueError, TypeError) as exc:
@@ -541,9 +559,6 @@ def connect(scheduler: str | None = None, workers: int | None = None) -> Iterato
             with held_signals():
                 client.close()
         return
-    count = workers if workers is not None else len(os.sched_getaffinity(0))
-    if not 1 <= count <= 4 * (os.cpu_count() or 1):
-        raise InputError(f"--workers: expected 1 to {4 * (os.cpu_count() or 1)}, got {count}")
     with tempfile.TemporaryDirectory(prefix="attitude-dask-") as scratch:
         with _workers_ignore_interrupts():
             cluster = LocalCluster(
@@ -628,6 +643,7 @@ def simulate(
     stage = stage or (lambda text: None)
     if batch_size is not None and not 1 <= batch_size <= mc.samples:
         raise InputError(f"--batch-size: expected 1 to {mc.samples}, got {batch_size}")
+    _check_where(scheduler, workers)
     started = time.perf_counter()
     nominal, sample_s = _nominal(mc)
     stage(f"nominal run: {sample_s:.3g} s a sample")

@@ -160,7 +160,8 @@ def test_bad_dispersions_exit_2_with_one_line_from_every_command(case, tmp_path,
         (["--batch-size", "0"], "spinner.toml: --batch-size: expected 1 to 10, got 0"),
         (["--sample", "10", "--emit-scenario", "{tmp}/e"], "spinner.toml: --sample: expected"),
         (["--sample", "1"], "spinner.toml: --sample K and --emit-scenario DIR go together"),
-        (["--scheduler", "tcp://127.0.0.1:9"], "spinner.toml: --scheduler tcp://127.0.0.1:9: "),
+        (["--scheduler", "tcp://localhost"], "spinner.toml: --scheduler 'tcp://localhost': not a"),
+        (["--scheduler", "nonsense://x:1"], "spinner.toml: --scheduler 'nonsense://x:1': not a"),
     ],
 )
 def test_bad_options_exit_2_with_one_line(options, expected, tmp_path, capsys):
