@@ -183,3 +183,16 @@ def test_a_scenario_without_dispersions_is_refused_by_montecarlo(tmp_path, capsy
     path.write_text(SPINNER)
     err = _refused(capsys, ["montecarlo", str(path), "--out", str(tmp_path / "o")])
     assert err[0].startswith("attitude: error: spinner.toml: no [dispersions] table")
+
+
+def test_the_users_folder_is_refused_for_the_report_and_for_emitted_samples(tmp_path, capsys):
+    user = tmp_path / "user"
+    user.mkdir()
+    path = user / "spinner.toml"
+    path.write_text(SPINNER + GOOD)
+    (user / "thesis.tex").write_text("months of work\n")
+    before = {p.name: p.read_bytes() for p in user.iterdir()}
+    for options in (["--out", str(user)], ["--sample", "1", "--emit-scenario", str(user)]):
+        err = _refused(capsys, ["montecarlo", str(path), "--quiet", *options])
+        assert "the folder holds files that attitude did not write" in err[0], err
+    assert {p.name: p.read_bytes() for p in user.iterdir()} == before
