@@ -4,9 +4,12 @@ The layers, each importing only the ones above it in this list (README "Layout")
 
 - ``attitude.elliptic``: Jacobi functions and elliptic integrals in mc = 1 − m
 - ``attitude.euler_solver``: ``EulerSolver``, the closed-form torque-free rigid body
+- ``attitude.torques``, ``splitting``, ``torqued_solver``: ``TorquedSolver``, torques
+  (gravity gradient, constant torques, user torques) by splitting with the exact free flow
 - ``attitude.spacecraft``, ``events``, ``scenario``, ``timescales``: the scenario layer
 - ``attitude.trajectory``, ``motion_analysis``: the propagated motion
-- ``attitude.ephemeris``, ``orbit``, ``eclipse``, ``pointing``, ``intervals``: pointing
+- ``attitude.ephemeris``, ``earth``, ``frames``, ``orbit``, ``keplerian``, ``oem``,
+  ``aem_input``, ``intervals``, ``extrema``, ``eclipse``, ``pointing``: pointing
 - ``attitude.exports``, ``aem``, ``plots``, ``report_page``, ``report``: reports and exports
 - ``attitude.scenario_file``, ``cli``: scenario files and the command line; beside them,
   ``dispersions``, ``scenario_writer`` and ``montecarlo`` (``run_montecarlo``): Monte
@@ -33,18 +36,28 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.aem import write_aem
     from attitude.euler_solver import EulerSolver
     from attitude.events import AngularImpulse, AttitudeReset, InertiaChange
+    from attitude.keplerian import KeplerianOrbit
     from attitude.montecarlo import run_montecarlo
     from attitude.motion_analysis import analyze
+    from attitude.oem import OemOrbit
     from attitude.orbit import TleOrbit
-    from attitude.pointing import BodyVector, PointingSpec, compute_pointing
+    from attitude.pointing import BodyVector, PointingSpec, pointing_analysis, pointing_samples
     from attitude.report import produce
     from attitude.scenario import InitialState, Scenario
     from attitude.scenario_file import load_scenario
     from attitude.spacecraft import Spacecraft
+    from attitude.torqued_solver import TorquedSolver, departure_time, propagate_batch
+    from attitude.torques import ConstantTorque, GravityGradient, UserTorque
     from attitude.trajectory import Trajectory, propagate
 
 _LAZY = {
     "EulerSolver": "attitude.euler_solver",
+    "TorquedSolver": "attitude.torqued_solver",
+    "propagate_batch": "attitude.torqued_solver",
+    "departure_time": "attitude.torqued_solver",
+    "GravityGradient": "attitude.torques",
+    "ConstantTorque": "attitude.torques",
+    "UserTorque": "attitude.torques",
     "Spacecraft": "attitude.spacecraft",
     "InitialState": "attitude.scenario",
     "Scenario": "attitude.scenario",
@@ -56,8 +69,11 @@ _LAZY = {
     "analyze": "attitude.motion_analysis",
     "BodyVector": "attitude.pointing",
     "PointingSpec": "attitude.pointing",
-    "compute_pointing": "attitude.pointing",
+    "pointing_samples": "attitude.pointing",
+    "pointing_analysis": "attitude.pointing",
     "TleOrbit": "attitude.orbit",
+    "KeplerianOrbit": "attitude.keplerian",
+    "OemOrbit": "attitude.oem",
     "write_aem": "attitude.aem",
     "load_scenario": "attitude.scenario_file",
     "produce": "attitude.report",
@@ -71,22 +87,31 @@ __all__ = [
     "AttitudeError",
     "AttitudeReset",
     "BodyVector",
+    "ConstantTorque",
     "EulerSolver",
+    "GravityGradient",
     "InertiaChange",
     "InertiaWarning",
     "InitialState",
     "InputError",
+    "KeplerianOrbit",
+    "OemOrbit",
     "PointingSpec",
     "Scenario",
     "Spacecraft",
     "TleOrbit",
+    "TorquedSolver",
     "Trajectory",
+    "UserTorque",
     "__version__",
     "analyze",
-    "compute_pointing",
+    "departure_time",
     "load_scenario",
+    "pointing_analysis",
+    "pointing_samples",
     "produce",
     "propagate",
+    "propagate_batch",
     "run_montecarlo",
     "write_aem",
 ]

@@ -1,12 +1,17 @@
-"""The command line: ``attitude run`` and ``attitude check`` (also ``python -m attitude``).
+"""The command line: ``attitude run``, ``check`` and ``montecarlo`` (also ``python -m attitude``).
 
     attitude run SCENARIO.toml --out DIR   propagate, write the outputs into DIR
     attitude check SCENARIO.toml           validate the file and describe the run
     attitude montecarlo SCENARIO.toml --out DIR   the [dispersions] samples, on Dask
 
+``run`` and ``check`` take ``--formats csv,parquet,aem,plots,report`` (the outputs to
+write; default ``csv,aem,plots,report``, or the file's ``[output] formats``) and
+``--aem-tolerance "1e-6 rad"`` (the accuracy the AEM is sampled for; an angle with its
+unit).  ``montecarlo`` writes its own outputs (``docs/montecarlo.md``).
 ``check`` goes through the same checks as ``run`` up to the sampling
-(``attitude.run_plan``): what ``check`` accepts, ``run`` computes.  ``--out`` given to
-``check`` also checks the folder and its free space.
+(``attitude.run_plan``): what ``check`` accepts, ``run`` computes, and it states the
+size of each chosen output.  ``--out`` given to ``check`` also checks the folder and
+its free space, which is the one thing ``check`` cannot know without it.
 
 The output folder (``attitude.output_folder``): ``run`` writes into a new or empty
 folder, or one it wrote before, where it replaces only its own previous outputs; it
@@ -81,6 +86,19 @@ def _parser() -> argparse.ArgumentParser:
     check = commands.add_parser("check", help="validate a scenario file and describe the run")
     check.add_argument("scenario", type=Path, help="scenario file (TOML)")
     check.add_argument("--out", type=Path, help="also check this output folder and its free space")
+    for command in (run, check):
+        command.add_argument(
+            "--formats",
+            help="the outputs to write, comma-separated, from csv, parquet, aem, plots, report "
+            "(default: the file's [output] formats, else csv,aem,plots,report); "
+            "summary.json, and intervals.csv with [pointing], are always written",
+        )
+        command.add_argument(
+            "--aem-tolerance",
+            metavar="ANGLE",
+            help="the AEM is sampled so that its declared interpolation stays within this "
+            'of the exact attitude, with its unit: "1e-6 rad" (the default), "0.2 arcsec"',
+        )
     _montecarlo_parser(commands)
     return parser
 
@@ -111,7 +129,38 @@ def _montecarlo_parser(commands) -> None:
     mc.add_argument("--quiet", action="store_true", help="no progress bar or messages")
 
 
-def _describe(loaded, plan) -> str:
+def _outputs(args, outputs):
+    """``outputs`` (the file's) with the command line's --formats and --aem-tolerance."""
+    import dataclasses
+    import re
+
+    from attitude.aem_sampling import check_tolerance
+    from attitude.errors import InputError
+    from attitude.output_formats import parse_formats
+    from attitude.quantities import convert_unit
+
+    if args.formats is not None:
+        outputs = dataclasses.replace(outputs, formats=parse_formats(args.formats))
+    if args.aem_tolerance is not None:
+        text = args.aem_tolerance
+        found = re.fullmatch(r"\s*([-+]?[0-9.]+(?:[eE][-+]?\d+)?)\s*(\S.*)?", text)
+        if not found or not found.group(2):
+            raise InputError(
+                f'--aem-tolerance: {text!r} needs an angle with its unit, e.g. "1e-6 rad" '
+                'or "0.2 arcsec"'
+            )
+        value = convert_unit(
+            float(found.group(1)), found.group(2).strip(), "angle", "--aem-tolerance"
+        )
+        outputs = dataclasses.replace(
+            outputs,
+            aem_tolerance_rad=check_tolerance(float(value), "--aem-tolerance"),
+            tolerance_key="--aem-tolerance",
+        )
+    return outputs
+
+
+def _describe(loaded, plan, out: Path | None = None) -> str:
     """What ``attitude check`` prints: the run as it will be done."""
     import math
 
@@ -126,6 +175,7 @@ def _describe(loaded, plan) -> str:
         f"  span        {scenario.stop_s:.12g} s, to {scenario.format_epoch(scenario.stop_s)}",
         f"  output      every {scenario.step_s:.12g} s from "
         f"{scenario.format_epoch(scenario.start_s)}",
+        f"  formats     {','.join(plan.outputs.formats)}",
         f"  outputs     {plan.budget.describe()}",
         f"  spacecraft  {craft.name}, principal moments {craft.principal_moments.tolist()} kg m²",
     ]
@@ -148,19 +198,22 @@ def _describe(loaded, plan) -> str:
         f"{f' ({event.label})' if event.label else ''}"
         for t, event in scenario.events
     ]
-    spec = loaded.pointing
-    if not spec.is_empty:
+    from attitude.pointing import describe_lines
+
+    lines += [f"  {line}" for line in describe_lines(loaded.pointing)]
+    if plan.aem is not None:
+        steps = [item.step_s for item in plan.aem.segments]
         lines.append(
-            f"  pointing    {len(spec.body_vectors)} body vectors, orbit: "
-            f"{'TLE' if spec.tle else 'Earth centre'}, interval ends to "
-            f"{spec.interval_precision_s:g} s"
+            f"  aem         {plan.aem.records} records (a record every "
+            f"{min(steps):.4g} to {max(steps):.4g} s), LAGRANGE interpolation within "
+            f"{plan.aem.tolerance_rad:g} rad of the exact attitude"
         )
-        for vector in spec.body_vectors:
-            half = vector.sun_exclusion_half_angle_deg
-            lines.append(
-                f"    {vector.name}: {vector.kind}, {vector.vector.tolist()} (body)"
-                + ("" if half is None else f", Sun exclusion half angle {half:.12g} deg")
-            )
+    if out is None:
+        lines.append("  disk        not checked: `check --out DIR` checks the free space of DIR")
+    else:
+        from attitude.output_budget import free_disk_bytes, size_text
+
+        lines.append(f"  disk        {size_text(free_disk_bytes(out))} free for {out}: enough")
     lines += [f"  note        {note}" for note in plan.notes]
     return "\n".join(lines)
 
@@ -185,18 +238,27 @@ def _checked_run(args, state: dict) -> int:
     from attitude.errors import InputError
     from attitude.output_budget import check_fits
     from attitude.output_folder import OutputFolderError, claim
+    from attitude.output_formats import OutputChoice
     from attitude.report import OUTPUT_NAMES, Progress, produce
     from attitude.run_plan import plan_run
     from attitude.scenario_file import ScenarioFileError, load_scenario
 
     try:
+        # The command line's own options first: their errors name the option, not a file.
+        try:
+            if args.command != "montecarlo":  # montecarlo writes no time series
+                _outputs(args, OutputChoice())
+        except InputError as exc:
+            _error(str(exc))
+            return 2
         loaded = load_scenario(args.scenario)
         state["file"] = loaded.path.name
-        plan = plan_run(loaded.scenario, loaded.pointing)
         if args.command == "montecarlo":
             from attitude.montecarlo import command
 
-            return command(args, loaded, plan)
+            return command(args, loaded)
+        outputs = _outputs(args, loaded.outputs)
+        plan = plan_run(loaded.scenario, loaded.pointing, outputs)
         montecarlo = None
         if "dispersions" in loaded.document:  # checked by run too: one reading of the file
             from attitude.montecarlo import plan_montecarlo
@@ -206,7 +268,7 @@ def _checked_run(args, state: dict) -> int:
             if args.out is not None:
                 check_fits(plan.budget, args.out)
                 claim(args.out, OUTPUT_NAMES, dry_run=True)
-            print(_describe(loaded, plan), flush=True)
+            print(_describe(loaded, plan, args.out), flush=True)
             if montecarlo is not None:
                 print("\n".join(montecarlo.describe()), flush=True)
             return 0

@@ -35,7 +35,10 @@ What each draw means:
   normal means each component N(0, σ²), so the angle |δ| has the χ distribution with
   3 degrees of freedom times σ (median 1.54 σ, 99 % below 3.37 σ); truncated normal
   cuts |δ| at truncation·σ; uniform fills the ball |δ| ≤ h.  The attitude becomes
-  R' = R exp(δ): δ turns the body before R takes it to ICRF.
+  R' = R exp(δ): δ turns the body before R takes it to the frame the file gives the
+  attitude in (ICRF, or the orbit's LVLH or RTN, which stays the sample's frame: a
+  nadir-pointing body stays dispersed about nadir on a dispersed orbit).  An attitude
+  read from an AEM file is written as the ICRF quaternion it gives.
 - **Directions** (impulse direction): a tilt vector θ across the nominal direction n
   (two components, the same three laws in the plane), n' = exp(θ) n; the tilt angle is
   |θ|, Rayleigh-distributed for the normal law (median 1.18 σ, 99 % below 3.03 σ).
@@ -70,7 +73,11 @@ from scipy.spatial.transform import Rotation
 
 from attitude.errors import InputError
 from attitude.inertia import violates_triangle_inequality
-from attitude.scenario_file import ScenarioFile, ScenarioFileError
+from attitude.scenario_file import (
+    ScenarioFile,
+    ScenarioFileError,
+    _attitude,  # the attitude as the file gives it
+)
 from attitude.scenario_file import _Table as Table  # the reader's own errors: file, key, value
 from attitude.vectors import basis_across
 
@@ -331,6 +338,10 @@ def read_dispersions(
         "tensor_given": "inertia_tensor" in loaded.document.get("spacecraft", {}),
         "attitude": scenario.initial_state.attitude,
     }
+    if loaded.document.get("initial_state", {}).get("frame", "icrf") != "icrf":
+        # The attitude in the orbit frame the file gives it in (the reader refuses a
+        # frame with an AEM file, so it is a quaternion or a matrix).
+        nominal["attitude"] = _attitude(root.table("initial_state"))
     moments = axes_rotation = attitude = rate = None
     rate_key = "angular_velocity"
     craft = table.table("spacecraft", required=False)
@@ -502,8 +513,9 @@ def draw_sample(dispersions: Dispersions, document: dict[str, Any], index: int) 
         δ = d.attitude.isotropic(_generator(d.seed, index, "initial_state.attitude"), 3)
         record("initial_state.attitude_error_{}_deg", np.degrees(δ))
         parameters["initial_state.attitude_error_deg"] = math.degrees(float(np.linalg.norm(δ)))
-        attitude = nominal["attitude"] * Rotation.from_rotvec(δ)
+        attitude = nominal["attitude"] * Rotation.from_rotvec(δ)  # in the file's frame
         state.pop("matrix", None)
+        state.pop("aem", None)  # an AEM's attitude: written as the ICRF quaternion it gave
         state["quaternion"] = _floats(attitude.as_quat(scalar_first=True))
     if d.rate is not None:
         key = d.rate_key

@@ -42,11 +42,11 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.interpolate import CubicSpline
 
+from attitude.earth import EARTH_EQUATORIAL_RADIUS_M, angular_radius
 from attitude.ephemeris import sun_position_from_earth
 from attitude.errors import InputError
-from attitude.orbit import EARTH_EQUATORIAL_RADIUS_M
+from attitude.intervals import find_intervals
 from attitude.quantities import as_si_array, as_si_scalar
 from attitude.timescales import as_time, offline_time, time_from_tt_seconds, tt_seconds
 from attitude.vectors import angle_between
@@ -57,6 +57,7 @@ __all__ = [
     "EclipseState",
     "eclipse_intervals",
     "eclipse_state",
+    "fraction_from_angles",
     "shadow_angles",
     "sunlit_fraction",
 ]
@@ -116,7 +117,7 @@ def shadow_angles(
     _outside(r_norm, earth_radius_m, r, "r_sat_m", "the Earth")
     _outside(to_sun_norm, sun_radius_m, to_sun, "r_sun_m - r_sat_m", "the Sun")
     a = np.arcsin(sun_radius_m / to_sun_norm)
-    b = np.arcsin(earth_radius_m / r_norm)
+    b = angular_radius(r, earth_radius_m - EARTH_EQUATORIAL_RADIUS_M)
     c = angle_between(-r, to_sun)
     return a, b, c
 
@@ -154,7 +155,13 @@ def sunlit_fraction(
     a, b, c = shadow_angles(
         r_sat_m, r_sun_m, earth_radius_m=earth_radius_m, sun_radius_m=sun_radius_m
     )
-    a, b, c = np.broadcast_arrays(a, b, c)
+    return fraction_from_angles(a, b, c)
+
+
+def fraction_from_angles(a: ArrayLike, b: ArrayLike, c: ArrayLike) -> NDArray[np.float64]:
+    """The visible fraction of the Sun's disc from the angles (a, b, c) of
+    :func:`shadow_angles` (radians, broadcast): see :func:`sunlit_fraction`."""
+    a, b, c = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (a, b, c)))
     fraction = np.ones(c.shape)
     fraction[c <= b - a] = 0.0
     annular = c <= a - b  # the Earth's disc inside the Sun's
@@ -213,21 +220,20 @@ def eclipse_intervals(
     stop: Any,
     *,
     step_s: float = 30.0,
+    precision_s: float = 1e-6,
     earth_radius_m: float = EARTH_EQUATORIAL_RADIUS_M,
     sun_radius_m: float = SUN_RADIUS_M,
 ) -> EclipseIntervals:
     """The shadow and umbra intervals of ``orbit`` between ``start`` and ``stop``.
 
-    ``orbit``: anything with ``position_velocity(times)`` (a
-    :class:`attitude.orbit.TleOrbit`).  The edges are the roots of the smooth
-    functions c − (a + b) (shadow) and c − (b − a) (umbra), sampled every ``step_s``
-    seconds and joined by a cubic spline, whose roots scipy finds exactly
-    (``PPoly.roots``).  Measured on an ISS orbit over a day: the edges agree with a
-    root search on direct skyfield positions (``tests/test_eclipse_against_direct_
-    geometry.py``) to 0.12 ms; sampling at 10 s to 120 s instead of 30 s moves them by
-    < 0.25 ms.  With ``TleOrbit(step_s=None)`` they agree to 0.03 µs: the error is the
-    orbit's, whose Hermite pieces have kinks in their second derivative at the nodes.
-    A shadow shorter than ``step_s`` (a grazing pass) may be missed.
+    ``orbit``: an :class:`attitude.orbit.Orbit` (anything with
+    ``position_velocity(times)``).  The edges are the roots of the continuous functions
+    c − (a + b) (shadow) and c − (b − a) (umbra), sampled every ``step_s`` seconds;
+    each sign change is bisected on the orbit and the ephemeris themselves
+    (:func:`attitude.intervals.find_intervals`) to ``precision_s``.  Measured on an
+    ISS orbit over a day: the edges agree with a root search on direct skyfield
+    positions (``tests/test_eclipse_against_direct_geometry.py``) to the precision
+    asked.  A shadow shorter than ``step_s`` (a grazing pass) may be missed.
     """
     start = as_time(start, name="start")
     stop = as_time(stop, name="stop")
@@ -238,29 +244,25 @@ def eclipse_intervals(
     if not span_s > 0.0:
         with offline_time():
             raise InputError(f"stop must be after start, got {start.isot} to {stop.isot}")
-    # At least 4 samples so that a cubic spline exists.
-    count = max(int(np.ceil(span_s / step_s)) + 1, 4)
+    count = max(int(np.ceil(span_s / step_s)) + 1, 2)
     seconds = np.linspace(0.0, span_s, count)
-    times = time_from_tt_seconds(start, seconds)
-    r_m, _ = orbit.position_velocity(times)
-    a, b, c = shadow_angles(
-        r_m,
-        sun_position_from_earth(times),
-        earth_radius_m=earth_radius_m,
-        sun_radius_m=sun_radius_m,
-    )
 
-    def intervals(edge: NDArray[np.float64]):
-        spline = CubicSpline(seconds, edge)
-        points = np.concatenate([[0.0], spline.roots(extrapolate=False), [span_s]])
-        points = np.unique(points)
-        # A segment between consecutive roots is inside where the function is
-        # negative at its middle; touching roots (a grazing edge) merge.
-        inside = spline(0.5 * (points[:-1] + points[1:])) < 0.0
-        change = np.diff(np.concatenate([[False], inside, [False]]).astype(np.int8))
-        entries = points[:-1][change[:-1] == 1]
-        exits = points[1:][change[1:] == -1]
-        edges_s = np.stack([entries, exits], axis=-1)
+    def margins(τ: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        times = time_from_tt_seconds(start, τ)
+        r_m, _ = orbit.position_velocity(times)
+        a, b, c = shadow_angles(
+            r_m,
+            sun_position_from_earth(times),
+            earth_radius_m=earth_radius_m,
+            sun_radius_m=sun_radius_m,
+        )
+        return (a + b) - c, (b - a) - c  # > 0 inside the shadow, inside the umbra
+
+    shadow_on_grid, umbra_on_grid = margins(seconds)
+
+    def edges(which: int, on_grid: NDArray[np.float64]):
+        found = find_intervals(lambda τ: margins(τ)[which], seconds, precision_s, on_grid)
+        edges_s = np.array([[i.start_s, i.end_s] for i in found]).reshape(-1, 2)
         return time_from_tt_seconds(start, edges_s)
 
-    return EclipseIntervals(shadow=intervals(c - (a + b)), umbra=intervals(c - (b - a)))
+    return EclipseIntervals(shadow=edges(0, shadow_on_grid), umbra=edges(1, umbra_on_grid))

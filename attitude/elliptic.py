@@ -6,6 +6,26 @@ Everything here takes the *complementary parameter* ``mc = 1 − m`` ([OLBC10] �
 matter there.  The solver computes ``mc`` from the physics without cancellation
 (Leroy, "The elliptic modulus") and hands it to these kernels unchanged.
 
+How small mc may be.  The general kernels below depend on mc through K (through
+ln mc as mc → 0: K = ln(4/√mc) + O(mc ln mc), [OLBC10] 19.12.1) and through the AGM of
+1 and √mc; both keep full accuracy for any float mc, down to the subnormals (checked
+against mpmath at mc from 1e-100 to 1e-320: a few ulps, plus eps·|u|·|f'| for large
+|u|).  What fails first is mc itself: a subnormal float carries fewer than 53
+significant bits (1e-320 has 11), and K moves by half the relative error of mc, so a
+subnormal mc that is a rounded physical ratio gives K, hence the period, to only a
+few digits; and a ratio below 5e-324 rounds to zero, the separatrix, whose motion is
+not periodic at all.  So below ``NEAR_ONE_MC`` (2^-128 ≈ 2.9e-39) the kernels take
+ln mc instead, which the solver computes from its exact integers for any mc however
+small, and use the expansions about m = 1: there the neglected terms are O(√mc)
+relative, below 2^-66 (derivation in ``reduced_sn_cn_dn_near_one`` and
+``pi_minus_f_near_one``).
+
+Arrays and floats.  Every function takes numpy arrays (vectorized over arguments and
+parameters).  ``JacobiParameter``, the interface the solver uses, also takes Python
+floats, for a single state: the same formulas run through ``attitude.float_math``, and
+the one kernel that branches per element (sn, cn, dn) has a float dispatcher over the
+same pieces.
+
 Why our own kernels: ``scipy.special.ellipj`` takes ``m`` and, for ``m ≥ 1 − 1e-9``,
 switches to an approximation that is only valid in the first quarter period (values
 of 1e47 and NaN further out; scipy issue #8480), and its error grows with ``u``
@@ -22,20 +42,30 @@ References
 
 from __future__ import annotations
 
+import math
+from typing import Any
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import special
 
+from attitude.float_math import FLOAT
+
 __all__ = [
+    "NEAR_ONE_MC",
+    "JacobiParameter",
     "complete_first_kind",
+    "complete_first_kind_near_one",
     "elliptic_f",
     "elliptic_pi",
     "elliptic_pi_complete",
     "jacobi_amplitude",
     "jacobi_sn_cn_dn",
     "pi_minus_f",
+    "pi_minus_f_near_one",
     "reduce_argument",
     "reduced_sn_cn_dn",
+    "reduced_sn_cn_dn_near_one",
 ]
 
 # Bulirsch's convergence threshold on the arithmetic-geometric mean: the method's
@@ -44,6 +74,10 @@ _AGM_TOLERANCE = 2.0**-27
 # Below this |u| the Taylor series to u⁵ is exact to rounding (the next term is
 # O(u⁶) ≈ 1e-24), and it avoids the overflow of Bulirsch's cot recurrence at tiny u.
 _SERIES_THRESHOLD = 1.0e-4
+# Below this complementary parameter the kernels work from ln mc and the expansions
+# about m = 1, whose neglected terms are O(√mc) = O(2^-64) relative (module docstring).
+NEAR_ONE_MC = 2.0**-128
+_LN4 = math.log(4.0)
 
 
 def _as_mc(mc: ArrayLike) -> NDArray[np.float64]:
@@ -81,25 +115,63 @@ def reduce_argument(u: ArrayLike, K: ArrayLike) -> tuple[NDArray[np.float64], ND
     return j, r
 
 
-def _agm_sequences(mc: NDArray[np.float64]) -> tuple[list, list, NDArray[np.float64]]:
-    """Arithmetic-geometric mean sequences a_i, b_i starting at (1, √mc) [Bul65].
+# ----------------------------------------------------------------- sn, cn, dn: the pieces
+# Each piece is elementwise arithmetic and functions of the namespace ``xp`` (numpy, or
+# attitude.float_math.FLOAT), shared by the array and the float dispatchers below.
 
-    With an array ``mc`` the iteration runs until every element has converged;
-    extra steps on an element that has already converged are identities to rounding.
+
+def _maclaurin(x: Any, mc: Any) -> tuple[Any, Any, Any]:
+    """sn, cn, dn to x⁵ for |x| < 1e-4 ([OLBC10] 22.10.1–3)."""
+    m = 1.0 - mc
+    x2 = x * x
+    sn = x * (1.0 - x2 * ((1.0 + m) / 6.0 - x2 * (1.0 + m * (14.0 + m)) / 120.0))
+    cn = 1.0 - x2 * (0.5 - x2 * (1.0 + 4.0 * m) / 24.0)
+    dn = 1.0 - m * x2 * (0.5 - x2 * (4.0 + m) / 24.0)
+    return sn, cn, dn
+
+
+def _bulirsch(z: Any, mc: Any, xp: Any) -> tuple[Any, Any, Any]:
+    """sn, cn, dn for 1e-4 ≤ |z| ≤ K/2 and mc > 0: Bulirsch's ``sncndn`` [Bul65].
+
+    The descending Gauss transformation driven by the AGM of 1 and √mc: one sine and
+    one cosine, then a rational recurrence.  With an array ``mc`` the AGM runs until
+    every element has converged; extra steps on a converged element are identities to
+    rounding.  Pass a scalar ``mc`` when all elements share it: the AGM is then
+    computed once.
     """
-    a = np.ones_like(mc)
+    a = 1.0
     emc = mc
     a_seq, b_seq = [], []
-    for _ in range(32):
+    for _ in range(40):
         a_seq.append(a)
-        emc = np.sqrt(emc)
+        emc = xp.sqrt(emc)
         b_seq.append(emc)
         c = 0.5 * (a + emc)
-        if np.all(np.abs(a - emc) <= _AGM_TOLERANCE * a):
-            return a_seq, b_seq, c
+        if xp.all(abs(a - emc) <= _AGM_TOLERANCE * a):
+            break
         emc = emc * a
         a = c
-    raise ArithmeticError("AGM did not converge")  # pragma: no cover  (quadratic convergence)
+    else:  # pragma: no cover  (quadratic convergence: 10 steps at mc = 1e-300)
+        raise ArithmeticError("AGM did not converge")
+    x = z * c
+    s = xp.sin(x)
+    a = xp.cos(x) / s
+    c = c * a
+    d = 1.0
+    for a_i, b_i in zip(reversed(a_seq), reversed(b_seq), strict=True):
+        a = a * c
+        c = c * d
+        d = (b_i + a) / (a_i + a)
+        a = c / a_i
+    s = xp.copysign(1.0 / xp.sqrt(c * c + 1.0), s)
+    return s, c * s, d
+
+
+def _quarter_shift(σ: Any, mc: Any, s: Any, c: Any, d: Any, xp: Any) -> tuple[Any, Any, Any]:
+    """sn, cn, dn of z + σK from those of z ([OLBC10] Table 22.4.3, σ = ±1):
+    sn = σ cd z, cn = −σ √mc sd z, dn = √mc nd z."""
+    sqrt_mc = xp.sqrt(mc)
+    return σ * c / d, -σ * sqrt_mc * s / d, sqrt_mc / d
 
 
 def _sn_cn_dn_core(
@@ -119,35 +191,15 @@ def _sn_cn_dn_core(
         cn[hyperbolic] = dn[hyperbolic] = 1.0 / np.cosh(x)
 
     if np.any(small):
-        x = z[small]
-        m = 1.0 - mc[small]
-        x2 = x * x
-        sn[small] = x * (1.0 - x2 * ((1.0 + m) / 6.0 - x2 * (1.0 + m * (14.0 + m)) / 120.0))
-        cn[small] = 1.0 - x2 * (0.5 - x2 * (1.0 + 4.0 * m) / 24.0)
-        dn[small] = 1.0 - m * x2 * (0.5 - x2 * (4.0 + m) / 24.0)
+        sn[small], cn[small], dn[small] = _maclaurin(z[small], mc[small])
 
     if np.any(general):
         # The AGM depends on mc only: computed once when mc is a scalar (the solver's
         # case), elementwise otherwise.
         mc_g = mc[general]
         if np.all(mc_g == mc_g.flat[0]):
-            mc_g = mc_g.flat[0:1].reshape(())
-        a_seq, b_seq, c = _agm_sequences(mc_g)
-        x = z[general] * c
-        s = np.sin(x)
-        a = np.cos(x) / s
-        c = c * a
-        d = np.ones_like(x)
-        for a_i, b_i in zip(reversed(a_seq), reversed(b_seq), strict=True):
-            a = a * c
-            c = c * d
-            d = (b_i + a) / (a_i + a)
-            a = c / a_i
-        a = 1.0 / np.sqrt(c * c + 1.0)
-        s = np.copysign(a, s)
-        sn[general] = s
-        cn[general] = c * s
-        dn[general] = d
+            mc_g = mc_g.flat[0]
+        sn[general], cn[general], dn[general] = _bulirsch(z[general], mc_g, np)
     return sn, cn, dn
 
 
@@ -177,13 +229,20 @@ def reduced_sn_cn_dn(
     s, c, d = _sn_cn_dn_core(z, mc)
     if not np.any(far):
         return s, c, d
-    sigma = np.copysign(1.0, r)
-    sqrt_mc = np.sqrt(mc)
-    return (
-        np.where(far, sigma * c / d, s),
-        np.where(far, -sigma * sqrt_mc * s / d, c),
-        np.where(far, sqrt_mc / d, d),
-    )
+    shifted = _quarter_shift(np.copysign(1.0, r), mc, s, c, d, np)
+    return tuple(np.where(far, f, g) for f, g in zip(shifted, (s, c, d), strict=True))
+
+
+def _reduced_sn_cn_dn_float(r: float, mc: float, K: float) -> tuple[float, float, float]:
+    """``reduced_sn_cn_dn`` for one float (0 < mc ≤ 1): the same pieces, chosen by ``if``."""
+    far = abs(r) > 0.5 * K
+    σ = math.copysign(1.0, r)
+    z = r - σ * K if far else r
+    if abs(z) < _SERIES_THRESHOLD:
+        s, c, d = _maclaurin(z, mc)
+    else:
+        s, c, d = _bulirsch(z, mc, FLOAT)
+    return _quarter_shift(σ, mc, s, c, d, FLOAT) if far else (s, c, d)
 
 
 def jacobi_sn_cn_dn(
@@ -196,25 +255,42 @@ def jacobi_sn_cn_dn(
     grow with |u| beyond the rounding of u itself.
     """
     mc = _as_mc(mc)
-    K = complete_first_kind(mc)
-    j, r = reduce_argument(u, K)
-    sn, cn, dn = reduced_sn_cn_dn(r, mc, K)
-    sign = 1.0 - 2.0 * np.mod(j, 2.0)  # (−1)^j
+    j, _r, sn, cn, dn = _jacobi_reduced(u, mc, complete_first_kind(mc))
+    sign = _parity_sign(j, np)
     return sign * sn, sign * cn, dn
+
+
+def _jacobi_reduced(u: ArrayLike, mc: NDArray[np.float64], K: NDArray[np.float64]):
+    j, r = reduce_argument(u, K)
+    return (j, r, *reduced_sn_cn_dn(r, mc, K))
+
+
+def _parity_sign(j: Any, xp: Any) -> Any:
+    """(−1)^j for an integer-valued float j: sn and cn change sign every 2K."""
+    return 1.0 - 2.0 * xp.abs(j - 2.0 * xp.rint(0.5 * j))
+
+
+def amplitude(j: Any, sn_r: Any, cn_r: Any, xp: Any = np) -> Any:
+    """am(u) = jπ + atan2(sn r, cn r) for u = 2jK + r, |r| ≤ K ([OLBC10] 22.16.2).
+
+    On |r| ≤ K, where cn ≥ 0, atan2 lies in [−π/2, π/2] with no branch jump, so the
+    amplitude is continuous and increasing in u.
+    """
+    return j * xp.pi + xp.arctan2(sn_r, cn_r)
 
 
 def jacobi_amplitude(u: ArrayLike, mc: ArrayLike) -> NDArray[np.float64]:
     """The Jacobi amplitude am(u|m), continuous and increasing in u, from mc = 1 − m.
 
-    am(u + 2jK) = am(u) + jπ ([OLBC10] 22.16.2), and on |r| ≤ K, where cn ≥ 0,
-    am(r) = atan2(sn r, cn r) lies in [−π/2, π/2] with no branch jump.  For mc = 0 it
-    is the Gudermannian gd(u) ([OLBC10] 22.16.4 with 4.23.40).
+    See ``amplitude``.  For mc = 0 it is the Gudermannian gd(u) ([OLBC10] 22.16.4
+    with 4.23.40).
     """
     mc = _as_mc(mc)
-    K = complete_first_kind(mc)
-    j, r = reduce_argument(u, K)
-    sn, cn, _ = reduced_sn_cn_dn(r, mc, K)
-    return j * np.pi + np.arctan2(sn, cn)
+    j, _r, sn, cn, _dn = _jacobi_reduced(u, mc, complete_first_kind(mc))
+    return amplitude(j, sn, cn)
+
+
+# ----------------------------------------------------------------- F and Π
 
 
 def _split_angle(phi: ArrayLike) -> tuple[NDArray[np.float64], ...]:
@@ -225,18 +301,23 @@ def _split_angle(phi: ArrayLike) -> tuple[NDArray[np.float64], ...]:
     return j, np.sin(phir), np.cos(phir)
 
 
+def _f_of_sin_cos(s: Any, c: Any, mc: Any) -> Any:
+    """F(φ|m) for |φ| ≤ π/2 from s = sin φ and c = cos φ ≥ 0: [OLBC10] 19.25.5,
+    F = s R_F(c², c² + mc s², 1) (``c² + mc s²`` is 1 − m s² without cancellation)."""
+    c2 = c * c
+    return s * special.elliprf(c2, c2 + mc * s * s, 1.0)
+
+
 def elliptic_f(phi: ArrayLike, mc: ArrayLike) -> NDArray[np.float64]:
     """Incomplete elliptic integral of the first kind F(φ|m) for any real φ, from mc.
 
-    Carlson form [OLBC10] 19.25.5 on |φ| ≤ π/2, F = s R_F(c², c² + mc s², 1) with
-    s = sin φ, c = cos φ (``c² + mc s²`` is 1 − m s² without cancellation), and the
-    quasi-periodicity F(φ + jπ) = F(φ) + 2jK ([OLBC10] 19.2.10).
+    Carlson form on |φ| ≤ π/2 (``_f_of_sin_cos``) and the quasi-periodicity
+    F(φ + jπ) = F(φ) + 2jK ([OLBC10] 19.2.10).
     """
     mc = _as_mc(mc)
     j, s, c = _split_angle(phi)
-    c2 = c * c
     with np.errstate(invalid="ignore"):
-        f = s * special.elliprf(c2, c2 + mc * s * s, 1.0)
+        f = _f_of_sin_cos(s, c, mc)
         return np.where(j == 0.0, f, f + 2.0 * j * complete_first_kind(mc))
 
 
@@ -255,13 +336,8 @@ def pi_minus_f(
     and Π(am u, n) = u + pi_minus_f(...), with sn, cn, dn of the reduced argument.
     Requires n < 1 (no singularity on the path; the solver's n are all ≤ 0).
     ``1 − n s²`` is written ``c² + (1 − n) s²`` so that it has no cancellation.
+    Takes arrays or, all together, floats.
     """
-    j = np.asarray(j, dtype=np.float64)
-    sn = np.asarray(sn, dtype=np.float64)
-    cn = np.asarray(cn, dtype=np.float64)
-    dn = np.asarray(dn, dtype=np.float64)
-    n = np.asarray(n, dtype=np.float64)
-    mc = _as_mc(mc)
     c2 = cn * cn
     s2 = sn * sn
     incomplete = sn * s2 * special.elliprj(c2, dn * dn, 1.0, c2 + (1.0 - n) * s2)
@@ -298,3 +374,164 @@ def elliptic_pi_complete(n: ArrayLike, mc: ArrayLike) -> NDArray[np.float64]:
     n = _check_n(n)
     mc = _as_mc(mc)
     return special.elliprf(0.0, mc, 1.0) + (n / 3.0) * special.elliprj(0.0, mc, 1.0, 1.0 - n)
+
+
+# ----------------------------------------------------------------- m within 2^-128 of 1
+
+
+def complete_first_kind_near_one(log_mc: ArrayLike) -> NDArray[np.float64]:
+    """K from ln mc, for mc < ``NEAR_ONE_MC``: K = ln 4 − ½ ln mc.
+
+    [OLBC10] 19.12.1: K = ln(4/k') + O(k'² ln k') with k' = √mc; the neglected term is
+    below 2^-128·100 there.  ``log_mc = −∞`` (the separatrix) gives K = ∞.
+    """
+    return _LN4 - 0.5 * log_mc
+
+
+def reduced_sn_cn_dn_near_one(r: Any, log_mc: Any, K: Any, xp: Any = np) -> tuple[Any, Any, Any]:
+    """sn, cn, dn of a reduced argument ``|r| ≤ K`` for mc < ``NEAR_ONE_MC``, from ln mc.
+
+    With k' = √mc and K = ln(4/k') (``complete_first_kind_near_one``):
+
+    - |r| ≤ K/2: sn = tanh r, cn = dn = sech r.  [OLBC10] 22.10.8–10 give the first
+      corrections, (k'²/4)(sinh r cosh r − r) times sech² r, −tanh r sech r and
+      +tanh r sech r: relative to the leading terms they are below k'²/4 for sn and
+      (k'²/4) sinh² r ≤ (k'²/4) e^K/4 = k'/4 for cn and dn.
+    - K/2 < |r| ≤ K: the quarter-period shift z = r ∓ K, |z| < K/2 ([OLBC10] Table
+      22.4.3): sn = ±cd z, cn = ∓k' sd z, dn = k' nd z, whose leading terms are ±1,
+      ∓k' sinh z and k' cosh z, with the same O(k') relative corrections.
+
+    So every value is exact to a relative 2^-66 when mc < 2^-128.  The products
+    k' sinh z and k' cosh z are formed as exponentials of ln k' ± |z|, so that a k'
+    below the float range (mc < 5e-324 has no float, ln mc always has one) still
+    gives the components that are representable; those below ~1e-308 round to 0.
+    ``log_mc = −∞`` (K = ∞) gives the separatrix functions tanh, sech, sech.
+    Arrays (``xp = numpy``) or floats (``xp = FLOAT``).
+    """
+    far = abs(r) > 0.5 * K
+    σ = xp.copysign(1.0, r)
+    z = xp.where(far, r - σ * K, r)
+    a = abs(z)
+    e = xp.exp(-a)
+    sech = 2.0 * e / (1.0 + e * e)  # no overflow of cosh for large |z|
+    log_kc = 0.5 * log_mc
+    grow = xp.exp(log_kc + a)  # k' e^|z| (≤ 2 √k' since |z| ≤ K/2)
+    decay = xp.exp(log_kc - a)  # k' e^-|z|
+    k_sinh = xp.copysign(0.5 * (grow - decay), z)  # k' sinh z
+    k_cosh = 0.5 * (grow + decay)  # k' cosh z
+    sn = xp.where(far, σ, xp.tanh(z))
+    cn = xp.where(far, -σ * k_sinh, sech)
+    dn = xp.where(far, k_cosh, sech)
+    return sn, cn, dn
+
+
+def pi_minus_f_near_one(j: Any, r: Any, sn: Any, n: Any, K: Any, xp: Any = np) -> Any:
+    """Π(am u, n|m) − u for u = 2jK + r, |r| ≤ K, n < 0 and mc < ``NEAR_ONE_MC``.
+
+    ``sn`` is sn r.  Derivation (the project's own; [OLBC10] 19.2.7 for Π): with
+    s = sin θ, c = cos θ and Δ = √(c² + mc s²),
+
+        Π(φ, n) − F(φ) = ∫₀^φ n s² dθ / ((1 − n s²) Δ)
+                       = n/(1 − n) · [F(φ) − ∫₀^φ c² dθ / ((1 − n s²) Δ)],
+
+    since n s²/(1 − n s²) = n/(1 − n) − n c²/((1 − n)(1 − n s²)).  For |φ| ≤ π/2,
+    c²/Δ differs from |c| by at most mc/Δ, whose integral is mc F(φ) ≤ mc K; and
+    ∫₀^φ c dθ/(1 − n s²) = A(sin φ) with A(x) = arctan(√−n x)/√−n.  On a Jacobi
+    amplitude F(am r) = r, so Π(am r) − r = n/(1 − n) (r − A(sn r)) + O(mc K), and by
+    the quasi-periodicity ([OLBC10] 19.2.10 for F and Π) each half period adds the
+    complete value n/(1 − n) (K − A(1)).  The error is below mc K ≈ 2^-121.
+    """
+    A_sn, A_1 = _arctan_integral(sn, n, xp), _arctan_integral(1.0, n, xp)
+    return (n / (1.0 - n)) * ((r - A_sn) + 2.0 * j * (K - A_1))
+
+
+def _arctan_integral(x: Any, n: Any, xp: Any) -> Any:
+    """A(x) = ∫₀^x ds/(1 − n s²) = arctan(√−n x)/√−n for n ≤ 0 (x in the limit n → 0)."""
+    a = xp.sqrt(-n)
+    positive = a > 0.0
+    a_safe = xp.where(positive, a, 1.0)
+    return xp.where(positive, xp.arctan(a_safe * x) / a_safe, x)
+
+
+# ----------------------------------------------------------------- the solver's interface
+
+
+class JacobiParameter:
+    """The parameter m = 1 − mc of the Jacobi functions of one state or of a batch.
+
+    Held as mc and ln mc, with K.  For mc ≥ ``NEAR_ONE_MC`` the kernels take mc;
+    below, where mc may be subnormal or below the float range while ln mc (which the
+    solver computes from exact integers) is always accurate, they take ln mc and the
+    expansions about m = 1.  One regime per instance: a batch that mixes them is
+    split by the caller.  ``mc`` and ``log_mc`` are floats (one state; ``xp = FLOAT``
+    builds K as a float) or arrays of a batch.  Each method takes the namespace of its
+    arguments: floats (``FLOAT``) or arrays (numpy) that broadcast with the parameter.
+    """
+
+    def __init__(self, mc: Any, log_mc: Any, near_one: bool, xp: Any = np) -> None:
+        self.mc = mc
+        self.log_mc = log_mc
+        self.near_one = near_one
+        if near_one:
+            self.K = complete_first_kind_near_one(log_mc)
+        elif xp is FLOAT:
+            self.K = float(special.ellipkm1(mc))
+        else:
+            self.K = special.ellipkm1(mc)
+        self.kc = xp.exp(0.5 * log_mc)  # k' = √mc (0 below the float range)
+
+    def jacobi(self, u: Any, xp: Any) -> tuple[Any, Any, Any, Any, Any]:
+        """j, r, sn r, cn r, dn r for u = 2jK + r, |r| ≤ K."""
+        K = self.K
+        if xp is FLOAT:
+            j = float(round(u / (2.0 * K)))
+            r = u - j * (2.0 * K)
+            if self.near_one:
+                return (j, r, *reduced_sn_cn_dn_near_one(r, self.log_mc, K, FLOAT))
+            return (j, r, *_reduced_sn_cn_dn_float(r, self.mc, K))
+        j, r = reduce_argument(u, K)
+        if self.near_one:
+            return (j, r, *reduced_sn_cn_dn_near_one(r, self.log_mc, K))
+        return (j, r, *reduced_sn_cn_dn(r, self.mc, K))
+
+    @staticmethod
+    def full(j: Any, sn_r: Any, cn_r: Any, dn_r: Any, xp: Any) -> tuple[Any, Any, Any]:
+        """sn u, cn u, dn u from those of r: (−1)^j sn r, (−1)^j cn r, dn r."""
+        sign = _parity_sign(j, xp)
+        return sign * sn_r, sign * cn_r, dn_r
+
+    def complete_pi_minus_k(self, n: Any, xp: Any) -> Any:
+        """Π(n|m) − K(m): what Π(am u, n) − u gains over each half period 2K.
+
+        (n/3) R_J(0, mc, 1, 1 − n) ([OLBC10] 19.25.2), or n/(1 − n) (K − A(1)) near
+        m = 1 (``pi_minus_f_near_one``).  A constant of the state: computed once.
+        """
+        if self.near_one:
+            return (n / (1.0 - n)) * (self.K - _arctan_integral(1.0, n, xp))
+        value = (n / 3.0) * special.elliprj(0.0, self.mc, 1.0, 1.0 - n)
+        return float(value) if xp is FLOAT else value
+
+    def pi_minus_f(
+        self, j: Any, r: Any, sn: Any, cn: Any, dn: Any, n: Any, complete: Any, xp: Any
+    ) -> Any:
+        """Π(am u, n) − u for u = 2jK + r, from the reduced functions and
+        ``complete = complete_pi_minus_k(n)``: ``pi_minus_f`` or its near-one form."""
+        if self.near_one:
+            incomplete = (n / (1.0 - n)) * (r - _arctan_integral(sn, n, xp))
+        else:
+            c2, s2 = cn * cn, sn * sn
+            r_j = special.elliprj(c2, dn * dn, 1.0, c2 + (1.0 - n) * s2)
+            incomplete = (n / 3.0) * sn * s2 * (float(r_j) if xp is FLOAT else r_j)
+        return incomplete + 2.0 * j * complete
+
+    def f_of_sin_cos(self, s: Any, c: Any, xp: Any) -> Any:
+        """F(φ|m) for sin φ = s, cos φ = c, φ ∈ (−π, π] (mc ≥ ``NEAR_ONE_MC``).
+
+        ``_f_of_sin_cos`` for c ≥ 0, and F(±π − φ') = ±2K − F(φ') ([OLBC10] 19.2.10)
+        beyond.  Working from (s, c) rather than from φ = atan2 keeps F accurate near
+        φ = ±π/2, where dF/dφ = 1/dn is large close to the separatrix.
+        """
+        f = _f_of_sin_cos(s, abs(c), self.mc)
+        if xp is FLOAT:
+            f = float(f)
+        return xp.where(c >= 0.0, f, xp.copysign(2.0 * self.K, s) - f)

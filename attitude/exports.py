@@ -2,16 +2,22 @@
 
 The CSV opens with ``#`` lines that state the epoch and time scale, the frames,
 the units and the quaternion convention; each column's name carries its frame and
-unit (``omega_body_x_rad_s``, ``q_body_to_icrf_w``).  Numbers are written with 17
-significant digits, so a file read back gives the same doubles.
+unit (``omega_body_x_rad_s``, ``q_body_to_icrf_w``).  Each number is written as the
+shortest text that reads back as the same double (17 significant digits at most:
+``0.1``, not ``0.10000000000000001``), so a file read back gives the same doubles.
+
+The CSV is written as it is computed, a chunk of rows at a time (:class:`CsvWriter`),
+by Apache Arrow's CSV writer: its C++ number formatting is about three times as fast
+as numpy's ``savetxt`` with ``%.17g`` (``benchmarks/report_outputs.py`` measures both).
 """
 
 from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from pathlib import Path
+from types import TracebackType
 from typing import Any
 
 import numpy as np
@@ -19,13 +25,14 @@ from numpy.typing import NDArray
 
 from attitude.intervals import Interval, total_duration
 from attitude.motion_analysis import LISTED_FLIPS, SegmentMotion
-from attitude.pointing import PointingResult
+from attitude.pointing import PointingAnalysis, PointingSamples
 from attitude.trajectory import Trajectory
 
 __all__ = [
     "Column",
+    "CsvWriter",
     "Samples",
-    "extremum",
+    "arrow_texts",
     "motion_summary",
     "pointing_columns",
     "pointing_summary",
@@ -74,7 +81,16 @@ class Samples:
 
 
 def sample(trajectory: Trajectory, seconds: NDArray[np.float64]) -> Samples:
-    """``trajectory`` at ``seconds`` (TT s since the epoch)."""
+    """``trajectory`` at ``seconds`` (TT s since the epoch).
+
+    A single epoch is evaluated as a pair and the first kept: numpy's matrix product
+    takes another path for one row (``gemv``), which can differ in the last bit, and a
+    stream's chunk of one epoch must write the digits the whole grid writes.
+    """
+    seconds = np.asarray(seconds, dtype=np.float64)
+    if seconds.size == 1:
+        pair = sample(trajectory, np.repeat(seconds, 2))
+        return Samples(seconds, *(getattr(pair, f.name)[:1] for f in fields(Samples)[1:]))
     return Samples(
         seconds,
         trajectory.attitude_quaternion(seconds),
@@ -123,33 +139,92 @@ def trajectory_columns(samples: Samples) -> list[Column]:
     ]
 
 
+def arrow_texts(epochs: NDArray) -> Any:
+    """ASCII texts (numpy ``S`` or ``U`` arrays) as an Arrow string array; ``S`` arrays
+    (:class:`attitude.epoch_texts.EpochTexts`) are wrapped without a copy."""
+    import pyarrow as pa
+
+    epochs = np.asarray(epochs)
+    if epochs.dtype.kind == "U":
+        epochs = np.char.encode(epochs, "ascii")
+    epochs = np.ascontiguousarray(epochs)
+    width = epochs.dtype.itemsize
+    offsets = np.arange(epochs.size + 1, dtype=np.int32) * width
+    return pa.Array.from_buffers(
+        pa.string(), epochs.size, [None, pa.py_buffer(offsets), pa.py_buffer(epochs)]
+    )
+
+
+class CsvWriter:
+    """``timeseries.csv`` written a chunk of rows at a time.
+
+    The ``#`` preamble goes first; the column descriptions and the header row are
+    written with the first chunk, whose columns every later chunk must repeat.
+    ``time_label`` names the first column (e.g. ``time_utc``), which holds each row's
+    ISO 8601 epoch.  A context manager: the file is closed on exit.
+    """
+
+    def __init__(self, path: Path, time_label: str, preamble: list[str]) -> None:
+        self.path = Path(path)
+        self.time_label = time_label
+        self._stream = open(self.path, "wb")
+        self._stream.write("".join(f"# {line}\n" for line in preamble).encode("utf-8"))
+        self._names: list[str] | None = None
+        self._writer = None
+
+    def write(self, epochs: NDArray, columns: list[Column]) -> None:
+        """Append one row per epoch: ``epochs`` (ISO texts), then each column's value."""
+        import pyarrow as pa
+        import pyarrow.csv as pa_csv
+
+        names = [c.name for c in columns]
+        if self._names is None:
+            header = ["# columns:"] + [f"#   {c.name}: {c.description}" for c in columns]
+            header.append(",".join([self.time_label, *names]))
+            self._stream.write(("\n".join(header) + "\n").encode("utf-8"))
+            self._names = names
+        elif names != self._names:
+            raise ValueError(f"{self.path.name}: the columns changed between chunks")
+        arrays = [arrow_texts(epochs)]
+        arrays += [pa.array(np.asarray(c.values, dtype=np.float64)) for c in columns]
+        table = pa.Table.from_arrays(arrays, names=[self.time_label, *names])
+        if self._writer is None:
+            options = pa_csv.WriteOptions(include_header=False, quoting_style="none")
+            self._writer = pa_csv.CSVWriter(self._stream, table.schema, write_options=options)
+        self._writer.write_table(table)
+
+    def close(self) -> None:
+        if self._writer is not None:
+            self._writer.close()
+            self._writer = None
+        self._stream.close()
+
+    def __enter__(self) -> CsvWriter:
+        return self
+
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        error: BaseException | None,
+        traceback: TracebackType | None,
+    ) -> None:
+        self.close()
+
+
 def write_csv(
     path: Path,
-    epochs_iso: NDArray[np.str_],
+    epochs_iso: NDArray,
     time_label: str,
     columns: list[Column],
     preamble: list[str],
 ) -> None:
-    """Write the time series: ``#`` preamble, a header row, then one row per epoch.
+    """Write the time series at once: ``#`` preamble, a header row, one row per epoch.
 
     ``time_label`` names the first column (e.g. ``time_utc``); ``epochs_iso`` are its
-    ISO 8601 texts.
+    ISO 8601 texts.  A run writes its series in chunks, through :class:`CsvWriter`.
     """
-    names = [time_label] + [c.name for c in columns]
-    descriptions = [f"#   {c.name}: {c.description}" for c in columns]
-    data = np.column_stack([c.values for c in columns])
-    integer_columns = {i for i, c in enumerate(columns) if c.name == "segment"}
-    formats = ["%d" if i in integer_columns else "%.17g" for i in range(len(columns))]
-    row_format = "%s," + ",".join(formats) + "\n"
-    with open(path, "w", encoding="utf-8", newline="") as stream:
-        for line in preamble:
-            stream.write(f"# {line}\n")
-        stream.write("# columns:\n")
-        for line in descriptions:
-            stream.write(line + "\n")
-        stream.write(",".join(names) + "\n")
-        for epoch, row in zip(epochs_iso, data, strict=True):
-            stream.write(row_format % (epoch, *row))
+    with CsvWriter(path, time_label, preamble) as writer:
+        writer.write(epochs_iso, columns)
 
 
 def to_json(value: Any) -> Any:
@@ -240,23 +315,6 @@ def motion_summary(trajectory: Trajectory, motion: list[SegmentMotion]) -> dict[
     return {"segments": segments, "flips": _flips_summary(scenario, motion)}
 
 
-def extremum(
-    seconds: NDArray[np.float64], values: NDArray[np.float64], largest: bool
-) -> tuple[float, float]:
-    """(time, value) of the largest or smallest sample, refined by the parabola through
-    it and its two neighbours (exact for a smooth extremum to O(step³))."""
-    k = int(np.argmax(values) if largest else np.argmin(values))
-    if 0 < k < values.size - 1:
-        y0, y1, y2 = values[k - 1], values[k], values[k + 1]
-        h = seconds[k + 1] - seconds[k]
-        curvature = y0 - 2.0 * y1 + y2
-        if curvature != 0.0 and np.isclose(seconds[k] - seconds[k - 1], h):
-            shift = 0.5 * (y0 - y2) / curvature  # in steps, within (−1, 1) at an extremum
-            if abs(shift) < 1.0:
-                return float(seconds[k] + shift * h), float(y1 - 0.25 * (y0 - y2) * shift)
-    return float(seconds[k]), float(values[k])
-
-
 def right_ascension_deg(radians: NDArray[np.float64]) -> NDArray[np.float64]:
     """Right ascensions in degrees, in [0, 360): an angle a hair below 2π rounds to
     360.0 in degrees, which is written as 0."""
@@ -264,29 +322,55 @@ def right_ascension_deg(radians: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.where(degrees >= 360.0, 0.0, degrees)
 
 
-def pointing_columns(result: PointingResult) -> list[Column]:
-    """The pointing columns of the time series, on the same grid as the trajectory's."""
+def _flag(name: str, values, description: str) -> list[Column]:
+    return [] if values is None else [Column(name, values.astype(float), description)]
+
+
+def _degrees(name: str, values, description: str) -> list[Column]:
+    return [] if values is None else [Column(name, np.degrees(values), description)]
+
+
+def pointing_columns(samples: PointingSamples) -> list[Column]:
+    """The pointing columns of the time series, at the samples' times (any chunk of
+    the output grid: the columns of consecutive chunks follow on)."""
     columns = _components(
-        "sun_icrf_{}", result.sun_direction_icrf, "xyz", "Sun direction (unit), ICRF axes"
+        "sun_icrf_{}",
+        samples.sun_direction_icrf,
+        "xyz",
+        "apparent Sun direction from the spacecraft (unit), ICRF axes",
     )
-    if result.on_orbit:
+    if samples.on_orbit:
         columns.append(
-            Column("sunlit_fraction", result.sunlit_fraction, "visible fraction of the Sun's disc")
+            Column("sunlit_fraction", samples.sunlit_fraction, "visible fraction of the Sun's disc")
         )
-        columns.append(
+        columns += _degrees(
+            "earth_angular_radius_deg",
+            samples.earth_angular_radius_rad,
+            "angular radius of the Earth (equatorial sphere) seen from the spacecraft, deg",
+        )
+    if samples.q_body_to_lvlh is not None:
+        columns += _components(
+            "q_body_to_lvlh_{}",
+            samples.q_body_to_lvlh,
+            "wxyz",
+            "attitude in the orbit's LVLH frame (z nadir, y -orbit normal), quaternion, "
+            "scalar first (w >= 0), body -> LVLH",
+        )
+    if samples.lvlh_euler_deg is not None:
+        sequence = samples.lvlh_euler_sequence
+        kind = "intrinsic" if sequence.isupper() else "extrinsic"
+        columns += [
             Column(
-                "earth_angular_radius_deg",
-                np.degrees(result.earth_angular_radius_rad),
-                "angular radius of the Earth seen from the spacecraft, deg",
+                f"lvlh_euler_{sequence}_{k + 1}_deg",
+                samples.lvlh_euler_deg[:, k],
+                f"Euler angle {k + 1} of body -> LVLH, {kind} sequence {sequence} "
+                f"(about {sequence[k]}), deg",
             )
-        )
-    for item in result.vectors:
+            for k in range(3)
+        ]
+    for item in samples.vectors:
         name = item.vector.name
-        columns.append(
-            Column(
-                f"{name}_sun_angle_deg", np.degrees(item.sun_angle_rad), f"angle {name}–Sun, deg"
-            )
-        )
+        columns += _degrees(f"{name}_sun_angle_deg", item.sun_angle_rad, f"angle {name}-Sun, deg")
         columns.append(
             Column(
                 f"{name}_cos_incidence",
@@ -294,14 +378,19 @@ def pointing_columns(result: PointingResult) -> list[Column]:
                 f"cosine of Sun incidence on {name} (0 if behind or in umbra, × visible fraction)",
             )
         )
-        if item.violated is not None:
-            columns.append(
-                Column(
-                    f"{name}_sun_exclusion_violated",
-                    item.violated.astype(float),
-                    f"1 if the Sun is inside {name}'s exclusion cone (and not in umbra)",
-                )
-            )
+        columns += _flag(
+            f"{name}_sun_exclusion_violated",
+            item.sun_violated,
+            f"1 if the Sun is inside {name}'s exclusion cone (and not in umbra)",
+        )
+        columns += _degrees(
+            f"{name}_moon_angle_deg", item.moon_angle_rad, f"angle {name}-Moon (apparent), deg"
+        )
+        columns += _flag(
+            f"{name}_moon_exclusion_violated",
+            item.moon_violated,
+            f"1 if the Moon is inside {name}'s exclusion cone (and not behind the Earth)",
+        )
         columns.append(
             Column(
                 f"{name}_ra_deg",
@@ -309,34 +398,47 @@ def pointing_columns(result: PointingResult) -> list[Column]:
                 f"{name} right ascension, deg",
             )
         )
-        columns.append(
-            Column(f"{name}_dec_deg", np.degrees(item.declination_rad), f"{name} declination, deg")
+        columns += _degrees(f"{name}_dec_deg", item.declination_rad, f"{name} declination, deg")
+        columns += _degrees(
+            f"{name}_nadir_angle_deg",
+            item.nadir_angle_rad,
+            f"angle between {name} and nadir (the Earth's centre), deg",
         )
-        if item.nadir_angle_rad is not None:
-            columns.append(
-                Column(
-                    f"{name}_nadir_angle_deg",
-                    np.degrees(item.nadir_angle_rad),
-                    f"angle between {name} and nadir (the Earth's centre), deg",
-                )
-            )
+        columns += _degrees(
+            f"{name}_earth_limb_angle_deg",
+            item.earth_limb_angle_rad,
+            f"angle of {name} above the Earth's limb (negative: towards the Earth), deg",
+        )
+        columns += _flag(
+            f"{name}_earth_limb_exclusion_violated",
+            item.earth_limb_violated,
+            f"1 if {name} is less than its exclusion angle above the Earth's limb",
+        )
     return columns
 
 
-def _interval_rows(result: PointingResult) -> list[tuple[str, str, Interval]]:
-    rows = [("eclipse", "", i) for i in result.shadow] + [("umbra", "", i) for i in result.umbra]
-    for item in result.vectors:
-        rows += [("sun_exclusion_violation", item.vector.name, i) for i in item.violations]
-        rows += [("sun_visible", item.vector.name, i) for i in item.sun_visible]
+# The kinds of interval in intervals.csv: (kind, the VectorAnalysis field), per vector.
+_VECTOR_INTERVALS = ("sun_exclusion", "moon_exclusion", "earth_limb_exclusion", "sun_visible")
+
+
+def _interval_rows(analysis: PointingAnalysis) -> list[tuple[str, str, Interval]]:
+    rows = [("eclipse", "", i) for i in analysis.shadow]
+    rows += [("umbra", "", i) for i in analysis.umbra]
+    rows += [("moon_behind_earth", "", i) for i in analysis.moon_hidden]
+    for item in analysis.vectors:
+        for kind in _VECTOR_INTERVALS:
+            rows += [(kind, item.vector.name, i) for i in getattr(item, kind)]
     return sorted(rows, key=lambda row: (row[0], row[1], row[2].start_s))
 
 
-def write_intervals_csv(path: Path, result: PointingResult, iso, preamble: list[str]) -> None:
+def write_intervals_csv(
+    path: Path, analysis: PointingAnalysis, iso, preamble: list[str]
+) -> None:
     """One row per interval: kind, body vector, start and end (ISO and TT s), duration.
 
     ``iso``: a function from TT seconds to ISO texts in the scenario's time scale.
     """
-    rows = _interval_rows(result)
+    rows = _interval_rows(analysis)
     starts = iso(np.array([r[2].start_s for r in rows])) if rows else []
     ends = iso(np.array([r[2].end_s for r in rows])) if rows else []
     with open(path, "w", encoding="utf-8", newline="") as stream:
@@ -352,53 +454,75 @@ def write_intervals_csv(path: Path, result: PointingResult, iso, preamble: list[
             )
 
 
-def _interval_totals(intervals: list[Interval]) -> dict[str, Any]:
-    return {
+def _interval_totals(intervals: list[Interval], format_epoch=None) -> dict[str, Any]:
+    totals: dict[str, Any] = {
         "count": len(intervals),
         "total_s": total_duration(intervals),
         "longest_s": max((i.duration_s for i in intervals), default=0.0),
     }
+    if format_epoch is not None:
+        totals["first"] = [
+            {
+                "start": format_epoch(i.start_s),
+                "end": format_epoch(i.end_s),
+                "duration_s": i.duration_s,
+            }
+            for i in intervals[:20]
+        ]
+    return totals
 
 
-def pointing_summary(result: PointingResult, format_epoch) -> dict[str, Any]:
-    """Extrema with their times, violation and visibility totals, eclipses."""
-    t = result.seconds
+# The extrema in the summary: (key in VectorAnalysis.extrema, summary name, in degrees).
+_EXTREMA = (
+    ("sun_angle", "sun_angle", True),
+    ("moon_angle", "moon_angle", True),
+    ("nadir_angle", "nadir_angle", True),
+    ("earth_limb_angle", "earth_limb_angle", True),
+    ("cos_incidence", "cos_incidence", False),
+)
+
+
+def pointing_summary(analysis: PointingAnalysis, format_epoch) -> dict[str, Any]:
+    """Extrema with their times, constraint and visibility totals, eclipses: all found
+    on the exact motion over the analysed span (``attitude.pointing.pointing_analysis``),
+    none from the output grid."""
     vectors = {}
-    for item in result.vectors:
-        angle = np.degrees(item.sun_angle_rad)
-        t_min, a_min = extremum(t, angle, largest=False)
-        t_max, a_max = extremum(t, angle, largest=True)
-        entry = {
-            "kind": item.vector.kind,
-            "vector_body": item.vector.vector,
-            "sun_angle_min_deg": a_min,
-            "sun_angle_min_at": format_epoch(t_min),
-            "sun_angle_max_deg": a_max,
-            "sun_angle_max_at": format_epoch(t_max),
-            "sun_visible": _interval_totals(item.sun_visible),
-            "mean_cos_incidence": float(np.mean(item.cos_incidence)),
-        }
-        if item.vector.sun_exclusion_half_angle_rad is not None:
-            entry["sun_exclusion_half_angle_deg"] = item.vector.sun_exclusion_half_angle_deg
-            entry["violations"] = _interval_totals(item.violations)
-            entry["violations"]["first"] = [
-                {
-                    "start": format_epoch(i.start_s),
-                    "end": format_epoch(i.end_s),
-                    "duration_s": i.duration_s,
-                }
-                for i in item.violations[:20]
-            ]
-        vectors[item.vector.name] = entry
+    for item in analysis.vectors:
+        v = item.vector
+        entry: dict[str, Any] = {"kind": v.kind, "vector_body": v.vector}
+        for key, name, degrees in _EXTREMA:
+            if key not in item.extrema:
+                continue
+            low, high = item.extrema[key]
+            unit = "_deg" if degrees else ""
+            convert = math.degrees if degrees else float
+            entry[f"{name}_min{unit}"] = convert(low.value)
+            entry[f"{name}_min_at"] = format_epoch(low.time_s)
+            entry[f"{name}_max{unit}"] = convert(high.value)
+            entry[f"{name}_max_at"] = format_epoch(high.time_s)
+        entry["mean_cos_incidence"] = item.mean_cos_incidence
+        entry["sun_visible"] = _interval_totals(item.sun_visible)
+        for constraint, angle in (
+            ("sun_exclusion", "sun_exclusion_half_angle_deg"),
+            ("moon_exclusion", "moon_exclusion_half_angle_deg"),
+            ("earth_limb_exclusion", "earth_limb_exclusion_angle_deg"),
+        ):
+            if getattr(v, angle) is not None:
+                entry[angle] = getattr(v, angle)
+                entry[constraint] = _interval_totals(getattr(item, constraint), format_epoch)
+        vectors[v.name] = entry
     summary: dict[str, Any] = {
-        "position": "TLE orbit" if result.on_orbit else "Earth centre",
-        "interval_precision_s": result.precision_s,
+        "position": analysis.orbit,
+        "span": {"start": format_epoch(analysis.start_s), "stop": format_epoch(analysis.stop_s)},
+        "interval_precision_s": analysis.precision_s,
+        "search_step_s": analysis.grid.step_s,
         "body_vectors": vectors,
     }
-    if result.on_orbit:
+    if analysis.on_orbit:
         summary["eclipses"] = {
-            "shadow": _interval_totals(result.shadow),
-            "umbra": _interval_totals(result.umbra),
-            "sunlit_fraction_of_span": float(np.mean(result.sunlit_fraction)),
+            "shadow": _interval_totals(analysis.shadow),
+            "umbra": _interval_totals(analysis.umbra),
+            "sunlit_fraction_of_span": analysis.sunlit_fraction_mean,
         }
+        summary["moon_behind_earth"] = _interval_totals(analysis.moon_hidden)
     return summary

@@ -58,10 +58,12 @@ from attitude.errors import InputError
 from attitude.exports import motion_summary, pointing_summary
 from attitude.output_budget import ResourceError, available_memory_bytes
 from attitude.output_folder import held_signals
-from attitude.pointing import PointingSpec, compute_pointing
+from attitude.output_formats import OutputChoice
+from attitude.pointing import PointingSpec, pointing_analysis, pointing_samples
 from attitude.run_plan import RunPlan, plan_run
 from attitude.scenario import Scenario
 from attitude.scenario_file import ScenarioFile, load_scenario, scenario_from_document
+from attitude.scenario_writer import with_absolute_files
 from attitude.trajectory import Trajectory
 from attitude.version import __version__
 
@@ -70,16 +72,21 @@ if TYPE_CHECKING:
 
 __all__ = [
     "ANGLE_STEP_DEG",
+    "METRICS_ONLY",
     "TIME_BINS",
     "Envelope",
+    "Job",
     "MonteCarloPlan",
     "MonteCarloResult",
     "choose_batch_size",
     "evaluate_batch",
+    "metric_names",
     "plan_montecarlo",
+    "pointing_outcome",
     "run_montecarlo",
     "sample_metrics",
     "simulate",
+    "sun_angles_deg",
 ]
 
 # The Sun-angle series of each sample is reduced to its extremes in this many time
@@ -96,6 +103,10 @@ _TASKS_PER_WORKER = 4
 # they arrive, the CSV and Parquet buffers), with a margin.
 _BYTES_PER_CELL = 64
 _CONNECT_TIMEOUT_S = 10
+# A sample writes no files: its plan checks the scenario, the motion and the pointing
+# as `attitude run` does, and no output's own limits (no AEM records are chosen, no
+# Parquet span is checked; the CSV's estimated size goes unused).
+METRICS_ONLY = OutputChoice(formats=("csv",))
 _OVERHEAD_PROBES = 40
 
 # ------------------------------------------------------------------------- metrics
@@ -120,6 +131,42 @@ def _segment_metric_names(k: int) -> list[str]:
     ]
 
 
+# Each body vector's extrema, as summary.json names them (attitude.exports): the
+# quantity, and whether it is an angle (reported in degrees).
+_VECTOR_EXTREMA = (
+    ("sun_angle", True, False),
+    ("moon_angle", True, False),
+    ("nadir_angle", True, True),
+    ("earth_limb_angle", True, True),
+    ("cos_incidence", False, False),
+)  # (quantity, in degrees, needs an orbit)
+_CONSTRAINTS = (
+    ("sun_exclusion", "sun_exclusion_half_angle_rad"),
+    ("moon_exclusion", "moon_exclusion_half_angle_rad"),
+    ("earth_limb_exclusion", "earth_limb_exclusion_angle_rad"),
+)
+
+
+def _vector_metric_names(vector, on_orbit: bool) -> list[str]:
+    v = vector.name
+    names = []
+    for quantity, degrees, needs_orbit in _VECTOR_EXTREMA:
+        if needs_orbit and not on_orbit:
+            continue
+        unit = "_deg" if degrees else ""
+        names += [
+            f"{v}_{quantity}_min{unit}",
+            f"{v}_{quantity}_min_at_s",
+            f"{v}_{quantity}_max{unit}",
+            f"{v}_{quantity}_max_at_s",
+        ]
+    names += [f"{v}_mean_cos_incidence", f"{v}_sun_visible_s"]
+    for constraint, angle in _CONSTRAINTS:
+        if getattr(vector, angle) is not None:
+            names += [f"{v}_{constraint}_{total}" for total in ("count", "total_s", "longest_s")]
+    return names
+
+
 def metric_names(scenario: Scenario, pointing: PointingSpec) -> list[str]:
     """The outcome columns of a scenario's samples (the same for every sample: the
     dispersions change numbers, not the number of segments or body vectors)."""
@@ -127,19 +174,15 @@ def metric_names(scenario: Scenario, pointing: PointingSpec) -> list[str]:
     for k in range(len(scenario.events) + 1):
         names += _segment_metric_names(k)
     for vector in pointing.body_vectors:
-        v = vector.name
+        names += _vector_metric_names(vector, pointing.on_orbit)
+    if pointing.on_orbit:
         names += [
-            f"{v}_sun_angle_min_deg",
-            f"{v}_sun_angle_min_at_s",
-            f"{v}_sun_angle_max_deg",
-            f"{v}_sun_angle_max_at_s",
-            f"{v}_sun_visible_s",
-            f"{v}_mean_cos_incidence",
+            "eclipse_count",
+            "eclipse_total_s",
+            "umbra_total_s",
+            "sunlit_fraction",
+            "moon_behind_earth_total_s",
         ]
-        if vector.sun_exclusion_half_angle_rad is not None:
-            names += [f"{v}_violation_count", f"{v}_violation_total_s", f"{v}_violation_longest_s"]
-    if pointing.tle is not None:
-        names += ["eclipse_count", "eclipse_total_s", "umbra_total_s", "sunlit_fraction"]
     return names
 
 
@@ -147,46 +190,56 @@ def _number(value: Any) -> float:
     return math.nan if value is None else float(value)
 
 
-def pointing_outcome(
-    trajectory: Trajectory, spec: PointingSpec, seconds: NDArray[np.float64]
-) -> tuple[dict[str, float], NDArray[np.float64]]:
-    """The pointing metrics of one sample, as ``summary.json`` reports them, and each
-    body vector's Sun angle on the output grid, deg (one row per vector).
-
-    The one place Monte Carlo computes pointing: today through ``compute_pointing`` on
-    the output grid; with the split of ``attitude.pointing``, the metrics come from
-    ``pointing_analysis(trajectory, spec)`` and the series from ``pointing_samples``.
-    """
-    result = compute_pointing(trajectory, spec, seconds)
-    summary = pointing_summary(result, float)  # times as TT seconds, not ISO text
+def pointing_outcome(plan: RunPlan) -> dict[str, float]:
+    """The pointing metrics of one checked scenario, as ``summary.json`` reports them:
+    each body vector's extrema (with their times, TT seconds) and constraint totals, and
+    the eclipses, all found on the exact motion over the span by
+    :func:`attitude.pointing.pointing_analysis` on the plan's search grid, as
+    ``attitude run`` finds them (none from the output grid)."""
+    analysis = pointing_analysis(plan.trajectory, plan.pointing, grid=plan.search)
+    summary = pointing_summary(analysis, float)  # times as TT seconds, not ISO text
     metrics: dict[str, float] = {}
     for name, entry in summary["body_vectors"].items():
-        metrics[f"{name}_sun_angle_min_deg"] = entry["sun_angle_min_deg"]
-        metrics[f"{name}_sun_angle_min_at_s"] = entry["sun_angle_min_at"]
-        metrics[f"{name}_sun_angle_max_deg"] = entry["sun_angle_max_deg"]
-        metrics[f"{name}_sun_angle_max_at_s"] = entry["sun_angle_max_at"]
-        metrics[f"{name}_sun_visible_s"] = entry["sun_visible"]["total_s"]
+        for quantity, degrees, _ in _VECTOR_EXTREMA:
+            unit = "_deg" if degrees else ""
+            if f"{quantity}_min{unit}" not in entry:  # an orbit's quantity, without one
+                continue
+            for end in ("min", "max"):
+                metrics[f"{name}_{quantity}_{end}{unit}"] = entry[f"{quantity}_{end}{unit}"]
+                metrics[f"{name}_{quantity}_{end}_at_s"] = entry[f"{quantity}_{end}_at"]
         metrics[f"{name}_mean_cos_incidence"] = entry["mean_cos_incidence"]
-        if "violations" in entry:
-            metrics[f"{name}_violation_count"] = entry["violations"]["count"]
-            metrics[f"{name}_violation_total_s"] = entry["violations"]["total_s"]
-            metrics[f"{name}_violation_longest_s"] = entry["violations"]["longest_s"]
+        metrics[f"{name}_sun_visible_s"] = entry["sun_visible"]["total_s"]
+        for constraint, _ in _CONSTRAINTS:
+            if constraint in entry:
+                for total in ("count", "total_s", "longest_s"):
+                    metrics[f"{name}_{constraint}_{total}"] = entry[constraint][total]
     if "eclipses" in summary:
         eclipses = summary["eclipses"]
         metrics["eclipse_count"] = eclipses["shadow"]["count"]
         metrics["eclipse_total_s"] = eclipses["shadow"]["total_s"]
         metrics["umbra_total_s"] = eclipses["umbra"]["total_s"]
         metrics["sunlit_fraction"] = eclipses["sunlit_fraction_of_span"]
-    angles = np.array([np.degrees(item.sun_angle_rad) for item in result.vectors])
-    return metrics, angles.reshape(len(result.vectors), seconds.size)
+        metrics["moon_behind_earth_total_s"] = summary["moon_behind_earth"]["total_s"]
+    return metrics
+
+
+def sun_angles_deg(plan: RunPlan, seconds: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Each body vector's Sun angle at ``seconds`` (deg, one row per vector): the series
+    the envelopes reduce (:func:`attitude.pointing.pointing_samples`, as the time
+    series of ``attitude run`` samples it)."""
+    samples = pointing_samples(plan.trajectory, plan.pointing, seconds)
+    angles = [np.degrees(item.sun_angle_rad) for item in samples.vectors]
+    return np.array(angles).reshape(len(samples.vectors), seconds.size)
 
 
 def grid_rates(trajectories: list[Trajectory], seconds: NDArray[np.float64]) -> NDArray:
     """|ω| (rad/s) of each trajectory on the output grid, shape (samples, epochs).
 
-    The batch's one evaluation on the output grid: with the vectorized free flow
-    (``attitude.free_flow.advance``), all samples of a batch advance together from one
-    output epoch to the next, here.
+    Each trajectory is evaluated over all its epochs at once (the solver is vectorized
+    over times).  Advancing the batch's samples together instead, with the free-flow map
+    vectorized over states (``attitude.free_flow.advance``), does not pay here: this
+    step is under 0.1 % of a sample's cost, which is the exact pointing search
+    (docs/benchmarks.md, "Monte Carlo").
     """
     rates = np.empty((len(trajectories), seconds.size))
     for row, trajectory in zip(rates, trajectories, strict=True):
@@ -211,7 +264,7 @@ def sample_metrics(
     # As the report takes it: the largest |ω| among the output epochs, in deg/s.
     metrics: dict[str, Any] = {
         "flip_count": motion["flips"]["count"],
-        "max_rate_deg_s": float(np.degrees(rate[int(np.argmax(rate))])),
+        "max_rate_deg_s": math.degrees(float(rate[int(np.argmax(rate))])),
     }
     for k, segment in enumerate(motion["segments"]):
         names = _segment_metric_names(k)
@@ -233,8 +286,9 @@ def sample_metrics(
         metrics[names[2]] = segment["flip_count"]  # a count: an integer column
     angles = np.empty((0, seconds.size))
     if not plan.pointing.is_empty:
-        pointing, angles = pointing_outcome(plan.trajectory, plan.pointing, seconds)
-        metrics.update(pointing)
+        metrics.update(pointing_outcome(plan))
+        if plan.pointing.body_vectors:
+            angles = sun_angles_deg(plan, seconds)
     return metrics, angles
 
 
@@ -300,7 +354,7 @@ def plan_montecarlo(
     (``plan``, from :func:`attitude.run_plan.plan_run` if not given), the
     ``[dispersions]`` table (``samples`` and ``seed`` replace its own), and the size of
     the per-sample table against the memory available."""
-    plan = plan or plan_run(loaded.scenario, loaded.pointing)
+    plan = plan or plan_run(loaded.scenario, loaded.pointing, METRICS_ONLY)
     dispersions = read_dispersions(loaded, samples, seed)
     mc = MonteCarloPlan(
         loaded,
@@ -334,6 +388,18 @@ class Job:
     parameters: list[str]
     metrics: list[str]
     vectors: int
+
+    @classmethod
+    def of(cls, mc: MonteCarloPlan) -> Job:
+        return cls(
+            mc.loaded.path.absolute(),
+            # The files it names, absolute: a worker's working folder may be another.
+            with_absolute_files(mc.loaded.document, mc.loaded.path.parent),
+            mc.dispersions,
+            mc.parameters,
+            mc.metrics,
+            len(mc.vectors),
+        )
 
 
 @dataclass
@@ -370,7 +436,7 @@ def evaluate_batch(job: Job, first: int, stop: int) -> BatchResult:
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always")
                 loaded = scenario_from_document(job.path, sample.document)
-                plan = plan_run(loaded.scenario, loaded.pointing)
+                plan = plan_run(loaded.scenario, loaded.pointing, METRICS_ONLY)
         except Exception as exc:  # a sample's failure is data: reported, not raised
             rows.append(_failure(index, sample.parameters, _error_text(exc)))
             continue
@@ -619,7 +685,7 @@ def _nominal(mc: MonteCarloPlan) -> tuple[dict[str, Any], float]:
     cost = time.perf_counter() - start
     if cost < 2.0:
         start = time.perf_counter()
-        plan = plan_run(loaded.scenario, loaded.pointing)
+        plan = plan_run(loaded.scenario, loaded.pointing, METRICS_ONLY)
         sample_metrics(plan)
         cost = time.perf_counter() - start
     return metrics, cost
@@ -649,14 +715,7 @@ def simulate(
     stage(f"nominal run: {sample_s:.3g} s a sample")
     seconds = mc.plan.scenario.output_seconds()
     envelope = Envelope(mc.vectors, seconds)
-    job = Job(
-        mc.loaded.path,
-        mc.loaded.document,
-        mc.dispersions,
-        mc.parameters,
-        mc.metrics,
-        len(mc.vectors),
-    )
+    job = Job.of(mc)
     rows: list[dict[str, Any]] = []
     failed = 0
     with connect(scheduler, workers) as client:
@@ -789,19 +848,21 @@ def emit_samples(mc: MonteCarloPlan, indices: list[int], out_dir: str | Path) ->
             ]
             if sample.error:
                 comments.append(f"This draw failed: {sample.error}")
-            (tmp / name).write_text(scenario_text(sample.document, comments), encoding="utf-8")
+            # The files it names (an OEM, an AEM) are named absolute: it is read from DIR.
+            document = with_absolute_files(sample.document, mc.loaded.path.parent)
+            (tmp / name).write_text(scenario_text(document, comments), encoding="utf-8")
         return list(names.values())
 
     folder.write(build, source, __version__)
     return [str(folder.path / name) for name in names.values()]
 
 
-def command(args, loaded: ScenarioFile, plan: RunPlan) -> int:
+def command(args, loaded: ScenarioFile) -> int:
     """``attitude montecarlo`` (the command line's options in ``args``): run the job into
     ``--out``, or write samples ``--sample`` into ``--emit-scenario``."""
     from attitude.report import Progress
 
-    mc = plan_montecarlo(loaded, plan, args.samples, args.seed)
+    mc = plan_montecarlo(loaded, None, args.samples, args.seed)
     if args.emit_scenario is not None or args.sample is not None:
         if args.emit_scenario is None or args.sample is None:
             raise InputError("--sample K and --emit-scenario DIR go together")

@@ -120,6 +120,11 @@ def statistics(result: MonteCarloResult) -> dict[str, Any]:
                 f"confidence >= {CONFIDENCE:g} (Wilks 1941, doi:10.1214/aoms/1177731788)"
             ),
             "over": "the samples that ran, and the finite values of each column (n)",
+            "metrics": (
+                "each sample's numbers as summary.json of attitude run reports them: the "
+                "pointing's extrema and intervals found on the sample's exact motion "
+                "(attitude.pointing.pointing_analysis), the largest rate on the output grid"
+            ),
         },
         "nominal": result.nominal,
         "metrics": {n: describe(ok[n].to_numpy(float)) for n in _numeric(table, mc.metrics)},
@@ -200,7 +205,10 @@ def _histogram_columns(mc: MonteCarloPlan, table) -> list[str]:
     pointing first, then flips, rates, nutation and periods."""
     ok = table[table["status"] == "ok"]
     order = [n for n in mc.metrics if "sun_angle" in n and not n.endswith("_at_s")]
-    order += [n for n in mc.metrics if n.endswith(("violation_total_s", "eclipse_total_s"))]
+    order += [n for n in mc.metrics if n.endswith("_exclusion_total_s")]
+    order += [n for n in mc.metrics if n == "eclipse_total_s"]
+    order += [n for n in mc.metrics if "_limb_angle_min" in n and not n.endswith("_at_s")]
+    order += [n for n in mc.metrics if "_moon_angle_min" in n and not n.endswith("_at_s")]
     order += ["flip_count", "max_rate_deg_s"]
     order += [n for n in mc.metrics if n.endswith(("nutation_max_deg", "spin_period_s"))]
     order += [n for n in mc.metrics if n.endswith("precession_period_s")]

@@ -51,6 +51,54 @@ def _table(header: list[str], rows: list[list[Any]]) -> str:
     return f"<table><tr>{head}</tr>{body}</table>"
 
 
+def _range(v: dict[str, Any], name: str) -> str | None:
+    """'least – greatest' of an extremum pair of the pointing summary, in degrees."""
+    if f"{name}_min_deg" not in v:
+        return None
+    return f"{v[f'{name}_min_deg']:.4f} – {v[f'{name}_max_deg']:.4f}"
+
+
+def _exclusion(v: dict[str, Any], name: str) -> str | None:
+    """'count, total s' of an exclusion of the pointing summary, or None."""
+    found = v.get(name)
+    return None if found is None else f"{found['count']}, {found['total_s']:.6g} s"
+
+
+def _pointing_table(vectors: dict[str, Any]) -> str:
+    rows = [
+        [
+            name,
+            v["kind"],
+            f"{v['sun_angle_min_deg']:.4f} at {v['sun_angle_min_at']}",
+            _range(v, "sun_angle"),
+            _range(v, "moon_angle"),
+            _range(v, "nadir_angle"),
+            _range(v, "earth_limb_angle"),
+            _exclusion(v, "sun_exclusion"),
+            _exclusion(v, "moon_exclusion"),
+            _exclusion(v, "earth_limb_exclusion"),
+            v["sun_visible"]["total_s"],
+            v["mean_cos_incidence"],
+        ]
+        for name, v in vectors.items()
+    ]
+    header = [
+        "body vector",
+        "kind",
+        "least Sun angle (deg)",
+        "Sun angle (deg)",
+        "Moon angle (deg)",
+        "nadir angle (deg)",
+        "above the limb (deg)",
+        "Sun exclusions (n, time)",
+        "Moon exclusions",
+        "limb exclusions",
+        "Sun visible (s)",
+        "mean cos incidence",
+    ]
+    return _table(header, rows)
+
+
 def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str]) -> str:
     """The HTML text of the report.
 
@@ -143,43 +191,13 @@ def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str
     if pointing:
         parts.append("<h2>Pointing</h2>")
         parts.append(
-            f"<p class='note'>Spacecraft at: {escape(pointing['position'])}. Interval ends "
-            f"refined on the exact motion to {pointing['interval_precision_s']:g} s.</p>"
+            f"<p class='note'>Spacecraft at: {escape(pointing['position'])}. Extrema and "
+            "interval ends found on the exact motion (search step "
+            f"{pointing['search_step_s']:.3g} s), interval ends to "
+            f"{pointing['interval_precision_s']:g} s. Angles are geometric: an extremum may "
+            "fall in an eclipse; exclusions leave out a hidden Sun or Moon.</p>"
         )
-        rows = []
-        for name, v in pointing["body_vectors"].items():
-            violations = v.get("violations")
-            rows.append(
-                [
-                    name,
-                    v["kind"],
-                    f"{v['sun_angle_min_deg']:.4f} at {v['sun_angle_min_at']}",
-                    f"{v['sun_angle_max_deg']:.4f} at {v['sun_angle_max_at']}",
-                    v.get("sun_exclusion_half_angle_deg"),
-                    None if violations is None else violations["count"],
-                    None if violations is None else violations["total_s"],
-                    None if violations is None else violations["longest_s"],
-                    v["sun_visible"]["total_s"],
-                    v["mean_cos_incidence"],
-                ]
-            )
-        parts.append(
-            _table(
-                [
-                    "body vector",
-                    "kind",
-                    "min Sun angle (deg, geometric: eclipses included)",
-                    "max Sun angle (deg, geometric)",
-                    "exclusion (deg)",
-                    "violations",
-                    "violated (s)",
-                    "longest (s)",
-                    "Sun visible (s)",
-                    "mean cos incidence",
-                ],
-                rows,
-            )
-        )
+        parts.append(_pointing_table(pointing["body_vectors"]))
         eclipses = pointing.get("eclipses")
         if eclipses:
             parts.append(
@@ -202,7 +220,8 @@ def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str
                     ],
                 )
             )
-    parts.append("<h2>Plots</h2>")
+    if images:
+        parts.append("<h2>Plots</h2>")
     for caption, name in images.items():
         parts.append(
             f"<figure><img src='{escape(name)}' alt='{escape(caption)}'>"
@@ -211,6 +230,14 @@ def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str
     parts.append("<h2>Files</h2><ul>")
     parts += [f"<li><a href='{escape(f)}'>{escape(f)}</a></li>" for f in files]
     parts.append("</ul>")
+    aem = summary.get("outputs", {}).get("aem")
+    if aem:
+        parts.append(
+            f"<p class='note'>attitude.aem: {aem['records']} records, sampled so that "
+            "LAGRANGE interpolation as declared (degree 7, each quaternion component over the "
+            "8 records centred on the interval, normalized) stays within "
+            f"{aem['tolerance_rad']:g} rad of the exact attitude.</p>"
+        )
     parts.append(
         "<p class='note'>Frames: body = spacecraft body axes; ICRF axes for inertial vectors. "
         "Quaternions are scalar first and rotate body coordinates into ICRF "

@@ -1,22 +1,28 @@
 """Everything a run checks before it samples: one path for ``attitude check`` and ``run``.
 
-``plan_run(scenario, pointing)`` propagates the scenario (the exact solver segments,
-refused where the motion is faster than TT seconds can follow), analyses each
-segment (flips counted, not listed), checks the pointing (the TLE, SGP4 over the
-span, the Sun ephemeris with the interpolation's margins), counts the output samples
-and estimates the outputs' size against the memory available.  What it refuses, a
-run would have refused later, after computing; what it returns is what the run uses.
-Errors are ``attitude.errors.InputError`` whose message starts with the scenario key.
+``plan_run(scenario, pointing, outputs)`` propagates the scenario (the exact solver
+segments, refused where the motion is faster than TT seconds can follow), analyses
+each segment (flips counted, not listed), checks the pointing (the orbit source over
+the span, the Sun and Moon ephemeris with the interpolation's margins, the size of
+the exact search), chooses the AEM's records for its tolerance, counts the output
+samples and estimates the outputs' sizes and the (constant) memory of the streamed
+run.  It notes an output step that undersamples the motion (more than a tenth of its
+shortest period).  What it refuses, a run would have refused later, after computing;
+what it returns is what the run uses.  Errors are ``attitude.errors.InputError``
+whose message starts with the scenario key.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+from attitude.aem_sampling import AemPlan, plan_aem
 from attitude.motion_analysis import SegmentMotion, analyze
 from attitude.output_budget import OutputBudget, check_fits, estimate
-from attitude.pointing import PointingSpec, check_pointing, search_grid_count
+from attitude.output_formats import OutputChoice
+from attitude.pointing import PointingSpec, SearchGrid, check_pointing, undersampling_note
 from attitude.scenario import Scenario
+from attitude.timeseries_parquet import check_span
 from attitude.trajectory import Trajectory, propagate
 
 __all__ = ["RunPlan", "plan_run"]
@@ -24,7 +30,7 @@ __all__ = ["RunPlan", "plan_run"]
 
 @dataclass
 class RunPlan:
-    """A scenario checked for a run: its trajectory, motion, output size and notes."""
+    """A scenario checked for a run: its trajectory, motion, outputs, sizes and notes."""
 
     scenario: Scenario
     pointing: PointingSpec
@@ -32,20 +38,47 @@ class RunPlan:
     motion: list[SegmentMotion]
     budget: OutputBudget
     notes: list[str] = field(default_factory=list)
+    outputs: OutputChoice = field(default_factory=OutputChoice)
+    aem: AemPlan | None = None
+    search: SearchGrid | None = None  # the pointing's exact search (None without pointing)
 
 
-def plan_run(scenario: Scenario, pointing: PointingSpec | None = None) -> RunPlan:
-    """Check ``scenario`` (and ``pointing``) as a run would, up to the sampling."""
+def plan_run(
+    scenario: Scenario, pointing: PointingSpec | None = None, outputs: OutputChoice | None = None
+) -> RunPlan:
+    """Check ``scenario`` (``pointing``, ``outputs``) as a run would, up to the sampling."""
     pointing = pointing or PointingSpec()
+    outputs = outputs or OutputChoice()
     samples = scenario.output_count()
+    if "parquet" in outputs:
+        check_span(scenario.start_s, scenario.stop_s, "--formats parquet")
     trajectory = propagate(scenario)
-    # The memory check comes before the analysis and the pointing checks, which do
-    # not depend on the output grid but can take a while on a long span.
-    grid = 0
-    if not pointing.is_empty:
-        grid = search_grid_count(trajectory, scenario.start_s, scenario.stop_s)
-    budget = estimate(samples, grid, len(pointing.body_vectors), pointing.tle is not None)
+    # The size and memory checks come before the analysis and the pointing checks,
+    # which do not depend on the output grid but can take a while on a long span.
+    vectors, on_orbit = len(pointing.body_vectors), pointing.on_orbit
+    budget = estimate(samples, 0, vectors, on_orbit, outputs.formats, aem_records=0)
     check_fits(budget)
     motion = analyze(trajectory)
-    notes = check_pointing(trajectory, pointing)
-    return RunPlan(scenario, pointing, trajectory, motion, budget, notes)
+    notes, search = check_pointing(trajectory, pointing)
+    undersampled = undersampling_note(trajectory, motion)
+    if undersampled:
+        notes.append(undersampled)
+    aem = None
+    if "aem" in outputs:
+        aem = plan_aem(
+            trajectory,
+            motion,
+            scenario.start_s,
+            scenario.stop_s,
+            outputs.aem_tolerance_rad,
+            outputs.tolerance_key,
+        )
+    budget = estimate(
+        samples,
+        0 if search is None else search.count,
+        vectors,
+        on_orbit,
+        outputs.formats,
+        0 if aem is None else aem.records,
+    )
+    return RunPlan(scenario, pointing, trajectory, motion, budget, notes, outputs, aem, search)

@@ -7,11 +7,17 @@ keys are refused (a misspelt key would otherwise be silently ignored).
 Numbers are in SI units (s, kg m², N m s, rad/s) unless given as a table with a
 unit, ``{ value = [0, 30, 0], unit = "deg/s" }``, read by ``astropy.units`` and
 converted strictly (``Hz`` is refused as ambiguous, see ``attitude.quantities``).
-An angle (``sun_exclusion_half_angle``) must carry its unit: a bare 3 would be
-171.9° in radians, or 3° to a reader of a data sheet.  Numbers are TOML numbers:
+An angle (``sun_exclusion_half_angle``, an inclination) must carry its unit: a bare 3
+would be 171.9° in radians, or 3° to a reader of a data sheet.  Numbers are TOML numbers:
 booleans and strings are refused, not read as 1 or parsed.  Warnings (a body that
 breaks the triangle inequality) are :class:`ScenarioFileWarning`, one line naming the
 file and the key.
+
+An attitude may be given in an orbit frame (``frame = "lvlh"`` or ``"rtn"``, in
+``[initial_state]`` and in attitude resets) or read from an AEM file (``aem = "..."``):
+it is resolved to ICRF here, at load time, with the orbit of ``[pointing]`` at the
+state's epoch, so that the scenario layer below only ever sees body → ICRF.  Files
+(``oem``, ``aem``) are read relative to the scenario file's folder.
 """
 
 from __future__ import annotations
@@ -26,13 +32,20 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from attitude.aem_input import attitude_from_aem
+from attitude.aem_sampling import check_tolerance
 from attitude.errors import InertiaWarning, InputError
 from attitude.events import AngularImpulse, AttitudeReset, InertiaChange
-from attitude.pointing import BodyVector, PointingSpec
+from attitude.frames import ORBIT_FRAMES, orbit_frame_to_icrf
+from attitude.keplerian import KeplerianOrbit
+from attitude.oem import OemOrbit
+from attitude.orbit import Orbit, TleOrbit
+from attitude.output_formats import DEFAULT_FORMATS, OutputChoice, parse_formats
+from attitude.pointing import KINDS, BodyVector, PointingSpec
 from attitude.quantities import convert_unit
 from attitude.scenario import InitialState, Scenario
 from attitude.spacecraft import Spacecraft
-from attitude.timescales import SCALES, as_time
+from attitude.timescales import SCALES, as_time, time_from_tt_seconds
 
 __all__ = [
     "ScenarioFile",
@@ -63,6 +76,7 @@ class ScenarioFile:
     path: Path
     scenario: Scenario
     pointing: PointingSpec = field(default_factory=PointingSpec)
+    outputs: OutputChoice = field(default_factory=OutputChoice)
     # The TOML document as read: attitude.dispersions reads its [dispersions] table
     # and writes each Monte Carlo sample as a copy of it.
     document: dict[str, Any] = field(default_factory=dict)
@@ -180,6 +194,19 @@ class _Table:
                 self.fail(f"{value!r} {unit} is beyond the float range in SI units", key)
         return array if shape else float(array)
 
+    def boolean(self, key: str, default: bool) -> bool:
+        value = self.raw(key, required=False, default=default)
+        if not isinstance(value, bool):
+            self.fail(f"expected true or false, got {_short(value)}", key)
+        return value
+
+    def file_path(self, key: str) -> Path:
+        """A file named by a string key, relative to the scenario file's folder."""
+        text = self.string(key)
+        if not text:
+            self.fail("expected a file name, got an empty string", key)
+        return self.file.parent / Path(text).expanduser()
+
     def epoch(self, key: str, scale: str, required: bool = True):
         value = self.string(key, required)
         if value is None:
@@ -254,6 +281,7 @@ def _without_inertia_name(message: str) -> str:
 
 
 def _attitude(table: _Table) -> Rotation | None:
+    """The attitude given as a quaternion or a matrix (in the table's frame), or None."""
     given = [key for key in ("quaternion", "matrix") if table.has(key)]
     if len(given) > 1:
         table.fail("give one of quaternion and matrix, not both")
@@ -269,6 +297,46 @@ def _attitude(table: _Table) -> Rotation | None:
     if np.max(np.abs(a @ a.T - np.eye(3))) > 1e-6 or np.linalg.det(a) < 0:
         table.fail(f"matrix must be a rotation (orthonormal, det +1), got {a.tolist()}", "matrix")
     return Rotation.from_matrix(a)
+
+
+def _attitude_in_icrf(table: _Table, orbit: Orbit | None, at) -> Rotation | None:
+    """The table's attitude (quaternion or matrix, or ``aem``) as body → ICRF at the
+    epoch ``at`` (a ``Time``): a ``frame = "lvlh"``/``"rtn"`` attitude is composed with
+    the orbit frame there, an AEM file is read at that epoch."""
+    frame = table.choice("frame", ("icrf", *ORBIT_FRAMES), default="icrf")
+    attitude = _attitude(table)
+    if table.has("aem"):
+        if attitude is not None:
+            table.fail("give one of quaternion, matrix and aem, not two")
+        if frame != "icrf":
+            table.fail("an AEM file states its own frame: frame applies to quaternion or matrix")
+        path = table.file_path("aem")
+        try:
+            attitude, notes = attitude_from_aem(path, at)
+        except InputError as exc:
+            table.fail(str(exc), "aem")
+        for note in notes:
+            warnings.warn(
+                f"{table.file.name}: {table.where('aem')}: {note}",
+                ScenarioFileWarning,
+                stacklevel=2,
+            )
+        return attitude
+    if frame == "icrf" or attitude is None:
+        if frame != "icrf":
+            table.fail(f"frame = {frame!r} without a quaternion or matrix to place in it", "frame")
+        return attitude
+    if orbit is None:
+        table.fail(
+            f"frame = {frame!r} needs an orbit: give [pointing] a tle, an oem or "
+            "[pointing.keplerian]",
+            "frame",
+        )
+    try:
+        r, v = orbit.position_velocity(at)
+        return orbit_frame_to_icrf(frame, r, v) * attitude
+    except InputError as exc:
+        table.fail(f"the orbit at {at.isot} {at.scale.upper()}: {exc}", "frame")
 
 
 def _rate(table: _Table, required: bool) -> dict[str, np.ndarray]:
@@ -291,7 +359,12 @@ def _event_epoch(table: _Table, scale: str):
     return table.quantity("offset", "time", ())
 
 
-def _events(root: _Table, scale: str) -> list:
+def _event_time(at, epoch):
+    """An event's epoch as a ``Time``: given, or the offset in TT seconds after ``epoch``."""
+    return at if not isinstance(at, float) else time_from_tt_seconds(epoch, at)
+
+
+def _events(root: _Table, scale: str, epoch, orbit: Orbit | None) -> list:
     events = []
     for table in root.tables("events"):
         kind = table.choice("type", ("angular_impulse", "inertia_change", "attitude_reset"))
@@ -308,55 +381,145 @@ def _events(root: _Table, scale: str) -> list:
             inertia, key = _inertia(table)
             events.append(_checked(table, key, InertiaChange, at, inertia, label))
         else:
-            table.allow(*common, "quaternion", "matrix", "angular_velocity", "angular_momentum")
-            attitude = _attitude(table)
+            table.allow(
+                *common,
+                "quaternion",
+                "matrix",
+                "frame",
+                "aem",
+                "angular_velocity",
+                "angular_momentum",
+            )
+            attitude = _attitude_in_icrf(table, orbit, _event_time(at, epoch))
             rate = _rate(table, required=attitude is None)
             events.append(_checked(table, None, AttitudeReset, at, attitude, label=label, **rate))
     return events
 
 
-def _pointing(root: _Table) -> PointingSpec:
-    table = root.table("pointing", required=False)
-    if table is None:
-        return PointingSpec()
-    table.allow("body_vectors", "tle", "interval_precision")
-    vectors = []
-    for item in table.tables("body_vectors"):
-        item.allow("name", "vector", "sun_exclusion_half_angle", "kind")
-        name = item.string("name")
-        vector = item.quantity("vector", "dimensionless", (3,))
-        if not np.linalg.norm(vector) > 0:
-            item.fail(f"must be a non-zero vector, got {vector.tolist()}", "vector")
-        exclusion_deg = item.quantity(
-            "sun_exclusion_half_angle", "angle", (), required=False, to="deg"
-        )
-        if exclusion_deg is not None and not 0.0 < exclusion_deg < 180.0:
-            item.fail(
-                f"must be between 0 and 180 deg, got {exclusion_deg!r} deg",
-                "sun_exclusion_half_angle",
-            )
-        kind = item.choice(
-            "kind", ("panel", "instrument", "star_tracker", "other"), default="other"
-        )
-        exclusion = None if exclusion_deg is None else math.radians(exclusion_deg)
-        vectors.append(
-            _checked(item, None, BodyVector, name, vector, exclusion, kind, exclusion_deg)
-        )
-    names = [v.name for v in vectors]
-    if len(set(names)) != len(names):
-        table.fail(f"body vector names must be unique, got {names}", "body_vectors")
-    tle = None
-    if table.has("tle"):
+def _angle_deg(item: _Table, key: str, low: float, high: float) -> float | None:
+    """An optional angle in degrees, with its unit, in [low, high) (low excluded if 0)."""
+    value = item.quantity(key, "angle", (), required=False, to="deg")
+    if value is not None and not (low <= value < high and (low < 0.0 or value > 0.0)):
+        item.fail(f"must be between {low:g} and {high:g} deg, got {value!r} deg", key)
+    return value
+
+
+def _body_vector(item: _Table) -> BodyVector:
+    item.allow(
+        "name",
+        "vector",
+        "kind",
+        "sun_exclusion_half_angle",
+        "moon_exclusion_half_angle",
+        "earth_limb_exclusion_angle",
+    )
+    name = item.string("name")
+    vector = item.quantity("vector", "dimensionless", (3,))
+    if not np.linalg.norm(vector) > 0:
+        item.fail(f"must be a non-zero vector, got {vector.tolist()}", "vector")
+    sun = _angle_deg(item, "sun_exclusion_half_angle", 0.0, 180.0)
+    moon = _angle_deg(item, "moon_exclusion_half_angle", 0.0, 180.0)
+    limb = _angle_deg(item, "earth_limb_exclusion_angle", -90.0, 180.0)
+    kind = item.choice("kind", KINDS, default="other")
+
+    def radians(degrees: float | None) -> float | None:
+        return None if degrees is None else math.radians(degrees)
+
+    return _checked(
+        item,
+        None,
+        BodyVector,
+        name,
+        vector,
+        radians(sun),
+        kind,
+        sun,
+        moon_exclusion_half_angle_rad=radians(moon),
+        moon_exclusion_half_angle_deg=moon,
+        earth_limb_exclusion_angle_rad=radians(limb),
+        earth_limb_exclusion_angle_deg=limb,
+    )
+
+
+def _keplerian(table: _Table, scale: str, epoch, name: str) -> KeplerianOrbit:
+    table.allow(
+        "epoch",
+        "semi_major_axis",
+        "eccentricity",
+        "inclination",
+        "raan",
+        "argument_of_perigee",
+        "mean_anomaly",
+        "true_anomaly",
+        "frame",
+        "j2",
+    )
+    at = table.epoch("epoch", scale, required=False)
+    at = epoch if at is None else at
+    if table.has("mean_anomaly") == table.has("true_anomaly"):
+        table.fail("give exactly one of mean_anomaly and true_anomaly")
+    anomaly = "mean_anomaly" if table.has("mean_anomaly") else "true_anomaly"
+    elements = {
+        "semi_major_axis_m": table.positive("semi_major_axis", "length"),
+        "eccentricity": table.quantity("eccentricity", "dimensionless", ()),
+        "inclination": table.quantity("inclination", "angle", ()),
+        "raan": table.quantity("raan", "angle", ()),
+        "argument_of_perigee": table.quantity("argument_of_perigee", "angle", ()),
+        anomaly: table.quantity(anomaly, "angle", ()),
+    }
+    frame = table.choice("frame", ("ICRF", "EME2000"), default="ICRF")
+    j2 = table.boolean("j2", default=False)
+    return _checked(table, None, KeplerianOrbit, at, frame=frame, j2=j2, name=name, **elements)
+
+
+def _orbit(table: _Table, scale: str, epoch, name: str) -> Orbit | None:
+    """The orbit of ``[pointing]``: one of tle, oem and [pointing.keplerian], or None."""
+    given = [key for key in ("tle", "oem", "keplerian") if table.has(key)]
+    if len(given) > 1:
+        table.fail(f"give one orbit: {' or '.join(given)}, not both")
+    if not given:
+        return None
+    if given[0] == "tle":
         lines = table.raw("tle")
         if not (
             isinstance(lines, list) and len(lines) == 2 and all(isinstance(s, str) for s in lines)
         ):
             table.fail(f"expected the two lines of a TLE, got {_short(lines)}", "tle")
-        tle = tuple(lines)
+        return _checked(table, "tle", TleOrbit, *lines, name)
+    if given[0] == "oem":
+        return _checked(table, "oem", OemOrbit, table.file_path("oem"), name)
+    return _keplerian(table.table("keplerian"), scale, epoch, name)
+
+
+def _pointing(root: _Table, scale: str, epoch, name: str) -> PointingSpec:
+    table = root.table("pointing", required=False)
+    if table is None:
+        return PointingSpec()
+    table.allow(
+        "body_vectors",
+        "tle",
+        "oem",
+        "keplerian",
+        "interval_precision",
+        "earth_limb_atmosphere_height",
+        "lvlh_euler_sequence",
+    )
+    vectors = [_body_vector(item) for item in table.tables("body_vectors")]
+    names = [v.name for v in vectors]
+    if len(set(names)) != len(names):
+        table.fail(f"body vector names must be unique, got {names}", "body_vectors")
+    orbit = _orbit(table, scale, epoch, name)
+    options: dict[str, Any] = {}
     precision = table.positive("interval_precision", "time", required=False)
-    if precision is None:
-        return PointingSpec(vectors, tle)
-    return PointingSpec(vectors, tle, precision)
+    if precision is not None:
+        options["interval_precision_s"] = precision
+    height = table.quantity("earth_limb_atmosphere_height", "length", (), required=False)
+    if height is not None:
+        options["earth_limb_atmosphere_height_m"] = height
+    sequence = table.string("lvlh_euler_sequence", required=False)
+    if sequence is not None:
+        options["lvlh_euler_sequence"] = sequence
+    return _checked(table, None, PointingSpec, vectors, orbit, **options)
 
 
 def read_document(path: Path) -> dict[str, Any]:
@@ -414,18 +577,21 @@ def scenario_from_document(path: Path, document: dict[str, Any]) -> ScenarioFile
     inertia, key = _inertia(craft)
     spacecraft = _checked(craft, key, Spacecraft, craft_name, inertia)
 
+    # The orbit comes first: an attitude may be given in its frame.
+    pointing = _pointing(root, scale, epoch, craft_name)
+
     initial = root.table("initial_state")
-    initial.allow("quaternion", "matrix", "angular_velocity", "angular_momentum")
-    attitude = _attitude(initial)
+    initial.allow("quaternion", "matrix", "frame", "aem", "angular_velocity", "angular_momentum")
+    attitude = _attitude_in_icrf(initial, pointing.orbit, epoch)
     if attitude is None:
         initial.fail("missing quaternion (w, x, y, z, body -> ICRF) or matrix")
     rate = _rate(initial, required=True)
     state = _checked(initial, None, InitialState, attitude, **rate)
 
-    events = _events(root, scale)
+    events = _events(root, scale, epoch, pointing.orbit)
 
     output = root.table("output")
-    output.allow("start", "stop", "duration", "step")
+    output.allow("start", "stop", "duration", "step", "formats", "aem_tolerance")
     if output.has("stop") == output.has("duration"):
         output.fail("give exactly one of stop (ISO 8601) and duration (seconds)")
     stop = output.epoch("stop", scale, required=False)
@@ -447,7 +613,26 @@ def scenario_from_document(path: Path, document: dict[str, Any]) -> ScenarioFile
     except InputError as exc:
         end = "stop" if stop is not None else "duration"
         raise ScenarioFileError(f"{path.name}: {_scenario_key(str(exc), end)}") from None
-    return ScenarioFile(path, scenario, _pointing(root), document)
+    return ScenarioFile(path, scenario, pointing, _outputs(output), document)
+
+
+def _outputs(output: _Table) -> OutputChoice:
+    """``formats`` (a list of names) and ``aem_tolerance`` (an angle, with its unit)."""
+    formats = output.raw("formats", required=False, default=list(DEFAULT_FORMATS))
+    if not isinstance(formats, list):
+        output.fail(f"expected a list of format names, got {_short(formats)}", "formats")
+    try:
+        formats = parse_formats(formats, "formats")
+    except InputError as exc:
+        output.fail(str(exc).removeprefix("formats: "), "formats")
+    tolerance = output.quantity("aem_tolerance", "angle", (), required=False)
+    if tolerance is None:
+        return OutputChoice(formats)
+    try:
+        check_tolerance(tolerance, "aem_tolerance")
+    except InputError as exc:
+        output.fail(str(exc).removeprefix("aem_tolerance: "), "aem_tolerance")
+    return OutputChoice(formats, tolerance)
 
 
 def _scenario_key(message: str, end: str) -> str:

@@ -117,3 +117,46 @@ def read_back(path) -> tuple[list[Segment], object]:
             )
         )
     return segments, message
+
+
+def interpolate_as_declared(segment: Segment, t_s: np.ndarray, epoch: Time) -> np.ndarray:
+    """``segment``'s attitude at ``t_s`` (TT seconds after ``epoch``), read the way its
+    metadata declares: INTERPOLATION_METHOD = LAGRANGE of INTERPOLATION_DEGREE d, on
+    each of Q1, Q2, Q3, QC as written, over the d + 1 records centred on t's interval
+    (shifted to stay inside the segment), then normalized.  Returns (w, x, y, z).
+
+    Written apart from the package (which has its own reading in
+    ``attitude.aem_sampling``): Neville's recurrence, vectorized over the epochs.
+    """
+    meta = segment.metadata
+    assert meta.interpolation_method == "LAGRANGE", meta.interpolation_method
+    degree = int(meta.interpolation_degree)
+    x = tt_seconds(segment.times, epoch)  # the records' epochs as written (1 ns)
+    # The quaternions as written: scalar last, signs as in the file.
+    q = segment.quaternion_body_to_inertial_scalar_first[:, [1, 2, 3, 0]]
+    count = x.size
+    interval = np.clip(np.searchsorted(x, t_s, side="right") - 1, 0, count - 2)
+    first = np.clip(interval - (degree - 1) // 2, 0, count - degree - 1)
+    nodes = first[:, None] + np.arange(degree + 1)
+    xs, values = x[nodes], q[nodes]  # (m, d+1), (m, d+1, 4)
+    t = np.asarray(t_s)[:, None]
+    table = values.copy()
+    for width in range(1, degree + 1):
+        for i in range(degree + 1 - width):
+            j = i + width
+            table[:, i] = (
+                (t - xs[:, j : j + 1]) * table[:, i] - (t - xs[:, i : i + 1]) * table[:, i + 1]
+            ) / (xs[:, i : i + 1] - xs[:, j : j + 1])
+    result = table[:, 0]
+    result = result / np.linalg.norm(result, axis=1, keepdims=True)
+    return result[:, [3, 0, 1, 2]]
+
+
+def rotation_angle(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The angle of the rotation between unit quaternions a and b (either sign), rad,
+    accurate for tiny angles: 2 atan2(|vector part|, |scalar part|) of a* ⊗ b."""
+    w1, v1 = a[:, 0], a[:, 1:]
+    w2, v2 = b[:, 0], b[:, 1:]
+    scalar = w1 * w2 + np.einsum("ij,ij->i", v1, v2)
+    vector = w1[:, None] * v2 - w2[:, None] * v1 - np.cross(v1, v2)
+    return 2.0 * np.arctan2(np.linalg.norm(vector, axis=1), np.abs(scalar))

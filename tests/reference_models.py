@@ -126,6 +126,46 @@ def half_period_mpmath(inertia, m0, digits=60):
         return float(2 * mp.ellipk(1 - mc) / λ)
 
 
+def flip_times_mpmath(inertia, m0, t_start, t_end, digits=60):
+    """Zeros of the intermediate-axis momentum in [t_start, t_end] (t0 = 0), closed form.
+
+    [Leroy] cases (i) and (ii) in mpmath at ``digits`` digits: with σ the sign of the
+    component carrying dn, m2 = −B21 sn(λt − ν) (case i, λ = −σλ3, ν = F(φ|m),
+    tan φ = (m2/m3)(B31/B21)) or −B23 sn(λt − ν|1/m) (case ii, λ = −σλ1,
+    tan φ = (m2/m1)(B13/B23)), so m2 vanishes at t = (ν + 2jK)/λ.  The axes are sorted
+    by a proper signed permutation (the middle one reversed for an odd permutation).
+    """
+    with mp.workdps(digits):
+        order = np.argsort(inertia, kind="stable")
+        odd = np.linalg.det(np.eye(3)[order]) < 0
+        I1, I2, I3 = (mp.mpf(float(inertia[k])) for k in order)
+        m1, m2, m3 = (mp.mpf(float(m0[k])) for k in order)
+        if odd:
+            m2 = -m2
+        G2 = m1**2 + m2**2 + m3**2
+        twoT = m1**2 / I1 + m2**2 / I2 + m3**2 / I3
+        Δ1, Δ2, Δ3 = (G2 - twoT * Ij for Ij in (I1, I2, I3))
+        if Δ2 < 0:
+            σ = mp.sign(m1)
+            B21 = mp.sqrt(I2 * Δ1 / (I2 - I1))
+            B31 = mp.sqrt(I3 * Δ1 / (I3 - I1))
+            mc = Δ2 * (I3 - I1) / (Δ3 * (I2 - I1))
+            λ = -σ * mp.sqrt(Δ3 * (I1 - I2) / (I1 * I2 * I3))
+            φ = mp.atan2(m2 * B31, m3 * B21)
+        else:
+            σ = mp.sign(m3)
+            B13 = mp.sqrt(I1 * Δ3 / (I1 - I3))
+            B23 = mp.sqrt(I2 * Δ3 / (I2 - I3))
+            mc = Δ2 * (I3 - I1) / (Δ1 * (I3 - I2))
+            λ = -σ * mp.sqrt(Δ1 * (I3 - I2) / (I1 * I2 * I3))
+            φ = mp.atan2(m2 * B13, m1 * B23)
+        ν = mp.ellipf(φ, 1 - mc)
+        K = mp.ellipk(1 - mc)
+        a, b = sorted((λ * t_start - ν, λ * t_end - ν))
+        js = range(int(mp.ceil(a / (2 * K))), int(mp.floor(b / (2 * K))) + 1)
+        return np.sort([float((ν + 2 * j * K) / λ) for j in js])
+
+
 def state_with_delta2(inertia_sorted, ratio, weight=0.5, rng=None):
     """A unit momentum x with δ2 = Δ2/G² = ``ratio`` (to rounding), sorted moments.
 

@@ -3,9 +3,10 @@
 Both go through one path up to the sampling (attitude.run_plan).  Each file below
 was accepted by `check` and refused by `run` after computing, or crashed `run` with a
 traceback: a bad TLE, an epoch outside the ephemeris (with the margins the pointing
-adds), a far TLE epoch, wrong types, absurd magnitudes, a grid that cannot fit in
-memory.  Each now gives exit 2 and the same message from both, naming the file and
-the key, before anything is written.
+adds), a far TLE epoch, wrong types, absurd magnitudes, outputs that cannot fit on
+any disk.  Each now gives exit 2 and the same message from both, naming the file and
+the key, before anything is written.  The disk is the one thing `check` can only
+check with the folder, `check --out DIR`: those cases are run that way.
 """
 
 import json
@@ -138,13 +139,16 @@ BAD = {
         _replace("step = 1.0", "step = 5e-324"),
         r"output\.step: 4\.94066e-324 s is below what TT seconds resolve",
     ),
-    "7 TiB of output epochs": (
+    # Streamed, a run holds a chunk whatever its span: only the disk can refuse these
+    # (hundreds of terabytes: no disk holds them).
+    "1e12 output epochs": (
         _replace("step = 1.0", "step = 1e-3", _replace("duration = 10.0", "duration = 1e9")),
-        r"output: 1000000000002 samples would need about .* of memory",
+        r"output: 1000000000002 samples would take about [\d.]+ TB \(timeseries\.csv .*\), "
+        r"and the disk of .* has",
     ),
-    "1e8 output epochs": (
-        _replace("step = 1.0", "step = 1e-2", _replace("duration = 10.0", "duration = 1e6")),
-        r"output: 100000001 samples would need about .* of memory",
+    "1e11 output epochs": (
+        _replace("step = 1.0", "step = 1e-2", _replace("duration = 10.0", "duration = 1e9")),
+        r"output: 100000000001 samples would take about [\d.]+ TB",
     ),
     "1e200 rad/s": (
         _replace("[0.01, 0.2, 0.01]", "[1e200, 1e200, 0]"),
@@ -155,6 +159,9 @@ BAD = {
         r"the state after events\[0\] \(angular_impulse at .*\): the body turns in",
     ),
 }
+
+# Refused by the disk, which `check` sees only with --out.
+DISK = {"1e12 output epochs", "1e11 output epochs"}
 
 BIG = "1" + "0" * 400  # 10**400, a valid TOML integer
 BIG_KEYS = {
@@ -184,12 +191,18 @@ def test_check_and_run_refuse_with_the_same_line(case, tmp_path, capsys):
     text, message = BAD[case]
     path = tmp_path / "bad.toml"
     path.write_text(text, encoding="utf-8")
-    assert main(["check", str(path)]) == 2
-    checked = _lines(capsys)
-    assert len(checked) == 1, checked
-    assert re.search(rf"^attitude: error: bad\.toml: {message}", checked[0]), checked[0]
-    assert checked[0].count("bad.toml") == 1  # the file named once, not `x: x: key`
     out = tmp_path / "out"
+    if case in DISK:
+        assert main(["check", str(path)]) == 0  # states the sizes; the disk needs --out
+        assert "disk        not checked" in capsys.readouterr().out
+    for check in (["check", str(path)], ["check", str(path), "--out", str(out)]):
+        if case in DISK and "--out" not in check:
+            continue
+        assert main(check) == 2
+        checked = _lines(capsys)
+        assert len(checked) == 1, checked
+        assert re.search(rf"^attitude: error: bad\.toml: {message}", checked[0]), checked[0]
+        assert checked[0].count("bad.toml") == 1  # the file named once, not `x: x: key`
     assert main(["run", str(path), "--out", str(out), "--quiet"]) == 2
     assert _lines(capsys) == checked
     assert not out.exists() and [p.name for p in tmp_path.iterdir()] == ["bad.toml"]
@@ -269,7 +282,7 @@ def test_check_with_out_refuses_what_run_would(tmp_path, capsys):
 
 def test_every_run_error_names_the_file_and_the_key(tmp_path, capsys):
     """Errors raised after loading (the TLE, the solver, the budget) used to lack both."""
-    for case in ("TLE lines swapped", "1e200 rad/s", "1e8 output epochs", "epoch 2060"):
+    for case in ("TLE lines swapped", "1e200 rad/s", "1e11 output epochs", "epoch 2060"):
         path = tmp_path / "bad.toml"
         path.write_text(BAD[case][0], encoding="utf-8")
         assert main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 2

@@ -227,10 +227,12 @@ _MOMENTA = [
 
 @pytest.mark.parametrize("inertia", _BODIES)
 def test_extreme_states_give_a_finite_motion_or_a_clear_error(inertia):
-    """Never a NaN: either a finite motion that conserves |m| and H, or an InputError.
+    """Never a NaN: a finite motion that conserves |m| and H, or an InputError.
 
-    The errors expected are states closer to the separatrix than double precision can
-    follow (mc < 1e-300) and angular velocities beyond the float range.
+    The only refusal expected is an angular velocity beyond the float range: every
+    other finite state is propagated, however close to the separatrix (mc below the
+    float range included).  Times too far from t0 for the angles to stay in the
+    float range are refused by name (test_solver_bad_input.py).
     """
     import warnings
 
@@ -243,7 +245,7 @@ def test_extreme_states_give_a_finite_motion_or_a_clear_error(inertia):
                 try:
                     solver = EulerSolver(inertia, m0, ATTITUDE0)
                 except ValueError as error:
-                    assert "separatrix" in str(error) or "beyond the float range" in str(error)
+                    assert "beyond the float range" in str(error)
                     continue
                 q = solver.attitude_quaternion(t)
                 m = solver.angular_momentum(t)

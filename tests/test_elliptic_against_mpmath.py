@@ -15,13 +15,17 @@ import numpy as np
 import pytest
 
 from attitude.elliptic import (
+    NEAR_ONE_MC,
     complete_first_kind,
+    complete_first_kind_near_one,
     elliptic_f,
     elliptic_pi,
     elliptic_pi_complete,
     jacobi_amplitude,
     jacobi_sn_cn_dn,
+    pi_minus_f_near_one,
     reduced_sn_cn_dn,
+    reduced_sn_cn_dn_near_one,
 )
 
 EPS = np.finfo(float).eps
@@ -165,3 +169,76 @@ def test_parameter_outside_zero_one_is_refused(bad):
 def test_characteristic_at_or_above_one_is_refused():
     with pytest.raises(ValueError, match="n must be < 1"):
         elliptic_pi(1.0, 1.0, 0.5)
+
+
+# ----------------------------------------------------------------- m within 2^-128 of 1
+
+
+@pytest.mark.parametrize("mc", [1e-100, 1e-300, 2e-308, 1e-310, 1e-320])
+def test_general_kernels_keep_accuracy_for_tiny_and_subnormal_mc(mc):
+    """For its float argument, however small, the AGM kernel stays accurate.
+
+    (What a subnormal mc loses is its own digits, as a rounded physical ratio: that is
+    why the solver switches to ln mc below NEAR_ONE_MC; see the next tests.)
+    """
+    m = mp_parameter(mc)
+    K = float(complete_first_kind(mc))
+    assert abs(K - mp.ellipk(m)) <= 4 * EPS * K
+    u = np.array([0.5, K / 3, K / 2, 0.7 * K, 0.999 * K, 1.7 * K, -2.3 * K])
+    sn, cn, dn = jacobi_sn_cn_dn(u, mc)
+    for i, x in enumerate(u):
+        s, c, d = (mp.ellipfun(f, mp.mpf(x), m=m) for f in ("sn", "cn", "dn"))
+        # Relative accuracy, up to the argument's rounding (|u| ≤ 3K ≈ 1100 here).
+        for ours, exact, deriv in ((sn[i], s, c * d), (cn[i], c, s * d), (dn[i], d, m * s * c)):
+            assert abs(ours - exact) <= 16 * EPS * abs(exact) + 4 * EPS * abs(x) * abs(deriv)
+
+
+def _mp_near_one(log_mc):
+    """m = 1 − e^log_mc in mpmath with 40 digits beyond those of mc."""
+    mp.mp.dps = 40 + int(-log_mc / math.log(10))
+    return 1 - mp.exp(mp.mpf(log_mc))
+
+
+# ln mc from just below NEAR_ONE_MC to far below the float range (mc = 1e-700).
+NEAR_ONE_LOG_MC = [
+    math.log(NEAR_ONE_MC) - 0.5,
+    math.log(1e-60),
+    math.log(1e-300),
+    -400 * math.log(10),
+    -700 * math.log(10),
+]
+
+
+@pytest.mark.parametrize("log_mc", NEAR_ONE_LOG_MC)
+def test_near_one_kernels_against_mpmath(log_mc):
+    """sn, cn, dn and K from ln mc, to a few ulps, where mc may have no float at all."""
+    m = _mp_near_one(log_mc)
+    K = float(complete_first_kind_near_one(log_mc))
+    assert abs(K - mp.ellipk(m)) <= 2 * EPS * K
+    r = K * np.array([0.0, 1e-6, 0.1, -0.3, 0.5 - 1e-9, 0.5 + 1e-9, -0.6, 0.8, 0.99, -1.0, 1.0])
+    sn, cn, dn = reduced_sn_cn_dn_near_one(r, log_mc, K)
+    for i, x in enumerate(r):
+        s, c, d = (mp.ellipfun(f, mp.mpf(x), m=m) for f in ("sn", "cn", "dn"))
+        # A few ulps, plus the rounding of r (and of K: a few ulps of K) times the
+        # derivative; values below the float range (~1e-308) come out as 0.
+        derivatives = (abs(c * d), abs(s * d), abs(m * s * c))
+        for ours, exact, deriv in zip((sn[i], cn[i], dn[i]), (s, c, d), derivatives, strict=True):
+            tolerance = 8 * EPS * abs(exact) + 4 * EPS * K * deriv + 1e-300
+            assert abs(ours - exact) <= tolerance, (x, ours, exact)
+
+
+@pytest.mark.parametrize("log_mc", NEAR_ONE_LOG_MC)
+@pytest.mark.parametrize("n", [-40.0, -2.0, -0.3, -1e-3])
+def test_near_one_pi_minus_f_against_mpmath(log_mc, n):
+    """Π(am u, n) − u for u = 2jK + r, against mpmath's Π on its own amplitude."""
+    m = _mp_near_one(log_mc)
+    K = float(complete_first_kind_near_one(log_mc))
+    for j, fraction in [(0, 0.0), (0, 0.2), (0, -0.45), (0, 0.7), (0, -0.999), (1, 0.3), (-3, 0.9)]:
+        r = fraction * K
+        sn, _cn, _dn = reduced_sn_cn_dn_near_one(r, log_mc, K)
+        ours = pi_minus_f_near_one(j, r, sn, n, K)
+        φ = mp.asin(mp.ellipfun("sn", mp.mpf(r), m=m))  # am r, in [−π/2, π/2] for |r| ≤ K
+        exact = mp.ellippi(n, φ, m) - r + 2 * j * (mp.ellippi(n, m) - mp.ellipk(m))
+        # A few ulps of the terms that make it up (|u| and the complete integrals).
+        scale = abs(n / (1 - n)) * (abs(r) + 2 * abs(j) * K + 1)
+        assert abs(ours - exact) <= 8 * EPS * scale, (j, fraction, ours, exact)

@@ -11,17 +11,35 @@ PACKAGE = Path(__file__).parents[1] / "attitude"
 
 # In order; a module may import modules of its own layer or of earlier ones.
 LAYERS = [
-    ["version", "errors", "quantities", "quaternions", "vectors"],  # shared base
+    ["version", "errors", "quantities", "quaternions", "vectors", "float_math"],  # shared base
     ["elliptic"],  # elliptic kernels
-    ["inertia", "euler_solver"],  # the Euler solver
-    ["timescales", "spacecraft", "events", "scenario"],  # spacecraft, scenario and events
+    ["inertia", "invariants", "closed_form", "euler_solver", "free_flow"],  # the Euler solver
+    ["torques", "splitting", "torqued_solver"],  # torques and splitting
+    ["timescales", "epoch_texts", "spacecraft", "events", "scenario"],  # scenario and events
     ["trajectory", "motion_analysis"],  # trajectory
-    ["ephemeris", "orbit", "eclipse", "pointing", "intervals"],  # pointing (skyfield)
+    [  # pointing (skyfield)
+        "ephemeris",
+        "earth",
+        "frames",
+        "orbit",
+        "keplerian",
+        "ccsds_files",
+        "oem",
+        "aem_input",
+        "intervals",
+        "extrema",
+        "eclipse",
+        "pointing",
+    ],
     [  # reports and exports
         "exports",
+        "timeseries_parquet",
         "aem",
+        "aem_sampling",
         "plots",
+        "report_figures",
         "report_page",
+        "output_formats",
         "output_budget",
         "run_plan",
         "output_folder",

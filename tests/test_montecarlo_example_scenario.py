@@ -26,7 +26,7 @@ def test_check_describes_the_dispersions(capsys):
 
 def test_the_first_samples_run_to_full_rows():
     mc = plan_montecarlo(load_scenario(EXAMPLE))
-    job = Job(EXAMPLE, mc.loaded.document, mc.dispersions, mc.parameters, mc.metrics, 3)
+    job = Job.of(mc)
     result = evaluate_batch(job, 0, 2)
     assert [row["status"] for row in result.rows] == ["ok", "ok"]
     assert result.extremes.shape == (2, 3, 2, 200)

@@ -19,6 +19,7 @@ from montecarlo_scenarios import write_spinner
 from scipy.spatial.transform import Rotation
 
 from attitude.cli import main
+from attitude.scenario_file import load_scenario
 
 SAMPLES = 8
 
@@ -56,14 +57,16 @@ def _summary_values(summary: dict) -> dict:
         ):
             values[f"segment{k}_{name}"] = s[key]
     for v, entry in summary["pointing"]["body_vectors"].items():
-        values[f"{v}_sun_angle_min_deg"] = entry["sun_angle_min_deg"]
-        values[f"{v}_sun_angle_max_deg"] = entry["sun_angle_max_deg"]
+        # Every extremum the summary gives (found on the exact motion), by its own key.
+        for key, value in entry.items():
+            if key.endswith(("_min_deg", "_max_deg", "_min", "_max")):
+                values[f"{v}_{key}"] = value
         values[f"{v}_sun_visible_s"] = entry["sun_visible"]["total_s"]
         values[f"{v}_mean_cos_incidence"] = entry["mean_cos_incidence"]
-        if "violations" in entry:
-            values[f"{v}_violation_count"] = entry["violations"]["count"]
-            values[f"{v}_violation_total_s"] = entry["violations"]["total_s"]
-            values[f"{v}_violation_longest_s"] = entry["violations"]["longest_s"]
+        for constraint in ("sun_exclusion", "moon_exclusion", "earth_limb_exclusion"):
+            if constraint in entry:
+                for total in ("count", "total_s", "longest_s"):
+                    values[f"{v}_{constraint}_{total}"] = entry[constraint][total]
     return values
 
 
@@ -82,7 +85,10 @@ def test_sample_k_emitted_and_run_alone_reproduces_its_row(job, k, tmp_path, cap
     row = table.iloc[k]
     assert row["sample"] == k and row["status"] == "ok"
     values = _summary_values(summary)
-    assert len(values) == 35  # 2, 11 per segment (2), 7 for the tracker, 4 for the panel
+    # 2, 11 per segment (2); per vector the least and greatest Sun angle, Moon angle and
+    # incidence, the Sun-visible time and the mean incidence (8), and the tracker's Sun
+    # exclusion (3).
+    assert len(values) == 43
     for name, value in values.items():
         if value is None:  # a quantity the motion does not have: null in JSON, empty in CSV
             assert row[name] == "", name
@@ -90,6 +96,12 @@ def test_sample_k_emitted_and_run_alone_reproduces_its_row(job, k, tmp_path, cap
             assert row[name] == value, name
         else:
             assert float(row[name]) == value, (name, row[name], value)  # exactly
+    # The extrema's times: TT seconds in the row, the epoch as text in summary.json.
+    scenario = load_scenario(path).scenario
+    for v, entry in summary["pointing"]["body_vectors"].items():
+        for key, value in entry.items():
+            if key.endswith("_at"):
+                assert scenario.format_epoch(float(row[f"{v}_{key}_s"])) == value, key
 
     document = tomllib.loads(path.read_text())
     assert "dispersions" not in document

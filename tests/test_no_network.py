@@ -26,7 +26,12 @@ EXERCISE = textwrap.dedent(
     from sgp4.io import fix_checksum
 
     from attitude.eclipse import eclipse_intervals, sunlit_fraction
-    from attitude.ephemeris import sun_direction_from_earth, sun_position_from_earth
+    from attitude.ephemeris import (
+        moon_position_from_earth,
+        sun_direction_from_earth,
+        sun_position_from_earth,
+        sun_position_from_observer,
+    )
     from attitude.orbit import TleOrbit
     from attitude.timescales import as_time, time_from_tt_seconds, tt_seconds
 
@@ -48,7 +53,8 @@ EXERCISE = textwrap.dedent(
         orbit = TleOrbit(LINE1, LINE2, "ISS moved to 2029")
         r_m, v_m_s = orbit.position_velocity(times)
         assert np.all(np.abs(np.linalg.norm(r_m, axis=-1) - 6.79e6) < 2e4)
-        assert orbit.sun_position_from_spacecraft(times).shape == (720, 3)
+        assert sun_position_from_observer(times, r_m, v_m_s).shape == (720, 3)
+        assert moon_position_from_earth(times).shape == (720, 3)
         assert np.ptp(sunlit_fraction(r_m, sun_m)) == 1.0  # both sunlit and eclipsed
         intervals = eclipse_intervals(orbit, epoch, times[-1])
         assert len(intervals.umbra) >= 1

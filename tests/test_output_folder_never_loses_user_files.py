@@ -237,17 +237,28 @@ def _cli(*args, cwd=None, **kwargs) -> subprocess.Popen:
     )
 
 
-def test_a_full_disk_leaves_nothing(user_folder):
+@pytest.mark.parametrize("formats", ["csv,aem,plots,report", "parquet", "aem"])
+def test_a_full_disk_leaves_nothing(user_folder, formats):
     """A file-size limit (RLIMIT_FSIZE) makes the writes fail as a full disk does (Python
-    ignores SIGXFSZ, so the write raises EFBIG instead of killing the process)."""
+    ignores SIGXFSZ, so the write raises EFBIG instead of killing the process), in the
+    middle of the stream of each format."""
     folder, scenario = user_folder
-    scenario = _scenario(folder, duration=20000.0, name="long.toml")
+    scenario = _scenario(folder, duration=200000.0, name="long.toml")
     before = _snapshot(folder)
 
     def limit():
         resource.setrlimit(resource.RLIMIT_FSIZE, (200_000, 200_000))
 
-    process = _cli("run", str(scenario), "--out", str(folder / "out"), "--quiet", preexec_fn=limit)
+    process = _cli(
+        "run",
+        str(scenario),
+        "--out",
+        str(folder / "out"),
+        "--quiet",
+        "--formats",
+        formats,
+        preexec_fn=limit,
+    )
     _, err = process.communicate(timeout=120)
     assert process.returncode == 1, err
     assert len(err.splitlines()) == 1 and "Traceback" not in err, err
@@ -268,12 +279,15 @@ def _run_until(folder: Path, scenario: Path, out: Path, stage: str) -> subproces
     [
         (signal.SIGINT, 130, "sampling"),
         (signal.SIGTERM, 143, "sampling"),
-        (signal.SIGINT, 130, "writing timeseries.csv"),
+        (signal.SIGINT, 130, "% ("),  # in the middle of the stream: a chunk was written
         (signal.SIGTERM, 143, "writing attitude.aem"),
+        (signal.SIGINT, 130, "plotting"),
     ],
+    ids=["SIGINT start", "SIGTERM start", "SIGINT mid-stream", "SIGTERM aem", "SIGINT plots"],
 )
 def test_a_signal_stops_the_run_with_one_line_and_no_leftovers(user_folder, number, code, stage):
     folder, _ = user_folder
+    # Long enough for several chunks (the stream reports after its first).
     scenario = _scenario(folder, duration=150000.0, name="long.toml")
     out = folder / "out"
     # A previous run of ours, which must survive the interrupted one untouched.

@@ -9,6 +9,8 @@
 - Nadir angles against skyfield's own satellite positions (no interpolation).
 - Interval ends: the condition changes on either side, within the stated precision;
   eclipse ends against the shadow computed from direct skyfield positions.
+- Earth limb angles by hand on constructed geometries; a spacecraft pointing its
+  +z at nadir (frame LVLH) has nadir angle 0 there.
 """
 
 import math
@@ -21,7 +23,8 @@ from scipy.spatial.transform import Rotation
 
 from attitude.eclipse import sunlit_fraction
 from attitude.ephemeris import sun_position_from_earth, timescale
-from attitude.pointing import BodyVector, PointingSpec, compute_pointing
+from attitude.orbit import Orbit
+from attitude.pointing import BodyVector, PointingSpec, pointing_analysis, pointing_samples
 from attitude.scenario import InitialState, Scenario
 from attitude.spacecraft import Spacecraft
 from attitude.trajectory import propagate
@@ -42,6 +45,18 @@ def _scenario(attitude, ω, duration, step, epoch="2027-06-21T00:00:00"):
     craft = Spacecraft("test", [10.0, 12.0, 15.0])
     state = InitialState(attitude, angular_velocity=ω)
     return Scenario("pointing", craft, epoch, state, duration=duration, step=step)
+
+
+def compute_pointing(trajectory, spec, seconds):
+    """The samples at ``seconds`` and the analysis over the output span, as one object."""
+    samples = pointing_samples(trajectory, spec, seconds)
+    analysis = pointing_analysis(trajectory, spec)
+    samples.analysis = analysis
+    samples.shadow, samples.umbra = analysis.shadow, analysis.umbra
+    samples.precision_s = analysis.precision_s
+    for item, found in zip(samples.vectors, analysis.vectors, strict=True):
+        item.sun_exclusion, item.sun_visible = found.sun_exclusion, found.sun_visible
+    return samples
 
 
 def _angle(u_vectors, v_vectors):
@@ -71,7 +86,7 @@ def test_fixed_attitude_sun_angles_match_a_hand_calculation():
     # at about 23.4° (outside its 20° cone), body x (ICRF z) at 66.6°.
     z = next(v for v in result.vectors if v.vector.name == "z_axis")
     assert math.degrees(z.sun_angle_rad[0]) == pytest.approx(23.44, abs=0.05)
-    assert not np.any(z.violated) and not z.violations
+    assert not np.any(z.sun_violated) and not z.sun_exclusion
 
 
 def test_incidence_on_a_side_panel_follows_the_spin():
@@ -132,8 +147,8 @@ def test_nadir_angles_against_direct_skyfield_positions(on_orbit):
     down /= np.linalg.norm(down, axis=1, keepdims=True)
     for item in result.vectors:
         icrf = trajectory.attitude(seconds).apply(item.vector.vector)
-        # 0.4 m of orbit interpolation over 7000 km: 6e-8 rad at most.
-        np.testing.assert_allclose(item.nadir_angle_rad[::97], _angle(icrf, down), atol=1e-7)
+        # The orbit is SGP4 at every epoch (only the TEME rotation is interpolated).
+        np.testing.assert_allclose(item.nadir_angle_rad[::97], _angle(icrf, down), atol=1e-10)
 
 
 def test_eclipse_ends_against_direct_geometry(on_orbit):
@@ -151,13 +166,13 @@ def test_eclipse_ends_against_direct_geometry(on_orbit):
         assert fraction[2] < 1.0 and fraction[3] == 1.0  # leaving it
 
 
-def test_violation_ends_are_refined_to_the_stated_precision(on_orbit):
+def test_sun_exclusion_ends_are_refined_to_the_stated_precision(on_orbit):
     scenario, trajectory, result = on_orbit
     x = next(v for v in result.vectors if v.vector.name == "x_axis")
-    assert len(x.violations) > 100  # the spin sweeps body x through the Sun every turn
+    assert len(x.sun_exclusion) > 100  # the spin sweeps body x through the Sun every turn
     half = x.vector.sun_exclusion_half_angle_rad
     δ = result.precision_s
-    inner = [i for i in x.violations if not (i.starts_before or i.ends_after)]
+    inner = [i for i in x.sun_exclusion if not (i.starts_before or i.ends_after)]
     ends = np.array([[i.start_s - δ, i.start_s + δ, i.end_s - δ, i.end_s + δ] for i in inner])
     sun = astropy_apparent_sun(scenario.times(ends.ravel()))[0]
     # From the spacecraft the Sun is 9.5" away from this geocentric one at most: the
@@ -166,21 +181,25 @@ def test_violation_ends_are_refined_to_the_stated_precision(on_orbit):
     angle = _angle(body_sun, np.array([1.0, 0.0, 0.0])).reshape(-1, 4)
     assert np.all(angle[:, 0] > half) and np.all(angle[:, 1] < half)
     assert np.all(angle[:, 2] < half) and np.all(angle[:, 3] > half)
-    # Flags on the output grid agree with the intervals.
-    inside = np.zeros(result.seconds.size, dtype=bool)
-    for i in x.violations:
-        inside |= (result.seconds >= i.start_s) & (result.seconds <= i.end_s)
-    assert np.array_equal(inside, x.violated)
+    # Flags on the output grid agree with the intervals (away from their ends, which are
+    # known to the precision δ only).
+    t = result.seconds
+    inside = np.zeros(t.size, dtype=bool)
+    near_an_end = np.zeros(t.size, dtype=bool)
+    for i in x.sun_exclusion:
+        inside |= (t >= i.start_s) & (t <= i.end_s)
+        near_an_end |= (np.abs(t - i.start_s) <= δ) | (np.abs(t - i.end_s) <= δ)
+    assert np.array_equal(inside[~near_an_end], x.sun_violated[~near_an_end])
 
 
-def test_no_violation_in_umbra(on_orbit):
+def test_no_sun_exclusion_in_umbra(on_orbit):
     _, _, result = on_orbit
     x = next(v for v in result.vectors if v.vector.name == "x_axis")
     assert len(result.umbra) == 2
-    for violation in x.violations:
+    for exclusion in x.sun_exclusion:
         for umbra in result.umbra:
             assert (
-                violation.end_s <= umbra.start_s + 1e-9 or violation.start_s >= umbra.end_s - 1e-9
+                exclusion.end_s <= umbra.start_s + 1e-9 or exclusion.start_s >= umbra.end_s - 1e-9
             )
 
 
@@ -189,3 +208,57 @@ def test_body_vector_names_must_fit_a_column():
         BodyVector("star tracker", [0.0, 0.0, 1.0])
     with pytest.raises(ValueError, match="body vector 'v' must be non-zero"):
         BodyVector("v", [0.0, 0.0, 0.0])
+
+
+class _Fixed(Orbit):
+    """A spacecraft held at one place (a constructed geometry, not an orbit)."""
+
+    def __init__(self, position_m, velocity_m_s):
+        self.r = np.asarray(position_m, dtype=float)
+        self.v = np.asarray(velocity_m_s, dtype=float)
+
+    def state_tt(self, jd1, jd2):
+        n = np.size(jd1)
+        return np.tile(self.r, (n, 1)), np.tile(self.v, (n, 1))
+
+    def describe(self):
+        return "fixed"
+
+
+@pytest.mark.parametrize("height_m", [0.0, 100e3])
+def test_earth_limb_angles_by_hand(height_m):
+    # Body axes = ICRF axes; the spacecraft 7000 km out on ICRF +x.  The Earth (plus
+    # ``height_m``) has the angular radius ρ = asin((R + h)/7000 km); a direction θ from
+    # nadir is θ − ρ above the limb.
+    rho = math.asin((6_378_137.0 + height_m) / 7.0e6)
+    directions = {
+        "down": ([-1.0, 0.0, 0.0], -rho),
+        "side": ([0.0, 1.0, 0.0], math.pi / 2 - rho),
+        "grazing": ([-math.cos(rho), math.sin(rho), 0.0], 0.0),
+        "up": ([1.0, 0.0, 0.0], math.pi - rho),
+        "oblique": ([-1.0, 0.0, 1.0], math.pi / 4 - rho),
+    }
+    vectors = [
+        BodyVector(name, d, earth_limb_exclusion_angle_rad=math.radians(23.0))
+        for name, (d, _) in directions.items()
+    ]
+    spec = PointingSpec(vectors, _Fixed([7.0e6, 0.0, 0.0], [0.0, 7.5e3, 0.0]), 1e-3, height_m)
+    scenario = _scenario(Rotation.identity(), [0.0, 0.0, 0.0], 120.0, 60.0)
+    trajectory = propagate(scenario)
+    samples = pointing_samples(trajectory, spec, scenario.output_seconds())
+    analysis = pointing_analysis(trajectory, spec)
+    for item, found in zip(samples.vectors, analysis.vectors, strict=True):
+        expected = directions[item.vector.name][1]
+        np.testing.assert_allclose(item.earth_limb_angle_rad, expected, rtol=0, atol=1e-12)
+        low, high = found.extrema["earth_limb_angle"]
+        assert low.value == pytest.approx(expected, abs=1e-12)
+        assert high.value == pytest.approx(expected, abs=1e-12)
+        violated = expected < math.radians(23.0)
+        assert np.all(item.earth_limb_violated == violated)
+        assert [(i.starts_before, i.ends_after) for i in found.earth_limb_exclusion] == (
+            [(True, True)] if violated else []
+        )
+    # 100 km of atmosphere lifts the limb by 2.1° seen from 7000 km: "side" (24.3° above
+    # the solid limb) comes within the 23° exclusion.
+    side = next(v for v in samples.vectors if v.vector.name == "side")
+    assert bool(side.earth_limb_violated[0]) == (height_m > 0.0)

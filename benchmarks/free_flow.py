@@ -1,0 +1,187 @@
+"""Benchmark: the free-flow map ``attitude.free_flow.advance``, against scipy's ellipj.
+
+In one run, as ratios to peers timed side by side (absolute times depend on the load,
+which is printed):
+
+- one state, one step: ``advance`` on a single state (its constants included), against
+  one scalar ``scipy.special.ellipj`` call and against building an ``EulerSolver`` and
+  evaluating its attitude and momentum once (what a splitting step cost before);
+- batches of N states, one step each, N = 1, 10, 100, 1000 and 1e5: nanoseconds per
+  state-step, against ``scipy.special.ellipj`` on N points.
+
+Each for several kinds of state: generic (both sides of the separatrix), within
+|Δ2|/G² = 1e-10 of it (whose case test needs the exact integers), on it, next to it
+with mc below the float range (the near-one kernels), a symmetric body, and a batch
+that mixes every case.
+
+    python -m benchmarks.free_flow
+    python -m benchmarks.free_flow --quick      # fewer repeats, N up to 1e4
+
+Results go to stdout and to benchmarks/results/free_flow.json.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import time
+from pathlib import Path
+
+import numpy as np
+from scipy import special
+from scipy.spatial.transform import Rotation
+
+from attitude import EulerSolver
+from attitude.free_flow import advance
+
+RESULTS = Path(__file__).parent / "results"
+
+
+def _best_per_call(function, repeats: int, window_s: float = 0.003) -> float:
+    """The best, over ``repeats`` runs of about ``window_s`` each, of the mean time of a
+    call (seconds).  Short runs, so that on a loaded machine some of them run
+    uninterrupted: the best is close to the tool's own cost, for ours and the peer's."""
+    start = time.perf_counter()
+    function()  # warm up, and size the runs
+    calls = max(1, int(window_s / max(time.perf_counter() - start, 1e-7)))
+    best = np.inf
+    for _ in range(repeats):
+        start = time.perf_counter()
+        for _ in range(calls):
+            function()
+        best = min(best, (time.perf_counter() - start) / calls)
+    return best
+
+
+def _state(kind: str, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """Moments (in a random order) and a momentum of the given kind."""
+    inertia = np.sort(rng.uniform(1.0, 10.0, 3))
+    if kind == "generic":
+        m = rng.normal(size=3)
+    elif kind == "near separatrix (1e-10)":
+        I1, I2, I3 = inertia
+        a, b = (I1 - I2) / I1, (I3 - I2) / I3
+        x1_2 = 0.3 * (1.0 - 1e-10 / b) / (1.0 - a / b)
+        x3_2 = (1e-10 - a * x1_2) / b
+        m = np.sqrt([x1_2, 1.0 - x1_2 - x3_2, x3_2])
+    elif kind == "separatrix":
+        inertia = np.array([2.0, 3.0, 6.0])
+        m = np.array([1.0, rng.uniform(-2.0, 2.0), -1.0])
+    elif kind == "mc below the float range":
+        inertia = np.array([1.0, 2.0, 3.0])
+        m = np.array([1e-200, 1.0, 2e-200])
+    elif kind == "symmetric":
+        inertia[1] = inertia[0]
+        m = rng.normal(size=3)
+    else:
+        raise ValueError(kind)
+    return inertia[rng.permutation(3)], m * rng.uniform(0.5, 2.0)
+
+
+SCALAR_KINDS = [
+    "generic",
+    "near separatrix (1e-10)",
+    "separatrix",
+    "mc below the float range",
+    "symmetric",
+]
+BATCH_KINDS = ["generic", "mixed (every case)"]
+
+
+def _batch(kind: str, count: int, rng: np.random.Generator):
+    if kind == "generic":
+        states = [_state("generic", rng) for _ in range(count)]
+    else:
+        kinds = [*SCALAR_KINDS, "sphere", "rest"]
+        states = []
+        for k in range(count):
+            which = kinds[k % len(kinds)]
+            if which == "sphere":
+                states.append((np.full(3, 2.0), rng.normal(size=3)))
+            elif which == "rest":
+                states.append((rng.uniform(1.0, 10.0, 3), np.zeros(3)))
+            else:
+                states.append(_state(which, rng))
+    moments = np.array([s[0] for s in states])
+    momentum = np.array([s[1] for s in states])
+    q = Rotation.random(count, random_state=1).as_quat(scalar_first=True)
+    dt = rng.uniform(0.1, 10.0, count)
+    return moments, momentum, q, dt
+
+
+def main(argv=None) -> dict:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true")
+    args = parser.parse_args(argv)
+    repeats = 9 if args.quick else 41
+    sizes = [1, 10, 100, 1000, 10_000] if args.quick else [1, 10, 100, 1000, 100_000]
+    rng = np.random.default_rng(2026)
+    load_before = os.getloadavg()
+
+    report: dict = {
+        "machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores",
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "scalar": {},
+        "batch": {},
+    }
+
+    # ------------------------------------------------------------ one state, one step
+    ellipj = _best_per_call(lambda: special.ellipj(0.7, 0.3), repeats)
+    report["scalar_ellipj_us"] = ellipj * 1e6
+    print(f"one scalar scipy.special.ellipj call: {ellipj * 1e9:.0f} ns")
+    print(f"{'one state, one step':34s} {'advance':>10s} {'/ellipj':>8s} {'EulerSolver':>12s}")
+    for kind in SCALAR_KINDS:
+        inertia, m = _state(kind, rng)
+        q = Rotation.random(random_state=3).as_quat(scalar_first=True)
+        dt = 3.7
+        step = _best_per_call(lambda: advance(inertia, m, q, dt), repeats)  # noqa: B023
+        attitude0 = Rotation.from_quat(q, scalar_first=True)
+
+        def solver_step():
+            solver = EulerSolver(inertia, m, attitude0)  # noqa: B023
+            return solver.angular_momentum(dt), solver.attitude_quaternion(dt)  # noqa: B023
+
+        solver = _best_per_call(solver_step, repeats)
+        report["scalar"][kind] = {
+            "advance_us": step * 1e6,
+            "ratio_to_ellipj": step / ellipj,
+            "euler_solver_us": solver * 1e6,
+            "ratio_euler_solver_to_advance": solver / step,
+        }
+        print(
+            f"  {kind:32s} {step * 1e6:8.1f} µs {step / ellipj:7.1f}x "
+            f"{solver * 1e6:9.0f} µs ({solver / step:.0f}x advance)"
+        )
+
+    # ------------------------------------------------------------ N states, one step each
+    header = ("N states, one step each", "N", "ns/state", "ellipj ns/pt", "ratio")
+    print("\n{:24s} {:>7s} {:>10s} {:>13s} {:>7s}".format(*header))
+    for kind in BATCH_KINDS:
+        report["batch"][kind] = {}
+        for count in sizes:
+            moments, momentum, q, dt = _batch(kind, count, rng)
+            u, mpar = rng.uniform(-3.0, 3.0, count), rng.uniform(0.0, 1.0, count)
+            ours = _best_per_call(lambda: advance(moments, momentum, q, dt), repeats)  # noqa: B023
+            peer = _best_per_call(lambda: special.ellipj(u, mpar), repeats)  # noqa: B023
+            report["batch"][kind][count] = {
+                "advance_ns_per_state": ours / count * 1e9,
+                "ellipj_ns_per_point": peer / count * 1e9,
+                "ratio_to_ellipj": ours / peer,
+            }
+            print(
+                f"  {kind:22s} {count:7d} {ours / count * 1e9:10.0f} "
+                f"{peer / count * 1e9:13.0f} {ours / peer:7.1f}"
+            )
+    load_after = os.getloadavg()
+    report["load_average_1min_before_after"] = [load_before[0], load_after[0]]
+    print(f"\nload average (1 min) before/after: {load_before[0]:.2f} / {load_after[0]:.2f}")
+    RESULTS.mkdir(exist_ok=True)
+    (RESULTS / "free_flow.json").write_text(json.dumps(report, indent=2) + "\n")
+    return report
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,201 @@
+"""Hostile input to the torque models and the torqued solver: clear errors, never NaN."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from attitude import ConstantTorque, GravityGradient, InputError, TorquedSolver, UserTorque
+from attitude.torqued_solver import propagate_batch
+
+INERTIA = [100.0, 200.0, 300.0]
+M0 = [1.0, 2.0, 3.0]
+
+
+def circular(t):
+    t = np.asarray(t, dtype=float)
+    return 7e6 * np.stack([np.cos(1e-3 * t), np.sin(1e-3 * t), 0 * t], axis=-1)
+
+
+def _solve(torques, **options):
+    solver = TorquedSolver(INERTIA, M0, torques=torques, **options)
+    return solver.attitude_quaternion([10.0, 20.0])
+
+
+@pytest.mark.parametrize(
+    "position, message",
+    [
+        (lambda t: np.zeros(3), "returned shape"),
+        (lambda t: np.full((*np.shape(t), 3), np.nan), "finite"),
+        (lambda t: np.zeros((*np.shape(t), 3)), "away from the centre"),
+        (lambda t: "far away", "numeric|returned shape|could not"),
+    ],
+)
+def test_bad_positions_are_refused_with_the_time(position, message):
+    with pytest.raises((InputError, ValueError), match=message):
+        _solve([GravityGradient(position)])
+
+
+@pytest.mark.parametrize("mu", [0.0, -3.986e14, math.nan, math.inf])
+def test_bad_gravitational_parameter(mu):
+    with pytest.raises(InputError, match="mu"):
+        GravityGradient(circular, mu=mu)
+
+
+def test_position_must_be_callable_or_an_orbit():
+    with pytest.raises(InputError, match="callable"):
+        GravityGradient([7e6, 0.0, 0.0])
+
+
+def test_orbit_without_epoch():
+    class Orbit:
+        def position(self, times):
+            return np.zeros((np.size(times), 3))
+
+    with pytest.raises(InputError, match="epoch"):
+        GravityGradient(Orbit())
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (([1.0, 0.0], 0.0, 1.0), "3-vector"),
+        (([1.0, 0.0, math.nan], 0.0, 1.0), "finite"),
+        (([1.0, 0.0, 0.0], 5.0, 5.0), "after start"),
+        (([1.0, 0.0, 0.0], 5.0, math.nan), "after start|finite"),
+        (([1.0, 0.0, 0.0], math.inf, 7.0), "finite"),
+    ],
+)
+def test_bad_constant_torques(args, message):
+    with pytest.raises(InputError, match=message):
+        ConstantTorque(*args)
+
+
+def test_constant_torque_frame_is_checked():
+    with pytest.raises(InputError, match="frame"):
+        ConstantTorque([1.0, 0.0, 0.0], 0.0, 1.0, frame="orbital")
+
+
+def test_constant_torque_accepts_quantities():
+    from astropy import units as u
+
+    burn = ConstantTorque([1.0, 0.0, 0.0] * u.mN * u.m, 0.0 * u.s, 1.0 * u.min)
+    assert burn.torque.tolist() == [1e-3, 0.0, 0.0] and burn.stop == 60.0
+    with pytest.raises(InputError, match="unit"):
+        ConstantTorque([1.0, 0.0, 0.0] * u.kg, 0.0, 1.0)
+
+
+@pytest.mark.parametrize(
+    "function, message",
+    [
+        (lambda t, attitude, ω: [1.0, 2.0], "shape"),
+        (lambda t, attitude, ω: [1.0, math.nan, 0.0], "finite"),
+        (lambda t, attitude, ω: [1.0, math.inf, 0.0], "finite"),
+    ],
+)
+def test_bad_user_torques_name_the_function_and_time(function, message):
+    with pytest.raises(InputError, match=message):
+        _solve([UserTorque(function, name="thruster_model")])
+
+
+def test_user_torque_errors_propagate_as_they_are():
+    def broken(t, attitude, ω):
+        raise RuntimeError("the user's model failed")
+
+    with pytest.raises(RuntimeError, match="user's model"):
+        _solve([broken])
+
+
+@pytest.mark.parametrize("item", ["gravity", 3.0, None])
+def test_torque_list_items_are_checked(item):
+    with pytest.raises(InputError, match="torques"):
+        TorquedSolver(INERTIA, M0, torques=[item])
+
+
+@pytest.mark.parametrize("step", [0.0, -1.0, math.nan, math.inf])
+def test_bad_steps(step):
+    with pytest.raises(InputError, match="step"):
+        TorquedSolver(INERTIA, M0, torques=[GravityGradient(circular)], step=step)
+
+
+def test_order_and_method_are_checked():
+    gg = GravityGradient(circular)
+    with pytest.raises(InputError, match="order"):
+        TorquedSolver(INERTIA, M0, torques=[gg], order=3)
+    with pytest.raises(InputError, match="method"):
+        TorquedSolver(INERTIA, M0, torques=[gg], method="rk4")
+    with pytest.raises(InputError, match="order 4, not 2"):
+        TorquedSolver(INERTIA, M0, torques=[gg], method="aba1064", order=2)
+    # order 6 needs torques independent of ω; a damper is refused, with the way out.
+    with pytest.raises(InputError, match="order 2 or 4"):
+        TorquedSolver(INERTIA, M0, torques=[lambda t, a, ω: -ω], order=6)
+
+
+def test_tolerance_needs_a_span_and_excludes_a_step():
+    gg = GravityGradient(circular)
+    with pytest.raises(InputError, match="span"):
+        TorquedSolver(INERTIA, M0, torques=[gg], tolerance=1e-6)
+    with pytest.raises(InputError, match="either step or tolerance"):
+        TorquedSolver(INERTIA, M0, torques=[gg], tolerance=1e-6, span=100.0, step=1.0)
+    for tolerance in (0.0, -1.0, math.nan):
+        with pytest.raises(InputError, match="tolerance"):
+            TorquedSolver(INERTIA, M0, torques=[gg], tolerance=tolerance, span=100.0)
+    with pytest.raises(InputError, match="span"):
+        TorquedSolver(INERTIA, M0, torques=[gg], tolerance=1e-6, span=-5.0)
+
+
+def test_times_before_t0_and_bad_times():
+    solver = TorquedSolver(INERTIA, M0, t0=100.0, torques=[GravityGradient(circular)])
+    with pytest.raises(InputError, match="t0"):
+        solver.attitude(99.0)
+    with pytest.raises(InputError, match="finite"):
+        solver.angular_momentum([150.0, math.nan])
+    with pytest.raises(InputError, match="1-D"):
+        solver.attitude(np.full((2, 2), 150.0))
+
+
+def test_the_solver_inputs_are_those_of_euler_solver():
+    gg = GravityGradient(circular)
+    with pytest.raises(InputError, match="positive"):
+        TorquedSolver([100.0, -1.0, 300.0], M0, torques=[gg])
+    with pytest.raises(InputError, match="angular_momentum"):
+        TorquedSolver(INERTIA, [1.0, 2.0], torques=[gg])
+    with pytest.raises(InputError, match="Rotation"):
+        TorquedSolver(INERTIA, M0, attitude=[1.0, 0.0, 0.0, 0.0], torques=[gg])
+
+
+def test_step_longer_than_the_span_and_a_resting_body():
+    gg = GravityGradient(circular)
+    solver = TorquedSolver(
+        INERTIA, [0.0, 0.0, 0.0], Rotation.from_rotvec([0.1, 0.2, 0.3]), torques=[gg], step=1e4
+    )
+    q = solver.attitude_quaternion([0.0, 1.0, 50.0])
+    assert np.all(np.isfinite(q))
+    # At rest in a gradient: it starts to turn, slowly.
+    assert np.linalg.norm(solver.angular_momentum(50.0)) > 0.0
+
+
+def test_absurd_magnitudes_stay_finite():
+    gg = GravityGradient(circular)
+    tiny = TorquedSolver([1e-6, 2e-6, 3e-6], [1e-9, 2e-9, 3e-9], torques=[gg], step=1.0)
+    huge = TorquedSolver([1e9, 2e9, 3e9], [1e8, 2e8, 3e8], torques=[gg], step=1.0)
+    for solver in (tiny, huge):
+        assert np.all(np.isfinite(solver.attitude_quaternion([0.5, 3.0])))
+
+
+def test_batch_input_is_checked():
+    gg = GravityGradient(circular)
+    with pytest.raises(InputError, match="shape"):
+        propagate_batch(INERTIA, M0, None, 0.0, [1.0], [gg])
+    with pytest.raises(InputError, match="moments"):
+        propagate_batch([[1.0, 2.0, 3.0]] * 2, [M0] * 3, None, 0.0, [1.0], [gg])
+    with pytest.raises(InputError, match="increasing"):
+        propagate_batch(INERTIA, [M0], None, 0.0, [5.0, 1.0], [gg])
+
+
+def test_a_huge_span_is_refused_not_hung():
+    solver = TorquedSolver(INERTIA, M0, torques=[GravityGradient(circular)], step=1.0)
+    with pytest.raises(InputError, match="steps"):
+        solver.attitude(1e12)
+    assert np.all(np.isfinite(solver.attitude_quaternion(3.0)))  # still usable after
