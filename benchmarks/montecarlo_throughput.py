@@ -17,7 +17,12 @@ load:
    scheduler's cost per task, and the bytes each task moves.
 
     python -m benchmarks.montecarlo_throughput                     # 10,000 and 1,000
-    python -m benchmarks.montecarlo_throughput --samples 200 --one-worker 50
+    python -m benchmarks.montecarlo_throughput --samples 40 --one-worker 20
+
+A sample of this case costs about 6 to 14 s here (the exact pointing search of a day
+of a 5 rpm spinner: 560,000 search points), so the default 10,000 samples would take
+a day on this machine; docs/benchmarks.md ("Monte Carlo") was measured with the
+second line (run A) and with `--samples 24 --one-worker 12` (run B), and extrapolates.
 
 Results: stdout and benchmarks/results/montecarlo_throughput.json.
 """
