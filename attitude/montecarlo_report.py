@@ -35,7 +35,11 @@ from attitude.montecarlo_statistics import (
 )
 from attitude.output_budget import DISK_SHARE, ResourceError
 from attitude.output_folder import claim
-from attitude.report_page import _STYLE, _table  # the page of attitude run, its look
+from attitude.report_page import (  # the page of attitude run, its look
+    _STYLE,
+    _figures_and_files,
+    _table,
+)
 from attitude.version import __version__
 
 __all__ = ["OUTPUT_NAMES", "check_folder", "statistics", "write_report"]
@@ -412,15 +416,7 @@ def _page(result: MonteCarloResult, stats, images: dict[str, str], files: list[s
             "<code>attitude montecarlo FILE --sample K --emit-scenario DIR</code> writes "
             "sample K as a scenario to run alone.</p>"
         )
-    parts.append("<h2>Plots</h2>")
-    for caption, name in images.items():
-        parts.append(
-            f"<figure><img src='{escape(name)}' alt='{escape(caption)}'>"
-            f"<figcaption class='note'>{escape(caption)}</figcaption></figure>"
-        )
-    parts.append("<h2>Files</h2><ul>")
-    parts += [f"<li><a href='{escape(f)}'>{escape(f)}</a></li>" for f in files]
-    parts.append("</ul>")
+    parts += _figures_and_files(images, files)
     parts.append(
         f"<p class='note'>{execution['tasks']} tasks of {execution['batch_size']} samples on "
         f"{escape(str(execution['scheduler']))}; one sample of the nominal took "

@@ -220,16 +220,7 @@ def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str
                     ],
                 )
             )
-    if images:
-        parts.append("<h2>Plots</h2>")
-    for caption, name in images.items():
-        parts.append(
-            f"<figure><img src='{escape(name)}' alt='{escape(caption)}'>"
-            f"<figcaption class='note'>{escape(caption)}</figcaption></figure>"
-        )
-    parts.append("<h2>Files</h2><ul>")
-    parts += [f"<li><a href='{escape(f)}'>{escape(f)}</a></li>" for f in files]
-    parts.append("</ul>")
+    parts += _figures_and_files(images, files)
     aem = summary.get("outputs", {}).get("aem")
     if aem:
         parts.append(
@@ -245,3 +236,18 @@ def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str
     )
     parts.append("</body></html>\n")
     return "\n".join(parts)
+
+
+def _figures_and_files(images: dict[str, str], files: list[str]) -> list[str]:
+    """The page's figures (caption: image file) under "Plots", if any, and its files
+    as links (also the Monte Carlo page's, attitude.montecarlo_report)."""
+    parts = ["<h2>Plots</h2>"] if images else []
+    for caption, name in images.items():
+        parts.append(
+            f"<figure><img src='{escape(name)}' alt='{escape(caption)}'>"
+            f"<figcaption class='note'>{escape(caption)}</figcaption></figure>"
+        )
+    parts.append("<h2>Files</h2><ul>")
+    parts += [f"<li><a href='{escape(f)}'>{escape(f)}</a></li>" for f in files]
+    parts.append("</ul>")
+    return parts
