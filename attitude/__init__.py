@@ -15,11 +15,13 @@ The layers, each importing only the ones above it in this list (README "Layout")
   ``surroundings``, ``pointing_sampling``, ``pointing_search``, ``pointing``: pointing
 - ``attitude.exports``, ``aem``, ``summaries``, ``plots``, ``report_page``, ``report``: reports
   and exports
-- ``attitude.scenario_file``, ``cli``: scenario files and the command line
+- ``attitude.scenario_file``, ``cli``: scenario files and the command line; beside them,
+  ``dispersions``, ``scenario_writer`` and ``montecarlo`` (``run_montecarlo``): Monte
+  Carlo jobs on Dask, which drive the scenario layer from above
 
 The names below are importable from ``attitude`` directly; all but the errors are
 loaded on first use, so that ``import attitude`` stays light (numpy, scipy, astropy,
-skyfield and matplotlib load only when needed), and the command line can install its
+skyfield, matplotlib, dask and pandas load only when needed), and the command line can install its
 signal handlers before anything heavy loads.
 
 Conventions: SI units (s, kg m², N m s, rad/s; astropy Quantities accepted at the
@@ -40,6 +42,7 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.events import AngularImpulse, AttitudeReset, InertiaChange
     from attitude.horizon import validity_horizon
     from attitude.keplerian import KeplerianOrbit
+    from attitude.montecarlo import run_montecarlo
     from attitude.motion_analysis import analyze
     from attitude.oem import OemOrbit
     from attitude.orbit import TleOrbit
@@ -83,6 +86,7 @@ _LAZY = {
     "write_aem": "attitude.aem",
     "load_scenario": "attitude.scenario_file",
     "produce": "attitude.report",
+    "run_montecarlo": "attitude.montecarlo",
 }
 
 # Spelled out (not built from _LAZY) so that linters and IDEs read it statically;
@@ -119,6 +123,7 @@ __all__ = [
     "produce",
     "propagate",
     "propagate_batch",
+    "run_montecarlo",
     "validity_horizon",
     "write_aem",
 ]

@@ -1,11 +1,13 @@
-"""The command line: ``attitude run`` and ``attitude check`` (also ``python -m attitude``).
+"""The command line: ``attitude run``, ``check`` and ``montecarlo`` (also ``python -m attitude``).
 
     attitude run SCENARIO.toml --out DIR   propagate, write the outputs into DIR
     attitude check SCENARIO.toml           validate the file and describe the run
+    attitude montecarlo SCENARIO.toml --out DIR   the [dispersions] samples, on Dask
 
-Both take ``--formats csv,parquet,aem,plots,report`` (the outputs to write; default
-``csv,aem,plots,report``, or the file's ``[output] formats``) and ``--aem-tolerance
-"1e-6 rad"`` (the accuracy the AEM is sampled for; an angle with its unit).
+``run`` and ``check`` take ``--formats csv,parquet,aem,plots,report`` (the outputs to
+write; default ``csv,aem,plots,report``, or the file's ``[output] formats``) and
+``--aem-tolerance "1e-6 rad"`` (the accuracy the AEM is sampled for; an angle with its
+unit).  ``montecarlo`` writes its own outputs (``docs/montecarlo.md``).
 ``check`` goes through the same checks as ``run`` up to the sampling
 (``attitude.run_plan``): what ``check`` accepts, ``run`` computes, and it states the
 size of each chosen output.  ``--out`` given to ``check`` also checks the folder and
@@ -97,7 +99,34 @@ def _parser() -> argparse.ArgumentParser:
             help="the AEM is sampled so that its declared interpolation stays within this "
             'of the exact attitude, with its unit: "1e-6 rad" (the default), "0.2 arcsec"',
         )
+    _montecarlo_parser(commands)
     return parser
+
+
+def _montecarlo_parser(commands) -> None:
+    """``attitude montecarlo``: the dispersed samples of a scenario on Dask."""
+    mc = commands.add_parser(
+        "montecarlo",
+        help="run the [dispersions] samples of a scenario on Dask (docs/montecarlo.md)",
+    )
+    mc.add_argument("scenario", type=Path, help="scenario file (TOML) with [dispersions]")
+    mc.add_argument("--out", type=Path, help="output folder (the rules of run --out)")
+    mc.add_argument("--samples", type=int, help="sample count (replaces the file's)")
+    mc.add_argument("--seed", type=int, help="seed (replaces the file's)")
+    where = mc.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", help="address of a Dask scheduler (default: local)")
+    where.add_argument("--workers", type=int, help="local worker processes (default: all cores)")
+    mc.add_argument("--batch-size", type=int, help="samples per task (default: from costs)")
+    mc.add_argument(
+        "--sample", type=int, action="append", help="with --emit-scenario: sample K (repeatable)"
+    )
+    mc.add_argument(
+        "--emit-scenario",
+        type=Path,
+        metavar="DIR",
+        help="write sample K as DIR/sample_K.toml, an ordinary scenario, instead of running",
+    )
+    mc.add_argument("--quiet", action="store_true", help="no progress bar or messages")
 
 
 def _outputs(args, outputs):
@@ -222,19 +251,31 @@ def _checked_run(args, state: dict) -> int:
     try:
         # The command line's own options first: their errors name the option, not a file.
         try:
-            _outputs(args, OutputChoice())
+            if args.command != "montecarlo":  # montecarlo writes no time series
+                _outputs(args, OutputChoice())
         except InputError as exc:
             _error(str(exc))
             return 2
         loaded = load_scenario(args.scenario)
         state["file"] = loaded.path.name
+        if args.command == "montecarlo":
+            from attitude.montecarlo import command
+
+            return command(args, loaded)
         outputs = _outputs(args, loaded.outputs)
         plan = plan_run(loaded.scenario, loaded.pointing, outputs)
+        montecarlo = None
+        if "dispersions" in loaded.document:  # checked by run too: one reading of the file
+            from attitude.montecarlo import plan_montecarlo
+
+            montecarlo = plan_montecarlo(loaded, plan)
         if args.command == "check":
             if args.out is not None:
                 check_fits(plan.budget, args.out)
                 claim(args.out, OUTPUT_NAMES, dry_run=True)
             print(_describe(loaded, plan, args.out), flush=True)
+            if montecarlo is not None:
+                print("\n".join(montecarlo.describe()), flush=True)
             return 0
         claim(args.out, OUTPUT_NAMES, dry_run=True)  # a folder that is not ours: say so first
         for note in plan.notes:

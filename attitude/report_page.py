@@ -304,11 +304,22 @@ def _plots_section(images: dict[str, str]) -> list[str]:
     ]
 
 
-def _files_section(files: list[str], aem: dict[str, Any] | None) -> list[str]:
-    """Links to the data files, the AEM's stated accuracy, and the conventions."""
+def _file_links(files: list[str]) -> list[str]:
     parts = ["<h2>Files</h2><ul>"]
     parts += [f"<li><a href='{escape(f)}'>{escape(f)}</a></li>" for f in files]
     parts.append("</ul>")
+    return parts
+
+
+def _figures_and_files(images: dict[str, str], files: list[str]) -> list[str]:
+    """The figures under "Plots", if any, and the files as links (the Monte Carlo
+    page's too, attitude.montecarlo_report)."""
+    return _plots_section(images) + _file_links(files)
+
+
+def _files_section(files: list[str], aem: dict[str, Any] | None) -> list[str]:
+    """Links to the data files, the AEM's stated accuracy, and the conventions."""
+    parts = _file_links(files)
     if aem:
         parts.append(
             f"<p class='note'>attitude.aem: {aem['records']} records, sampled so that "

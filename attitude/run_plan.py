@@ -51,9 +51,17 @@ class RunPlan:
 
 
 def plan_run(
-    scenario: Scenario, pointing: PointingSpec | None = None, outputs: OutputChoice | None = None
+    scenario: Scenario,
+    pointing: PointingSpec | None = None,
+    outputs: OutputChoice | None = None,
+    *,
+    horizon: bool = True,
 ) -> RunPlan:
-    """Check ``scenario`` (``pointing``, ``outputs``) as a run would, up to the sampling."""
+    """Check ``scenario`` (``pointing``, ``outputs``) as a run would, up to the sampling.
+
+    ``horizon=False`` leaves out the validity horizon of a torque-free scenario on an
+    orbit (a torqued propagation beside the exact one: seconds), which Monte Carlo
+    samples do not report."""
     pointing = pointing or PointingSpec()
     outputs = outputs or OutputChoice()
     samples = scenario.output_count()
@@ -81,9 +89,9 @@ def plan_run(
             f"torques: the propagation has no finite error estimate ({errors}): "
             "give a smaller step or an accuracy"
         )
-    horizon = None
-    if pointing.orbit is not None and not scenario.torques.any:
-        horizon = validity_horizon(trajectory, pointing.orbit)
+    held = None
+    if horizon and pointing.orbit is not None and not scenario.torques.any:
+        held = validity_horizon(trajectory, pointing.orbit)
     aem = None
     if "aem" in outputs:
         aem = plan_aem(
@@ -104,5 +112,5 @@ def plan_run(
         pointing_columns=columns,
     )
     return RunPlan(
-        scenario, pointing, trajectory, motion, budget, notes, outputs, aem, search, horizon
+        scenario, pointing, trajectory, motion, budget, notes, outputs, aem, search, held
     )

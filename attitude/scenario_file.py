@@ -48,7 +48,14 @@ from attitude.scenario_torques import Burn, ScenarioTorques
 from attitude.spacecraft import Spacecraft
 from attitude.timescales import SCALES, as_time, time_from_tt_seconds
 
-__all__ = ["ScenarioFile", "ScenarioFileError", "ScenarioFileWarning", "load_scenario"]
+__all__ = [
+    "ScenarioFile",
+    "ScenarioFileError",
+    "ScenarioFileWarning",
+    "load_scenario",
+    "read_document",
+    "scenario_from_document",
+]
 
 # A scenario is a few kilobytes; anything this large is not one (and reading a huge
 # or endless file, e.g. /dev/zero, must not exhaust the memory).
@@ -71,6 +78,9 @@ class ScenarioFile:
     scenario: Scenario
     pointing: PointingSpec = field(default_factory=PointingSpec)
     outputs: OutputChoice = field(default_factory=OutputChoice)
+    # The TOML document as read: attitude.dispersions reads its [dispersions] table
+    # and writes each Monte Carlo sample as a copy of it.
+    document: dict[str, Any] = field(default_factory=dict)
 
 
 class _Table:
@@ -558,7 +568,7 @@ def _torques(root: _Table, scale: str, orbit: Orbit | None) -> ScenarioTorques |
         raise ScenarioFileError(f"{table.file.name}: {exc}") from None
 
 
-def _read(path: Path) -> dict[str, Any]:
+def read_document(path: Path) -> dict[str, Any]:
     """The TOML document at ``path``; ScenarioFileError for anything that is not one."""
     try:
         with open(path, "rb") as stream:
@@ -587,8 +597,26 @@ def _read(path: Path) -> dict[str, Any]:
 def load_scenario(path: str | Path) -> ScenarioFile:
     """Read and check a scenario file; raises :class:`ScenarioFileError`."""
     path = Path(path)
-    root = _Table(path, "", _read(path))
-    root.allow("scenario", "spacecraft", "initial_state", "events", "output", "pointing", "torques")
+    return scenario_from_document(path, read_document(path))
+
+
+def scenario_from_document(path: Path, document: dict[str, Any]) -> ScenarioFile:
+    """Check a TOML document as :func:`load_scenario` checks a file (``path`` names it in
+    the errors): a Monte Carlo sample is built from its document through this one path.
+
+    A ``[dispersions]`` table is let through unread: ``attitude.dispersions`` reads it.
+    """
+    root = _Table(path, "", document)
+    root.allow(
+        "scenario",
+        "spacecraft",
+        "initial_state",
+        "events",
+        "output",
+        "pointing",
+        "torques",
+        "dispersions",
+    )
 
     meta = root.table("scenario")
     meta.allow("name", "epoch", "time_scale")
@@ -640,7 +668,7 @@ def load_scenario(path: str | Path) -> ScenarioFile:
     except InputError as exc:
         end = "stop" if stop is not None else "duration"
         raise ScenarioFileError(f"{path.name}: {_scenario_key(str(exc), end)}") from None
-    return ScenarioFile(path, scenario, pointing, _outputs(output))
+    return ScenarioFile(path, scenario, pointing, _outputs(output), document)
 
 
 def _outputs(output: _Table) -> OutputChoice:

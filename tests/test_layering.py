@@ -58,7 +58,16 @@ LAYERS = [
         "output_folder",
         "report",
     ],
-    ["scenario_file", "cli", "__main__"],  # command line
+    [  # command line, and Monte Carlo beside it (it drives the scenario layer from above)
+        "scenario_file",
+        "dispersions",
+        "scenario_writer",
+        "montecarlo",
+        "montecarlo_statistics",
+        "montecarlo_report",
+        "cli",
+        "__main__",
+    ],
 ]
 
 
@@ -119,7 +128,7 @@ def test_every_public_name_resolves_and_import_stays_light():
     for name in attitude.__all__:
         assert getattr(attitude, name) is not None, name
     # `import attitude` alone loads none of the heavy dependencies of the later layers.
-    heavy = "{'astropy', 'skyfield', 'matplotlib'}"
+    heavy = "{'astropy', 'skyfield', 'matplotlib', 'dask', 'distributed', 'pandas', 'pyarrow'}"
     code = f"import sys, attitude; print(sorted({heavy} & set(sys.modules)))"
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert run.stdout.strip() == "[]"
