@@ -13,7 +13,7 @@ The layers, each importing only the ones above it in this list (README "Layout")
 - ``attitude.ephemeris``, ``earth``, ``frames``, ``orbit``, ``keplerian``, ``oem``,
   ``aem_input``, ``intervals``, ``extrema``, ``eclipse``, ``pointing_spec``,
   ``surroundings``, ``pointing_sampling``, ``pointing_search``, ``pointing``: pointing
-- ``attitude.exports``, ``aem``, ``summaries``, ``plots``, ``report_page``, ``report``: reports
+- ``attitude.csv_files``, ``aem``, ``summaries``, ``plots``, ``report_page``, ``report``: reports
   and exports
 - ``attitude.scenario_file``, ``cli``: scenario files and the command line; beside them,
   ``dispersions``, ``scenario_writer`` and ``montecarlo`` (``run_montecarlo``): Monte
@@ -47,7 +47,7 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.oem import OemOrbit
     from attitude.orbit import TleOrbit
     from attitude.pointing import BodyVector, PointingSpec, pointing_analysis, pointing_samples
-    from attitude.report import produce
+    from attitude.report import write_report
     from attitude.scenario import InitialState, Scenario
     from attitude.scenario_file import load_scenario
     from attitude.scenario_torques import Burn, ScenarioTorques
@@ -85,7 +85,7 @@ _LAZY = {
     "OemOrbit": "attitude.oem",
     "write_aem": "attitude.aem",
     "load_scenario": "attitude.scenario_file",
-    "produce": "attitude.report",
+    "write_report": "attitude.report",
     "run_montecarlo": "attitude.montecarlo",
 }
 
@@ -120,12 +120,12 @@ __all__ = [
     "load_scenario",
     "pointing_analysis",
     "pointing_samples",
-    "produce",
     "propagate",
     "propagate_batch",
     "run_montecarlo",
     "validity_horizon",
     "write_aem",
+    "write_report",
 ]
 
 

@@ -369,7 +369,7 @@ def write_planned_aem(
         )
         for first in range(0, item.count, chunk_records):
             τ = item.seconds(first, first + chunk_records)
-            # One record is evaluated as a pair (see attitude.exports.sample).
+            # One record is evaluated as a pair (see attitude.csv_files.sample).
             pair = np.repeat(τ, 2) if τ.size == 1 else τ
             writer.write_records(
                 texts(τ),

@@ -244,7 +244,7 @@ def _checked_run(args, state: dict) -> int:
     from attitude.output_budget import check_fits
     from attitude.output_folder import OutputFolderError, claim
     from attitude.output_formats import OutputChoice
-    from attitude.report import OUTPUT_NAMES, Progress, produce
+    from attitude.report import OUTPUT_NAMES, Progress, write_report
     from attitude.run_plan import plan_run
     from attitude.scenario_file import ScenarioFileError, load_scenario
 
@@ -281,7 +281,7 @@ def _checked_run(args, state: dict) -> int:
         for note in plan.notes:
             print(f"attitude: note: {loaded.path.name}: {note}", file=sys.stderr, flush=True)
         progress = Progress(None if args.quiet else lambda line: print(line, file=sys.stderr))
-        produce(loaded.scenario, args.out, loaded.pointing, loaded.path.name, progress, plan)
+        write_report(loaded.scenario, args.out, loaded.pointing, loaded.path.name, progress, plan)
         return 0
     except (ScenarioFileError, OutputFolderError) as exc:
         _error(str(exc))

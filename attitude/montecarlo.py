@@ -55,7 +55,6 @@ from numpy.typing import NDArray
 
 from attitude.dispersions import Dispersions, draw_sample, read_dispersions
 from attitude.errors import InputError
-from attitude.exports import motion_summary, pointing_summary
 from attitude.output_budget import ResourceError, available_memory_bytes
 from attitude.output_folder import held_signals
 from attitude.output_formats import OutputChoice
@@ -64,6 +63,7 @@ from attitude.run_plan import RunPlan, plan_run
 from attitude.scenario import Scenario
 from attitude.scenario_file import ScenarioFile, load_scenario, scenario_from_document
 from attitude.scenario_writer import with_absolute_files
+from attitude.summaries import motion_summary, pointing_summary
 from attitude.trajectory import Trajectory
 from attitude.version import __version__
 
@@ -131,7 +131,7 @@ def _segment_metric_names(k: int) -> list[str]:
     ]
 
 
-# Each body vector's extrema, as summary.json names them (attitude.exports): the
+# Each body vector's extrema, as summary.json names them (attitude.summaries): the
 # quantity, and whether it is an angle (reported in degrees).
 _VECTOR_EXTREMA = (
     ("sun_angle", True, False),

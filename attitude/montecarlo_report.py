@@ -25,7 +25,6 @@ from typing import Any
 
 import numpy as np
 
-from attitude.exports import write_json
 from attitude.montecarlo import ANGLE_STEP_DEG, MonteCarloPlan, MonteCarloResult
 from attitude.montecarlo_statistics import (
     CONFIDENCE,
@@ -40,6 +39,7 @@ from attitude.report_page import (  # the page of attitude run, its look
     _figures_and_files,
     _table,
 )
+from attitude.summaries import write_json
 from attitude.version import __version__
 
 __all__ = ["OUTPUT_NAMES", "check_folder", "statistics", "write_report"]

@@ -111,7 +111,7 @@ def estimate(
     ``body_vectors`` and ``on_orbit``: the pointing columns; ``formats``: the chosen
     outputs; ``aem_records``: the AEM's records (``attitude.aem_sampling``; the
     output epochs when None); ``pointing_columns``: the time series' pointing columns
-    (``attitude.exports.pointing_column_count``; without it, the fewest a pointing
+    (``attitude.csv_files.pointing_column_count``; without it, the fewest a pointing
     with these vectors can have: 3, and 5 a vector).  Python ints: a hostile span of
     1e9 s every 1e-3 s is 1e12 samples, and is counted, not allocated.
     """

@@ -1,6 +1,6 @@
 """A scenario run, from a scenario to its report folder, streamed in chunks.
 
-``produce(scenario, out_dir, pointing)`` checks the scenario (``attitude.run_plan``),
+``write_report(scenario, out_dir, pointing)`` checks the scenario (``attitude.run_plan``),
 claims the output folder (``attitude.output_folder``: it never touches a file it did
 not write, and refuses a folder of the user's), propagates and writes into
 ``out_dir``; a failed or interrupted run leaves no half-written output and the
@@ -42,16 +42,15 @@ import numpy as np
 
 from attitude.aem import aem_text
 from attitude.aem_sampling import INTERPOLATION_METHOD, write_planned_aem
-from attitude.epoch_texts import EpochTexts
-from attitude.exports import (
+from attitude.csv_files import (
     QUATERNION_CONVENTION,
     CsvWriter,
     pointing_columns,
     sample,
     trajectory_columns,
     write_intervals_csv,
-    write_json,
 )
+from attitude.epoch_texts import EpochTexts
 from attitude.orbit import TleOrbit
 from attitude.output_budget import check_fits
 from attitude.output_folder import claim
@@ -80,12 +79,18 @@ from attitude.report_figures import (
 from attitude.report_page import render_page
 from attitude.run_plan import RunPlan, plan_run
 from attitude.scenario import Scenario
-from attitude.summaries import motion_summary, outputs_summary, pointing_summary, scenario_summary
+from attitude.summaries import (
+    motion_summary,
+    outputs_summary,
+    pointing_summary,
+    scenario_summary,
+    write_json,
+)
 from attitude.timeseries_parquet import ParquetWriter
 from attitude.torques_summary import torques_summary
 from attitude.version import __version__
 
-__all__ = ["CHUNK_SAMPLES", "OUTPUT_NAMES", "Progress", "output_grid", "produce"]
+__all__ = ["CHUNK_SAMPLES", "OUTPUT_NAMES", "Progress", "output_grid", "write_report"]
 
 # Output epochs evaluated and written at a time: large enough that the per-chunk
 # overheads vanish, small enough that a chunk with pointing holds tens of MB.
@@ -144,7 +149,7 @@ class _Pointing:
 # --- the run -----------------------------------------------------------------------
 
 
-def produce(
+def write_report(
     scenario: Scenario,
     out_dir: Path,
     pointing: PointingSpec | None = None,

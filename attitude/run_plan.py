@@ -20,8 +20,8 @@ import math
 from dataclasses import dataclass, field
 
 from attitude.aem_sampling import AemPlan, plan_aem
+from attitude.csv_files import pointing_column_count
 from attitude.errors import InputError
-from attitude.exports import pointing_column_count
 from attitude.horizon import ValidityHorizon, validity_horizon
 from attitude.motion_analysis import SegmentMotion, analyze
 from attitude.output_budget import OutputBudget, check_fits, estimate

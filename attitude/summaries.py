@@ -16,7 +16,9 @@ in the scenario's time scale (``Scenario.format_epoch``).
 
 from __future__ import annotations
 
+import json
 import math
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -31,7 +33,14 @@ from attitude.trajectory import Trajectory
 if TYPE_CHECKING:
     from attitude.run_plan import RunPlan
 
-__all__ = ["motion_summary", "outputs_summary", "pointing_summary", "scenario_summary"]
+__all__ = [
+    "motion_summary",
+    "outputs_summary",
+    "pointing_summary",
+    "scenario_summary",
+    "to_json",
+    "write_json",
+]
 
 
 def scenario_summary(scenario: Scenario, source: str) -> dict[str, Any]:
@@ -246,3 +255,24 @@ def outputs_summary(plan: RunPlan) -> dict[str, Any]:
             ],
         }
     return entry
+
+
+def to_json(value: Any) -> Any:
+    """``value`` with numpy arrays and scalars made JSON-serializable (inf/nan as None)."""
+    if isinstance(value, dict):
+        return {str(k): to_json(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [to_json(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return to_json(value.tolist())
+    if isinstance(value, np.generic):
+        return to_json(value.item())
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def write_json(path: Path, data: dict[str, Any]) -> None:
+    path.write_text(
+        json.dumps(to_json(data), indent=2, ensure_ascii=False) + "\n", encoding="utf-8"
+    )

@@ -34,8 +34,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from attitude.csv_files import Column, arrow_texts
 from attitude.errors import InputError
-from attitude.exports import Column, arrow_texts
 
 __all__ = ["MAX_SPAN_S", "ParquetWriter", "check_span", "unit_of"]
 

@@ -3,7 +3,7 @@
 On the one-day spinner's time series (86 401 rows, 41 columns: trajectory and
 pointing), in one process, alternately, best of ``--repeat``:
 
-- the CSV: ``attitude.exports.CsvWriter`` (Arrow's C++ formatter, shortest round-trip
+- the CSV: ``attitude.csv_files.CsvWriter`` (Arrow's C++ formatter, shortest round-trip
   text) against numpy's fastest text path, ``np.savetxt`` with ``%.17g`` on the same
   numbers (without the epoch column, which savetxt cannot mix in: the peer has less
   to write);
@@ -51,8 +51,8 @@ def main(argv: list[str] | None = None) -> dict:
     args = parser.parse_args(argv)
 
     from attitude.aem import AemSegment, AemWriter, write_aem
+    from attitude.csv_files import CsvWriter, pointing_columns, sample, trajectory_columns
     from attitude.epoch_texts import EpochTexts
-    from attitude.exports import CsvWriter, pointing_columns, sample, trajectory_columns
     from attitude.pointing import pointing_samples
     from attitude.scenario_file import load_scenario
     from attitude.timeseries_parquet import ParquetWriter

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-import attitude.exports
+import attitude.csv_files
 import attitude.timeseries_parquet
 from attitude.cli import main
 
@@ -161,7 +161,7 @@ def test_a_disk_full_in_the_middle_of_the_stream_leaves_nothing(
     (out / "notes.txt").write_text("mine\n")
     before = {p.name: p.read_bytes() for p in out.iterdir()}
     target = {
-        "csv": attitude.exports.CsvWriter,
+        "csv": attitude.csv_files.CsvWriter,
         "parquet": attitude.timeseries_parquet.ParquetWriter,
     }[failing]
     write = target.write

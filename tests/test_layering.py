@@ -43,7 +43,7 @@ LAYERS = [
         "pointing",
     ],
     [  # reports and exports
-        "exports",
+        "csv_files",
         "timeseries_parquet",
         "aem",
         "aem_sampling",

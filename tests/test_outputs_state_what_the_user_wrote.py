@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from attitude.cli import main
-from attitude.exports import right_ascension_deg
+from attitude.csv_files import right_ascension_deg
 from attitude.version import __version__
 
 SCENARIO = """

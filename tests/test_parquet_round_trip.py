@@ -113,13 +113,13 @@ def test_the_schema_states_frames_units_scale_and_convention(run):
 def test_a_row_group_per_chunk(tmp_path):
     (tmp_path / "s.toml").write_text(SCENARIO.split("[pointing]")[0])
     from attitude.output_formats import OutputChoice
-    from attitude.report import produce
+    from attitude.report import write_report
     from attitude.run_plan import plan_run
     from attitude.scenario_file import load_scenario
 
     loaded = load_scenario(tmp_path / "s.toml")
     plan = plan_run(loaded.scenario, loaded.pointing, OutputChoice(("parquet",)))
-    produce(loaded.scenario, tmp_path / "out", plan=plan, chunk_samples=100)
+    write_report(loaded.scenario, tmp_path / "out", plan=plan, chunk_samples=100)
     metadata = pq.ParquetFile(tmp_path / "out" / "timeseries.parquet").metadata
     assert metadata.num_row_groups == 5 and metadata.num_rows == 481
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())

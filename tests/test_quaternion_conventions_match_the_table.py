@@ -28,9 +28,9 @@ from attitude import (
     Scenario,
     Spacecraft,
     load_scenario,
-    produce,
     propagate,
     propagate_batch,
+    write_report,
 )
 from attitude.aem import QUATERNION_COMMENT, AemSegment, write_aem
 from attitude.free_flow import advance
@@ -115,7 +115,7 @@ def _scenario() -> Scenario:
 @pytest.fixture(scope="module")
 def report(tmp_path_factory):
     out = tmp_path_factory.mktemp("conventions") / "out"
-    produce(_scenario(), out, outputs=OutputChoice(formats=("csv", "parquet", "aem")))
+    write_report(_scenario(), out, outputs=OutputChoice(formats=("csv", "parquet", "aem")))
     return out
 
 

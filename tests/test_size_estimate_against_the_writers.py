@@ -1,7 +1,7 @@
 """The size estimate of a run (attitude.output_budget) against what the writers write.
 
 The disk check before a run counts the time series' columns from the pointing spec
-(attitude.exports.pointing_column_count); it is compared here with the columns the
+(attitude.csv_files.pointing_column_count); it is compared here with the columns the
 writer actually produces (pointing_columns of real samples) for every shape of spec,
 and the CSV estimate with the size of a CSV written by a run.
 """
@@ -11,10 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from attitude.exports import pointing_column_count, pointing_columns
+from attitude.csv_files import pointing_column_count, pointing_columns
 from attitude.output_formats import OutputChoice
 from attitude.pointing import BodyVector, PointingSpec, pointing_samples
-from attitude.report import produce
+from attitude.report import write_report
 from attitude.run_plan import plan_run
 from attitude.scenario_file import load_scenario
 from attitude.trajectory import propagate
@@ -67,7 +67,7 @@ def test_csv_estimate_covers_the_written_file(tmp_path):
     file = load_scenario(path)
     outputs = OutputChoice(("csv",))
     plan = plan_run(file.scenario, file.pointing, outputs)
-    produce(file.scenario, tmp_path / "out", file.pointing, plan=plan, outputs=outputs)
+    write_report(file.scenario, tmp_path / "out", file.pointing, plan=plan, outputs=outputs)
     written = (tmp_path / "out" / "timeseries.csv").stat().st_size
     estimated = plan.budget.files["timeseries.csv"]
     # An estimate for a disk check: not below what is written, and not far above it.

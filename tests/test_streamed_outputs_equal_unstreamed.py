@@ -18,7 +18,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from attitude.output_formats import OutputChoice
-from attitude.report import output_grid, produce
+from attitude.report import output_grid, write_report
 from attitude.run_plan import plan_run
 from attitude.scenario_file import load_scenario
 
@@ -48,7 +48,7 @@ def runs(tmp_path_factory):
     for chunk in (10**9, 100, 7, 1):
         out = folder / f"chunk-{chunk}"
         plan = plan_run(loaded.scenario, loaded.pointing, outputs)
-        produce(
+        write_report(
             loaded.scenario, out, loaded.pointing, "spinner.toml", plan=plan, chunk_samples=chunk
         )
         made[chunk] = out

@@ -21,8 +21,8 @@ from attitude import (
     Scenario,
     Spacecraft,
     Trajectory,
-    produce,
     propagate,
+    write_report,
 )
 
 
@@ -52,7 +52,7 @@ def describe(scenario: Scenario, trajectory: Trajectory) -> None:
 def main(out_dir: Path) -> dict:
     scenario = build()
     describe(scenario, propagate(scenario))
-    return produce(scenario, out_dir)  # what `attitude run` writes; returns the summary
+    return write_report(scenario, out_dir)  # what `attitude run` writes; returns the summary
 
 
 if __name__ == "__main__":

@@ -1,5 +1,6 @@
-"""The time series of a propagated scenario (its columns, the CSV), intervals.csv and
-the JSON writer (what the summary says is :mod:`attitude.summaries`).
+"""The CSV files of a run: the time series of a propagated scenario (its columns,
+which the Parquet file shares, and the CSV) and intervals.csv (the JSON summary is
+:mod:`attitude.summaries`).
 
 The CSV opens with ``#`` lines that state the epoch and time scale, the frames, the
 units and the quaternion convention; each column's name carries its frame and
@@ -14,8 +15,6 @@ as numpy's ``savetxt`` with ``%.17g`` (``benchmarks/report_outputs.py`` measures
 
 from __future__ import annotations
 
-import json
-import math
 from dataclasses import dataclass, fields
 from pathlib import Path
 from types import TracebackType
@@ -26,10 +25,6 @@ from numpy.typing import NDArray
 
 from attitude.intervals import Interval
 from attitude.pointing import PointingAnalysis, PointingSamples, PointingSpec
-
-# The summaries moved to attitude.summaries; importable from here too, as callers of
-# this module (attitude.montecarlo) import them.
-from attitude.summaries import motion_summary, pointing_summary
 from attitude.trajectory import Trajectory
 
 __all__ = [
@@ -37,17 +32,13 @@ __all__ = [
     "CsvWriter",
     "Samples",
     "arrow_texts",
-    "motion_summary",
     "pointing_column_count",
     "pointing_columns",
-    "pointing_summary",
     "right_ascension_deg",
     "sample",
-    "to_json",
     "trajectory_columns",
     "write_csv",
     "write_intervals_csv",
-    "write_json",
 ]
 
 QUATERNION_CONVENTION = (
@@ -230,27 +221,6 @@ def write_csv(
     """
     with CsvWriter(path, time_label, preamble) as writer:
         writer.write(epochs_iso, columns)
-
-
-def to_json(value: Any) -> Any:
-    """``value`` with numpy arrays and scalars made JSON-serializable (inf/nan as None)."""
-    if isinstance(value, dict):
-        return {str(k): to_json(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [to_json(v) for v in value]
-    if isinstance(value, np.ndarray):
-        return to_json(value.tolist())
-    if isinstance(value, np.generic):
-        return to_json(value.item())
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    return value
-
-
-def write_json(path: Path, data: dict[str, Any]) -> None:
-    path.write_text(
-        json.dumps(to_json(data), indent=2, ensure_ascii=False) + "\n", encoding="utf-8"
-    )
 
 
 def right_ascension_deg(radians: NDArray[np.float64]) -> NDArray[np.float64]:
