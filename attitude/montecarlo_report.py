@@ -308,24 +308,16 @@ def _envelope_panel(axes, t, label: str, name: str, low, high, limit_deg: float 
     """One body vector's panel: the bands between percentiles of the bins' smallest
     (``low``) and largest (``high``) Sun angles, their medians, its exclusion limit."""
     p = {q: i for i, q in enumerate(PERCENTILES)}
-    axes.fill_between(
-        t,
-        low[p[1]],
-        high[p[99]],
-        step="mid",
-        color="C0",
-        alpha=0.2,
-        label="1 % of min to 99 % of max",
-    )
-    axes.fill_between(
-        t,
-        low[p[5]],
-        high[p[95]],
-        step="mid",
-        color="C0",
-        alpha=0.35,
-        label="5 % of min to 95 % of max",
-    )
+    for below, above, alpha in ((1, 99, 0.2), (5, 95, 0.35)):
+        axes.fill_between(
+            t,
+            low[p[below]],
+            high[p[above]],
+            step="mid",
+            color="C0",
+            alpha=alpha,
+            label=f"{below} % of min to {above} % of max",
+        )
     axes.step(t, low[p[50]], where="mid", color="C0", linewidth=1.0, label="median min, max")
     axes.step(t, high[p[50]], where="mid", color="C0", linewidth=1.0)
     if limit_deg is not None:
