@@ -575,41 +575,16 @@ def _group_formulas(
 ) -> list[tuple[np.ndarray, CaseFormula]]:
     """(indices, formula) per case present, from the preferred components ``m`` (N, 3).
 
-    An elliptic state whose rate λ underflows is steady (see ``Steady``): its ``case``,
-    ``flips`` and ``m`` are updated in place, with Steady's flip of m3.  A separatrix
-    state that P maps onto e1 gets the case code iii-e1 (its relabelling).
+    An elliptic state whose rate λ underflows is steady (``_elliptic_groups``): its
+    ``case``, ``flips`` and ``m`` are updated in place.  A separatrix state that P maps
+    onto e1 gets the case code iii-e1 (its relabelling).
     """
-    I1, I2, I3 = moments
-    N = G.shape[0]
-    elliptic = (case == _CODE["i"]) | (case == _CODE["ii"])
-    groups: list[tuple[np.ndarray, CaseFormula]] = []
 
     def constants(k):
-        if k.size == N:  # every state: the arrays themselves, no gather
-            return (I1, I2, I3, m[:, 0], m[:, 1], m[:, 2], G, inv)
-        inv_k = Invariants(None, inv.δ1[k], inv.δ3[k], inv.mc[k], inv.log_mc[k])
-        return (I1[k], I2[k], I3[k], m[k, 0], m[k, 1], m[k, 2], G[k], inv_k)
+        return _constants(k, moments, m, G, inv)
 
     with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
-        # Elliptic, in the two regimes of the kernels; a rate that underflows is steady.
-        for near_one in (False, True):
-            k = np.flatnonzero(elliptic & ((inv.mc < NEAR_ONE_MC) == near_one))
-            if not k.size:
-                continue
-            formula = Elliptic(*constants(k), case[k] == _CODE["ii"], near_one, np)
-            still = formula.λ != 0.0
-            if not np.all(still):
-                lost = k[~still]
-                case[lost] = _CODE["steady"]
-                sign3 = np.where(m[lost, 2] < 0.0, -1.0, 1.0)  # Steady's flip of m3
-                more = np.stack([np.ones_like(sign3), sign3, sign3], axis=-1)
-                flips[lost] *= more
-                m[lost] *= more
-                k = k[still]
-                if k.size:
-                    formula = Elliptic(*constants(k), case[k] == _CODE["ii"], near_one, np)
-            if k.size:
-                groups.append((k, formula))
+        groups = _elliptic_groups(constants, inv.mc, case, flips, m)
         k = np.flatnonzero(case == _CODE["iii"])
         if k.size:
             formula = Separatrix(*constants(k), np)
@@ -621,6 +596,46 @@ def _group_formulas(
         k = np.flatnonzero(case == _CODE["rest"])
         if k.size:
             groups.append((k, Rest()))
+    return groups
+
+
+def _constants(k: np.ndarray, moments, m: np.ndarray, G: np.ndarray, inv: Invariants) -> tuple:
+    """I1, I2, I3, m1, m2, m3, G and the invariants of the states ``k``, as the formulas
+    take them (every state: the arrays themselves, no gather)."""
+    I1, I2, I3 = moments
+    if k.size == G.shape[0]:
+        return (I1, I2, I3, m[:, 0], m[:, 1], m[:, 2], G, inv)
+    inv_k = Invariants(None, inv.δ1[k], inv.δ3[k], inv.mc[k], inv.log_mc[k])
+    return (I1[k], I2[k], I3[k], m[k, 0], m[k, 1], m[k, 2], G[k], inv_k)
+
+
+def _elliptic_groups(
+    constants: Any, mc: np.ndarray, case: np.ndarray, flips: np.ndarray, m: np.ndarray
+) -> list[tuple[np.ndarray, CaseFormula]]:
+    """The elliptic formulas, one per regime of the kernels (mc above or below
+    ``NEAR_ONE_MC``).  A state whose rate λ underflows cannot move (``Steady``): it is
+    made steady, its ``case``, ``flips`` and ``m`` updated in place with Steady's flip
+    of m3, and the formula of the others made again."""
+    groups: list[tuple[np.ndarray, CaseFormula]] = []
+    elliptic = (case == _CODE["i"]) | (case == _CODE["ii"])
+    for near_one in (False, True):
+        k = np.flatnonzero(elliptic & ((mc < NEAR_ONE_MC) == near_one))
+        if not k.size:
+            continue
+        formula = Elliptic(*constants(k), case[k] == _CODE["ii"], near_one, np)
+        still = formula.λ != 0.0
+        if not np.all(still):
+            lost = k[~still]
+            case[lost] = _CODE["steady"]
+            sign3 = np.where(m[lost, 2] < 0.0, -1.0, 1.0)  # Steady's flip of m3
+            more = np.stack([np.ones_like(sign3), sign3, sign3], axis=-1)
+            flips[lost] *= more
+            m[lost] *= more
+            k = k[still]
+            if k.size:
+                formula = Elliptic(*constants(k), case[k] == _CODE["ii"], near_one, np)
+        if k.size:
+            groups.append((k, formula))
     return groups
 
 
