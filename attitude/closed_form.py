@@ -505,101 +505,153 @@ class ManyStates:
     (indices, formula) with one formula per case present (the elliptic cases split by
     the regime of their kernels, mc above or below ``NEAR_ONE_MC``); ``index`` and
     ``sign`` (N, 3) are the signed permutations to each state's P-frame.
+
+    In the steps of the module docstring: sorted (``_sorted_rows``, step 1), each
+    state's case (``_cases``), the preferred flips (``_preferred_flips_per_case``,
+    step 2), the formulas (``_group_formulas``: an elliptic rate that underflows makes
+    the state steady) and the relabelling into the P-frame (``_relabel``, step 3).
     """
 
     def __init__(self, moments: np.ndarray, momentum: np.ndarray) -> None:
-        N = moments.shape[0]
         (I1, I2, I3), (m1, m2, m3), order, odd = _sorted_rows(moments, momentum)
-        sorted_signs = np.ones((N, 3))
+        sorted_signs = np.ones((moments.shape[0], 3))
         sorted_signs[:, 1] = np.where(odd, -1.0, 1.0)
         m2 = sorted_signs[:, 1] * m2
         m = np.stack([m1, m2, m3], axis=-1)
         G = norm(m1, m2, m3, np)
         self.G = G
-        case = np.full(N, _CODE["rest"], dtype=np.int8)
-        sphere = (G > 0.0) & (I1 == I3)
-        general = (G > 0.0) & ~sphere
-        case[sphere] = _CODE["steady"]
-        if general.all():  # the usual batch: no gather
-            inv = invariants(I1, I2, I3, m1, m2, m3, np)
-            case = np.where(
-                inv.sign < 0.0, _CODE["i"], np.where(inv.sign > 0.0, _CODE["ii"], _CODE["iii"])
-            ).astype(np.int8)
-            mc, log_mc, δ1, δ3 = inv.mc, inv.log_mc, inv.δ1, inv.δ3
-        else:
-            g = np.flatnonzero(general)
-            mc = np.full(N, np.nan)
-            log_mc = np.full(N, np.nan)
-            δ1 = np.zeros(N)
-            δ3 = np.zeros(N)
-            if g.size:
-                inv = invariants(I1[g], I2[g], I3[g], m1[g], m2[g], m3[g], np)
-                case[g] = np.where(
-                    inv.sign < 0.0, _CODE["i"], np.where(inv.sign > 0.0, _CODE["ii"], _CODE["iii"])
-                )
-                mc[g], log_mc[g], δ1[g], δ3[g] = inv.mc, inv.log_mc, inv.δ1, inv.δ3
-        elliptic = (case == _CODE["i"]) | (case == _CODE["ii"])
-        flip1 = (m1 < 0.0) & ((case == _CODE["i"]) | (case == _CODE["iii"]))
-        flip3 = (m3 < 0.0) & ((case == _CODE["ii"]) | (case == _CODE["iii"]))
-        flip3 |= (m3 < 0.0) & (case == _CODE["steady"])
-        flips = np.stack(preferred_flips(flip1, flip3, np), axis=-1)
+        case, inv = _cases(I1, I2, I3, m1, m2, m3, G)
+        flips = _preferred_flips_per_case(case, m1, m3)
         m = flips * m
-        self.groups: list[tuple[np.ndarray, CaseFormula]] = []
+        self.groups = _group_formulas((I1, I2, I3), m, G, inv, case, flips)
+        self.index, self.sign = _relabel(case, order, flips, sorted_signs)
 
-        def constants(k):
-            if k.size == N:  # every state: the arrays themselves, no gather
-                return (
-                    I1,
-                    I2,
-                    I3,
-                    m[:, 0],
-                    m[:, 1],
-                    m[:, 2],
-                    G,
-                    Invariants(None, δ1, δ3, mc, log_mc),
-                )
-            inv_k = Invariants(None, δ1[k], δ3[k], mc[k], log_mc[k])
-            return (I1[k], I2[k], I3[k], m[k, 0], m[k, 1], m[k, 2], G[k], inv_k)
 
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
-            # Elliptic, in the two regimes of the kernels; a rate that underflows is steady.
-            for near_one in (False, True):
-                k = np.flatnonzero(elliptic & ((mc < NEAR_ONE_MC) == near_one))
-                if not k.size:
-                    continue
-                formula = Elliptic(*constants(k), case[k] == _CODE["ii"], near_one, np)
-                still = formula.λ != 0.0
-                if not np.all(still):
-                    lost = k[~still]
-                    case[lost] = _CODE["steady"]
-                    sign3 = np.where(m[lost, 2] < 0.0, -1.0, 1.0)  # Steady's flip of m3
-                    more = np.stack([np.ones_like(sign3), sign3, sign3], axis=-1)
-                    flips[lost] *= more
-                    m[lost] *= more
-                    k = k[still]
-                    if k.size:
-                        formula = Elliptic(*constants(k), case[k] == _CODE["ii"], near_one, np)
-                if k.size:
-                    self.groups.append((k, formula))
-            k = np.flatnonzero(case == _CODE["iii"])
-            if k.size:
-                formula = Separatrix(*constants(k), np)
-                case[k[formula.onto_e1]] = _CODE["iii-e1"]
-                self.groups.append((k, formula))
-            k = np.flatnonzero(case == _CODE["steady"])
-            if k.size:
-                self.groups.append((k, Steady(*constants(k)[:7], np)))
-            k = np.flatnonzero(case == _CODE["rest"])
-            if k.size:
-                self.groups.append((k, Rest()))
-        # P[k] = r_sign[k] f[r_index[k]] s[r_index[k]] principal[order[r_index[k]]].
-        r_index = _RELABEL_INDEX[case]
-        self.index = np.take_along_axis(order, r_index, axis=1)
-        self.sign = (
-            _RELABEL_SIGN[case]
-            * np.take_along_axis(flips, r_index, axis=1)
-            * np.take_along_axis(sorted_signs, r_index, axis=1)
+def _cases(I1: Any, I2: Any, I3: Any, m1: Any, m2: Any, m3: Any, G: Any):
+    """Each state's case code (``_CODE``: rest for G = 0, steady for the sphere I1 = I3,
+    else i, ii or iii by the sign of Δ2) and its invariants δ1, δ3, mc, log mc (zeros and
+    NaNs where the case has none; ``sign`` left out)."""
+    N = G.shape[0]
+    case = np.full(N, _CODE["rest"], dtype=np.int8)
+    sphere = (G > 0.0) & (I1 == I3)
+    general = (G > 0.0) & ~sphere
+    case[sphere] = _CODE["steady"]
+    if general.all():  # the usual batch: no gather
+        inv = invariants(I1, I2, I3, m1, m2, m3, np)
+        case = np.where(
+            inv.sign < 0.0, _CODE["i"], np.where(inv.sign > 0.0, _CODE["ii"], _CODE["iii"])
+        ).astype(np.int8)
+        return case, Invariants(None, inv.δ1, inv.δ3, inv.mc, inv.log_mc)
+    g = np.flatnonzero(general)
+    mc = np.full(N, np.nan)
+    log_mc = np.full(N, np.nan)
+    δ1 = np.zeros(N)
+    δ3 = np.zeros(N)
+    if g.size:
+        inv = invariants(I1[g], I2[g], I3[g], m1[g], m2[g], m3[g], np)
+        case[g] = np.where(
+            inv.sign < 0.0, _CODE["i"], np.where(inv.sign > 0.0, _CODE["ii"], _CODE["iii"])
         )
+        mc[g], log_mc[g], δ1[g], δ3[g] = inv.mc, inv.log_mc, inv.δ1, inv.δ3
+    return case, Invariants(None, δ1, δ3, mc, log_mc)
+
+
+def _preferred_flips_per_case(case: np.ndarray, m1: np.ndarray, m3: np.ndarray) -> np.ndarray:
+    """(N, 3) axis signs of step 2: the component carrying dn (m1 in case i, m3 in case
+    ii), both sech components on the separatrix, and m3 of a steady state made ≥ 0."""
+    flip1 = (m1 < 0.0) & ((case == _CODE["i"]) | (case == _CODE["iii"]))
+    flip3 = (m3 < 0.0) & ((case == _CODE["ii"]) | (case == _CODE["iii"]))
+    flip3 |= (m3 < 0.0) & (case == _CODE["steady"])
+    return np.stack(preferred_flips(flip1, flip3, np), axis=-1)
+
+
+def _group_formulas(
+    moments: tuple[np.ndarray, np.ndarray, np.ndarray],
+    m: np.ndarray,
+    G: np.ndarray,
+    inv: Invariants,
+    case: np.ndarray,
+    flips: np.ndarray,
+) -> list[tuple[np.ndarray, CaseFormula]]:
+    """(indices, formula) per case present, from the preferred components ``m`` (N, 3).
+
+    An elliptic state whose rate λ underflows is steady (``_elliptic_groups``): its
+    ``case``, ``flips`` and ``m`` are updated in place.  A separatrix state that P maps
+    onto e1 gets the case code iii-e1 (its relabelling).
+    """
+
+    def constants(k):
+        return _constants(k, moments, m, G, inv)
+
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+        groups = _elliptic_groups(constants, inv.mc, case, flips, m)
+        k = np.flatnonzero(case == _CODE["iii"])
+        if k.size:
+            formula = Separatrix(*constants(k), np)
+            case[k[formula.onto_e1]] = _CODE["iii-e1"]
+            groups.append((k, formula))
+        k = np.flatnonzero(case == _CODE["steady"])
+        if k.size:
+            groups.append((k, Steady(*constants(k)[:7], np)))
+        k = np.flatnonzero(case == _CODE["rest"])
+        if k.size:
+            groups.append((k, Rest()))
+    return groups
+
+
+def _constants(k: np.ndarray, moments, m: np.ndarray, G: np.ndarray, inv: Invariants) -> tuple:
+    """I1, I2, I3, m1, m2, m3, G and the invariants of the states ``k``, as the formulas
+    take them (every state: the arrays themselves, no gather)."""
+    I1, I2, I3 = moments
+    if k.size == G.shape[0]:
+        return (I1, I2, I3, m[:, 0], m[:, 1], m[:, 2], G, inv)
+    inv_k = Invariants(None, inv.δ1[k], inv.δ3[k], inv.mc[k], inv.log_mc[k])
+    return (I1[k], I2[k], I3[k], m[k, 0], m[k, 1], m[k, 2], G[k], inv_k)
+
+
+def _elliptic_groups(
+    constants: Any, mc: np.ndarray, case: np.ndarray, flips: np.ndarray, m: np.ndarray
+) -> list[tuple[np.ndarray, CaseFormula]]:
+    """The elliptic formulas, one per regime of the kernels (mc above or below
+    ``NEAR_ONE_MC``).  A state whose rate λ underflows cannot move (``Steady``): it is
+    made steady, its ``case``, ``flips`` and ``m`` updated in place with Steady's flip
+    of m3, and the formula of the others made again."""
+    groups: list[tuple[np.ndarray, CaseFormula]] = []
+    elliptic = (case == _CODE["i"]) | (case == _CODE["ii"])
+    for near_one in (False, True):
+        k = np.flatnonzero(elliptic & ((mc < NEAR_ONE_MC) == near_one))
+        if not k.size:
+            continue
+        formula = Elliptic(*constants(k), case[k] == _CODE["ii"], near_one, np)
+        still = formula.λ != 0.0
+        if not np.all(still):
+            lost = k[~still]
+            case[lost] = _CODE["steady"]
+            sign3 = np.where(m[lost, 2] < 0.0, -1.0, 1.0)  # Steady's flip of m3
+            more = np.stack([np.ones_like(sign3), sign3, sign3], axis=-1)
+            flips[lost] *= more
+            m[lost] *= more
+            k = k[still]
+            if k.size:
+                formula = Elliptic(*constants(k), case[k] == _CODE["ii"], near_one, np)
+        if k.size:
+            groups.append((k, formula))
+    return groups
+
+
+def _relabel(
+    case: np.ndarray, order: np.ndarray, flips: np.ndarray, sorted_signs: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """Step 3: the signed permutations (N, 3) to each state's P-frame,
+    P[k] = r_sign[k] f[r_index[k]] s[r_index[k]] principal[order[r_index[k]]]."""
+    r_index = _RELABEL_INDEX[case]
+    index = np.take_along_axis(order, r_index, axis=1)
+    sign = (
+        _RELABEL_SIGN[case]
+        * np.take_along_axis(flips, r_index, axis=1)
+        * np.take_along_axis(sorted_signs, r_index, axis=1)
+    )
+    return index, sign
 
 
 def _sorted_rows(moments: np.ndarray, momentum: np.ndarray):

@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from attitude.intervals import Interval
-from attitude.pointing import PointingAnalysis, PointingSamples, PointingSpec
+from attitude.pointing import PointingAnalysis, PointingSamples, PointingSpec, VectorSamples
 from attitude.trajectory import Trajectory
 
 __all__ = [
@@ -263,7 +263,16 @@ def pointing_column_count(spec: PointingSpec) -> int:
 
 def pointing_columns(samples: PointingSamples) -> list[Column]:
     """The pointing columns of the time series, at the samples' times (any chunk of
-    the output grid: the columns of consecutive chunks follow on)."""
+    the output grid: the columns of consecutive chunks follow on): the Sun and, on an
+    orbit, the Earth; the attitude in LVLH; then each body vector's columns."""
+    columns = _sun_and_earth_columns(samples) + _lvlh_columns(samples)
+    for item in samples.vectors:
+        columns += _vector_columns(item)
+    return columns
+
+
+def _sun_and_earth_columns(samples: PointingSamples) -> list[Column]:
+    """The Sun's direction; on an orbit, its visible fraction and the Earth's angular radius."""
     columns = _components(
         "sun_icrf_{}",
         samples.sun_direction_icrf,
@@ -279,6 +288,12 @@ def pointing_columns(samples: PointingSamples) -> list[Column]:
             samples.earth_angular_radius_rad,
             "angular radius of the Earth (equatorial sphere) seen from the spacecraft, deg",
         )
+    return columns
+
+
+def _lvlh_columns(samples: PointingSamples) -> list[Column]:
+    """The attitude in the orbit's LVLH frame: its quaternion, its Euler angles if asked."""
+    columns: list[Column] = []
     if samples.q_body_to_lvlh is not None:
         columns += _components(
             "q_body_to_lvlh_{}",
@@ -299,52 +314,57 @@ def pointing_columns(samples: PointingSamples) -> list[Column]:
             )
             for k in range(3)
         ]
-    for item in samples.vectors:
-        name = item.vector.name
-        columns += _degrees(f"{name}_sun_angle_deg", item.sun_angle_rad, f"angle {name}-Sun, deg")
-        columns.append(
-            Column(
-                f"{name}_cos_incidence",
-                item.cos_incidence,
-                f"cosine of Sun incidence on {name} (0 if behind or in umbra, × visible fraction)",
-            )
+    return columns
+
+
+def _vector_columns(item: VectorSamples) -> list[Column]:
+    """A body vector's Sun and Moon angles, incidence, right ascension and declination,
+    on an orbit its nadir and limb angles, and a flag per constraint."""
+    name = item.vector.name
+    columns = _degrees(f"{name}_sun_angle_deg", item.sun_angle_rad, f"angle {name}-Sun, deg")
+    columns.append(
+        Column(
+            f"{name}_cos_incidence",
+            item.cos_incidence,
+            f"cosine of Sun incidence on {name} (0 if behind or in umbra, × visible fraction)",
         )
-        columns += _flag(
-            f"{name}_sun_exclusion_violated",
-            item.sun_violated,
-            f"1 if the Sun is inside {name}'s exclusion cone (and not in umbra)",
+    )
+    columns += _flag(
+        f"{name}_sun_exclusion_violated",
+        item.sun_violated,
+        f"1 if the Sun is inside {name}'s exclusion cone (and not in umbra)",
+    )
+    columns += _degrees(
+        f"{name}_moon_angle_deg", item.moon_angle_rad, f"angle {name}-Moon (apparent), deg"
+    )
+    columns += _flag(
+        f"{name}_moon_exclusion_violated",
+        item.moon_violated,
+        f"1 if the Moon is inside {name}'s exclusion cone (and not behind the Earth)",
+    )
+    columns.append(
+        Column(
+            f"{name}_ra_deg",
+            right_ascension_deg(item.right_ascension_rad),
+            f"{name} right ascension, deg",
         )
-        columns += _degrees(
-            f"{name}_moon_angle_deg", item.moon_angle_rad, f"angle {name}-Moon (apparent), deg"
-        )
-        columns += _flag(
-            f"{name}_moon_exclusion_violated",
-            item.moon_violated,
-            f"1 if the Moon is inside {name}'s exclusion cone (and not behind the Earth)",
-        )
-        columns.append(
-            Column(
-                f"{name}_ra_deg",
-                right_ascension_deg(item.right_ascension_rad),
-                f"{name} right ascension, deg",
-            )
-        )
-        columns += _degrees(f"{name}_dec_deg", item.declination_rad, f"{name} declination, deg")
-        columns += _degrees(
-            f"{name}_nadir_angle_deg",
-            item.nadir_angle_rad,
-            f"angle between {name} and nadir (the Earth's centre), deg",
-        )
-        columns += _degrees(
-            f"{name}_earth_limb_angle_deg",
-            item.earth_limb_angle_rad,
-            f"angle of {name} above the Earth's limb (negative: towards the Earth), deg",
-        )
-        columns += _flag(
-            f"{name}_earth_limb_exclusion_violated",
-            item.earth_limb_violated,
-            f"1 if {name} is less than its exclusion angle above the Earth's limb",
-        )
+    )
+    columns += _degrees(f"{name}_dec_deg", item.declination_rad, f"{name} declination, deg")
+    columns += _degrees(
+        f"{name}_nadir_angle_deg",
+        item.nadir_angle_rad,
+        f"angle between {name} and nadir (the Earth's centre), deg",
+    )
+    columns += _degrees(
+        f"{name}_earth_limb_angle_deg",
+        item.earth_limb_angle_rad,
+        f"angle of {name} above the Earth's limb (negative: towards the Earth), deg",
+    )
+    columns += _flag(
+        f"{name}_earth_limb_exclusion_violated",
+        item.earth_limb_violated,
+        f"1 if {name} is less than its exclusion angle above the Earth's limb",
+    )
     return columns
 
 

@@ -323,61 +323,12 @@ def read_dispersions(
             "count and what to disperse (docs/scenarios.md)"
         )
     table.allow("seed", "samples", "spacecraft", "initial_state", "events", "pointing")
-    seed = _integer(table, "seed", 0, 2**63 - 1) if seed is None else seed
-    samples = _integer(table, "samples", 1, MAX_SAMPLES) if samples is None else samples
-    if not (isinstance(seed, int) and seed >= 0):
-        raise ScenarioFileError(f"--seed: expected a whole number ≥ 0, got {seed!r}")
-    if not (isinstance(samples, int) and 1 <= samples <= MAX_SAMPLES):
-        raise ScenarioFileError(f"--samples: expected 1 to {MAX_SAMPLES:,}, got {samples!r}")
-
-    scenario = loaded.scenario
-    axes = scenario.spacecraft.principal_axes
-    nominal: dict[str, Any] = {
-        "moments": axes.moments,
-        "body_to_principal": axes.body_to_principal.as_matrix(),
-        "tensor_given": "inertia_tensor" in loaded.document.get("spacecraft", {}),
-        "attitude": scenario.initial_state.attitude,
-    }
-    if loaded.document.get("initial_state", {}).get("frame", "icrf") != "icrf":
-        # The attitude in the orbit frame the file gives it in (the reader refuses a
-        # frame with an AEM file, so it is a quaternion or a matrix).
-        nominal["attitude"] = _attitude(root.table("initial_state"))
-    moments = axes_rotation = attitude = rate = None
-    rate_key = "angular_velocity"
-    craft = table.table("spacecraft", required=False)
-    if craft is not None:
-        craft.allow("principal_moments", "principal_axes")
-        moments = _distribution(craft, "principal_moments", "", relative=True, per_component=True)
-        axes_rotation = _distribution(craft, "principal_axes", "angle", isotropic=True)
-        if moments is not None and violates_triangle_inequality(axes.moments):
-            craft.fail(
-                f"the nominal moments {axes.moments.tolist()} kg m² break the triangle "
-                "inequality: no body near them is physical",
-                "principal_moments",
-            )
-    initial = table.table("initial_state", required=False)
-    if initial is not None:
-        initial.allow("attitude", "angular_velocity", "angular_momentum")
-        attitude = _distribution(initial, "attitude", "angle", isotropic=True)
-        state = scenario.initial_state
-        for key in ("angular_velocity", "angular_momentum"):
-            if not initial.has(key):
-                continue
-            if getattr(state, key) is None:
-                other = "angular_momentum" if key == "angular_velocity" else "angular_velocity"
-                initial.fail(f"the initial state gives {other}: disperse that instead", key)
-            rate = _distribution(initial, key, key, per_component=True)
-            rate_key = key
-            nominal["rate"] = getattr(state, key)
+    seed, samples = _seed_and_samples(table, seed, samples)
+    nominal = _nominal_values(loaded, root)
+    moments, axes_rotation = _spacecraft_dispersions(table, loaded)
+    attitude, rate, rate_key = _initial_state_dispersions(table, loaded, nominal)
     events = _event_dispersions(table, loaded, nominal)
-    tle_epoch = None
-    pointing = table.table("pointing", required=False)
-    if pointing is not None:
-        pointing.allow("tle_epoch")
-        tle_epoch = _distribution(pointing, "tle_epoch", "time")
-        if tle_epoch is not None and loaded.pointing.tle is None:
-            pointing.fail("the scenario has no [pointing] tle to disperse", "tle_epoch")
-        nominal["tle"] = loaded.pointing.tle
+    tle_epoch = _pointing_dispersions(table, loaded, nominal)
     return Dispersions(
         seed,
         samples,
@@ -390,6 +341,94 @@ def read_dispersions(
         tle_epoch,
         nominal,
     )
+
+
+def _seed_and_samples(table: Table, seed: int | None, samples: int | None) -> tuple[int, int]:
+    """The seed and the sample count: the command line's if given, else the table's."""
+    seed = _integer(table, "seed", 0, 2**63 - 1) if seed is None else seed
+    samples = _integer(table, "samples", 1, MAX_SAMPLES) if samples is None else samples
+    if not (isinstance(seed, int) and seed >= 0):
+        raise ScenarioFileError(f"--seed: expected a whole number ≥ 0, got {seed!r}")
+    if not (isinstance(samples, int) and 1 <= samples <= MAX_SAMPLES):
+        raise ScenarioFileError(f"--samples: expected 1 to {MAX_SAMPLES:,}, got {samples!r}")
+    return seed, samples
+
+
+def _nominal_values(loaded: ScenarioFile, root: Table) -> dict[str, Any]:
+    """The nominal inertia and attitude the draws start from, SI, as the reader computed
+    them (the rate, the events and the TLE are added where they are dispersed)."""
+    axes = loaded.scenario.spacecraft.principal_axes
+    nominal: dict[str, Any] = {
+        "moments": axes.moments,
+        "body_to_principal": axes.body_to_principal.as_matrix(),
+        "tensor_given": "inertia_tensor" in loaded.document.get("spacecraft", {}),
+        "attitude": loaded.scenario.initial_state.attitude,
+    }
+    if loaded.document.get("initial_state", {}).get("frame", "icrf") != "icrf":
+        # The attitude in the orbit frame the file gives it in (the reader refuses a
+        # frame with an AEM file, so it is a quaternion or a matrix).
+        nominal["attitude"] = _attitude(root.table("initial_state"))
+    return nominal
+
+
+def _spacecraft_dispersions(
+    table: Table, loaded: ScenarioFile
+) -> tuple[Distribution | None, Distribution | None]:
+    """``[dispersions.spacecraft]``: the moments' and the principal axes' distributions."""
+    craft = table.table("spacecraft", required=False)
+    if craft is None:
+        return None, None
+    craft.allow("principal_moments", "principal_axes")
+    moments = _distribution(craft, "principal_moments", "", relative=True, per_component=True)
+    axes_rotation = _distribution(craft, "principal_axes", "angle", isotropic=True)
+    nominal_moments = loaded.scenario.spacecraft.principal_axes.moments
+    if moments is not None and violates_triangle_inequality(nominal_moments):
+        craft.fail(
+            f"the nominal moments {nominal_moments.tolist()} kg m² break the triangle "
+            "inequality: no body near them is physical",
+            "principal_moments",
+        )
+    return moments, axes_rotation
+
+
+def _initial_state_dispersions(
+    table: Table, loaded: ScenarioFile, nominal: dict[str, Any]
+) -> tuple[Distribution | None, Distribution | None, str]:
+    """``[dispersions.initial_state]``: the attitude's and the rate's distributions, and
+    the rate's key (the one the initial state gives)."""
+    attitude = rate = None
+    rate_key = "angular_velocity"
+    initial = table.table("initial_state", required=False)
+    if initial is None:
+        return attitude, rate, rate_key
+    initial.allow("attitude", "angular_velocity", "angular_momentum")
+    attitude = _distribution(initial, "attitude", "angle", isotropic=True)
+    state = loaded.scenario.initial_state
+    for key in ("angular_velocity", "angular_momentum"):
+        if not initial.has(key):
+            continue
+        if getattr(state, key) is None:
+            other = "angular_momentum" if key == "angular_velocity" else "angular_velocity"
+            initial.fail(f"the initial state gives {other}: disperse that instead", key)
+        rate = _distribution(initial, key, key, per_component=True)
+        rate_key = key
+        nominal["rate"] = getattr(state, key)
+    return attitude, rate, rate_key
+
+
+def _pointing_dispersions(
+    table: Table, loaded: ScenarioFile, nominal: dict[str, Any]
+) -> Distribution | None:
+    """``[dispersions.pointing]``: the TLE epoch's distribution."""
+    pointing = table.table("pointing", required=False)
+    if pointing is None:
+        return None
+    pointing.allow("tle_epoch")
+    tle_epoch = _distribution(pointing, "tle_epoch", "time")
+    if tle_epoch is not None and loaded.pointing.tle is None:
+        pointing.fail("the scenario has no [pointing] tle to disperse", "tle_epoch")
+    nominal["tle"] = loaded.pointing.tle
+    return tle_epoch
 
 
 def _event_dispersions(
@@ -451,67 +490,95 @@ def _floats(values: Any) -> Any:
     return np.asarray(values, dtype=float).tolist()
 
 
-def draw_sample(dispersions: Dispersions, document: dict[str, Any], index: int) -> Sample:
-    """Sample ``index``: the nominal ``document`` with its dispersed keys drawn."""
-    d = dispersions
-    nominal = d.nominal
-    # A copy of each table this sample changes (their values are replaced, never
-    # changed in place): the nominal document stays as read.
+def _copy_for_sample(document: dict[str, Any]) -> dict[str, Any]:
+    """A copy of each table a sample changes (their values are replaced, never changed
+    in place): the nominal document stays as read.  The ``[dispersions]`` table is left out."""
     doc = {key: value for key, value in document.items() if key != "dispersions"}
     for key in ("spacecraft", "initial_state", "pointing"):
         if key in doc:
             doc[key] = dict(doc[key])
     if "events" in doc:
         doc["events"] = [dict(event) for event in doc["events"]]
+    return doc
+
+
+def _record(parameters: dict[str, float], name: str, values: Any) -> None:
+    """One column for a scalar; one per axis (``name`` formatted with x, y, z) for a vector."""
+    values = np.atleast_1d(np.asarray(values, dtype=float))
+    if values.size == 1:
+        parameters[name] = float(values[0])
+        return
+    for c, value in zip(_AXES, values, strict=True):
+        parameters[name.format(c)] = float(value)
+
+
+def draw_sample(dispersions: Dispersions, document: dict[str, Any], index: int) -> Sample:
+    """Sample ``index``: the nominal ``document`` with its dispersed keys drawn."""
+    doc = _copy_for_sample(document)
     parameters: dict[str, float] = {}
     error = None
+    if dispersions.moments is not None or dispersions.axes is not None:
+        error = _draw_inertia(dispersions, index, doc["spacecraft"], parameters)
+    _draw_initial_state(dispersions, index, doc["initial_state"], parameters)
+    for item in dispersions.events:
+        event_error = _draw_event(dispersions, index, item, doc["events"][item.index], parameters)
+        error = error or event_error
+    if dispersions.tle_epoch is not None:
+        _draw_tle_epoch(dispersions, index, doc["pointing"], parameters)
+    return Sample(index, parameters, doc, error)
 
-    def record(name: str, values: Any) -> None:
-        values = np.atleast_1d(np.asarray(values, dtype=float))
-        if values.size == 1:
-            parameters[name] = float(values[0])
-            return
-        for c, value in zip(_AXES, values, strict=True):
-            parameters[name.format(c)] = float(value)
 
-    if d.moments is not None or d.axes is not None:
-        moments = nominal["moments"]
-        if d.moments is not None:
-            rng = _generator(d.seed, index, "spacecraft.principal_moments")
-            for draws in range(1, MAX_DRAWS + 1):  # noqa: B007 (the count is recorded)
-                ε = d.moments.components(rng, 3)
-                moments = nominal["moments"] * (1.0 + ε)
-                if _physical(moments):
-                    break
-            else:
-                error = (
-                    f"spacecraft.principal_moments: no physical draw in {MAX_DRAWS} tries "
-                    f"(last {moments.tolist()} kg m²)"
-                )
-        craft = doc["spacecraft"]
-        for i, value in enumerate(moments, start=1):
-            parameters[f"spacecraft.moment_{i}_kg_m2"] = float(value)
-        if d.moments is not None:
-            for i, value in enumerate(ε, start=1):
-                parameters[f"spacecraft.moment_{i}_relative_error"] = float(value)
-            parameters["spacecraft.inertia_draws"] = float(draws)
-        if d.axes is not None or nominal["tensor_given"]:
-            turn = np.eye(3)
-            if d.axes is not None:
-                δ = d.axes.isotropic(_generator(d.seed, index, "spacecraft.principal_axes"), 3)
-                record("spacecraft.axes_rotation_{}_deg", np.degrees(δ))
-                turn = Rotation.from_rotvec(δ).as_matrix()
-            v = nominal["body_to_principal"]  # principal = V body
-            tensor = turn @ v.T @ np.diag(moments) @ v @ turn.T
-            craft.pop("principal_moments", None)
-            craft["inertia_tensor"] = _floats(0.5 * (tensor + tensor.T))
+def _draw_inertia(
+    d: Dispersions, index: int, craft: dict[str, Any], parameters: dict[str, float]
+) -> str | None:
+    """The moments I' = I (1 + ε), drawn again until physical, and the axes turned by E:
+    T' = E Vᵀ diag(I') V Eᵀ (module doc), written to ``craft``; the error if no draw
+    of the moments was physical."""
+    nominal = d.nominal
+    moments = nominal["moments"]
+    error = None
+    if d.moments is not None:
+        rng = _generator(d.seed, index, "spacecraft.principal_moments")
+        for draws in range(1, MAX_DRAWS + 1):  # noqa: B007 (the count is recorded)
+            ε = d.moments.components(rng, 3)
+            moments = nominal["moments"] * (1.0 + ε)
+            if _physical(moments):
+                break
         else:
-            craft["principal_moments"] = _floats(moments)
+            error = (
+                f"spacecraft.principal_moments: no physical draw in {MAX_DRAWS} tries "
+                f"(last {moments.tolist()} kg m²)"
+            )
+    for i, value in enumerate(moments, start=1):
+        parameters[f"spacecraft.moment_{i}_kg_m2"] = float(value)
+    if d.moments is not None:
+        for i, value in enumerate(ε, start=1):
+            parameters[f"spacecraft.moment_{i}_relative_error"] = float(value)
+        parameters["spacecraft.inertia_draws"] = float(draws)
+    if d.axes is not None or nominal["tensor_given"]:
+        turn = np.eye(3)
+        if d.axes is not None:
+            δ = d.axes.isotropic(_generator(d.seed, index, "spacecraft.principal_axes"), 3)
+            _record(parameters, "spacecraft.axes_rotation_{}_deg", np.degrees(δ))
+            turn = Rotation.from_rotvec(δ).as_matrix()
+        v = nominal["body_to_principal"]  # principal = V body
+        tensor = turn @ v.T @ np.diag(moments) @ v @ turn.T
+        craft.pop("principal_moments", None)
+        craft["inertia_tensor"] = _floats(0.5 * (tensor + tensor.T))
+    else:
+        craft["principal_moments"] = _floats(moments)
+    return error
 
-    state = doc["initial_state"]
+
+def _draw_initial_state(
+    d: Dispersions, index: int, state: dict[str, Any], parameters: dict[str, float]
+) -> None:
+    """The attitude R' = R exp(δ) in the file's frame, and the rate plus its deviation,
+    written to ``state``."""
+    nominal = d.nominal
     if d.attitude is not None:
         δ = d.attitude.isotropic(_generator(d.seed, index, "initial_state.attitude"), 3)
-        record("initial_state.attitude_error_{}_deg", np.degrees(δ))
+        _record(parameters, "initial_state.attitude_error_{}_deg", np.degrees(δ))
         parameters["initial_state.attitude_error_deg"] = math.degrees(float(np.linalg.norm(δ)))
         attitude = nominal["attitude"] * Rotation.from_rotvec(δ)  # in the file's frame
         state.pop("matrix", None)
@@ -522,51 +589,65 @@ def draw_sample(dispersions: Dispersions, document: dict[str, Any], index: int) 
         deviation = d.rate.components(_generator(d.seed, index, f"initial_state.{key}"), 3)
         rate = nominal["rate"] + deviation
         unit = _RATE_UNITS[key]
-        record(f"initial_state.{key}_{{}}_{unit}", rate)
-        record(f"initial_state.{key}_error_{{}}_{unit}", deviation)
+        _record(parameters, f"initial_state.{key}_{{}}_{unit}", rate)
+        _record(parameters, f"initial_state.{key}_error_{{}}_{unit}", deviation)
         state[key] = _floats(rate)
 
-    for item in d.events:
-        key = f"events[{item.index}]"
-        event = doc["events"][item.index]
-        values = nominal[key]
-        if item.time is not None:
-            shift = float(item.time.components(_generator(d.seed, index, f"{key}.time"), 1)[0])
-            event.pop("epoch", None)
-            event["offset"] = values["offset"] + shift
-            parameters[f"{key}.offset_s"] = event["offset"]
-            parameters[f"{key}.time_shift_s"] = shift
-        if item.magnitude is None and item.direction is None:
-            continue
-        impulse, ε, draws, tilt = values["impulse"], None, None, None
-        if item.magnitude is not None:
-            rng = _generator(d.seed, index, f"{key}.impulse_magnitude")
-            for draws in range(1, MAX_DRAWS + 1):  # noqa: B007 (the count is recorded)
-                ε = float(item.magnitude.components(rng, 1)[0])
-                if 1.0 + ε > 0.0:
-                    break
-            else:
-                error = error or f"{key}.impulse_magnitude: no positive draw in {MAX_DRAWS} tries"
-            impulse = impulse * (1.0 + ε)
-        if item.direction is not None:
-            rng = _generator(d.seed, index, f"{key}.impulse_direction")
-            tilt = item.direction.isotropic(rng, 2)
-            e1, e2 = basis_across(values["impulse"] / np.linalg.norm(values["impulse"]))
-            impulse = Rotation.from_rotvec(tilt[0] * e1 + tilt[1] * e2).apply(impulse)
-        record(f"{key}.impulse_{{}}_N_m_s", impulse)
-        if ε is not None:
-            parameters[f"{key}.impulse_relative_error"] = ε
-            parameters[f"{key}.impulse_draws"] = float(draws)
-        if tilt is not None:
-            parameters[f"{key}.impulse_tilt_deg"] = math.degrees(float(np.linalg.norm(tilt)))
-        event["impulse"] = _floats(impulse)
 
-    if d.tle_epoch is not None:
-        shift = float(d.tle_epoch.components(_generator(d.seed, index, "pointing.tle_epoch"), 1)[0])
-        line1, applied = shifted_tle_epoch(nominal["tle"][0], shift)
-        doc["pointing"]["tle"] = [line1, nominal["tle"][1]]
-        parameters["pointing.tle_epoch_shift_s"] = applied
-    return Sample(index, parameters, doc, error)
+def _draw_event(
+    d: Dispersions,
+    index: int,
+    item: EventDispersion,
+    event: dict[str, Any],
+    parameters: dict[str, float],
+) -> str | None:
+    """``events[item.index]``: its time shifted, its impulse scaled by 1 + ε (drawn again
+    until positive) and tilted by θ across its direction, n' = exp(θ) n, written to
+    ``event``; the error if no draw of the magnitude was positive."""
+    key = f"events[{item.index}]"
+    values = d.nominal[key]
+    if item.time is not None:
+        shift = float(item.time.components(_generator(d.seed, index, f"{key}.time"), 1)[0])
+        event.pop("epoch", None)
+        event["offset"] = values["offset"] + shift
+        parameters[f"{key}.offset_s"] = event["offset"]
+        parameters[f"{key}.time_shift_s"] = shift
+    if item.magnitude is None and item.direction is None:
+        return None
+    impulse, ε, draws, tilt, error = values["impulse"], None, None, None, None
+    if item.magnitude is not None:
+        rng = _generator(d.seed, index, f"{key}.impulse_magnitude")
+        for draws in range(1, MAX_DRAWS + 1):  # noqa: B007 (the count is recorded)
+            ε = float(item.magnitude.components(rng, 1)[0])
+            if 1.0 + ε > 0.0:
+                break
+        else:
+            error = f"{key}.impulse_magnitude: no positive draw in {MAX_DRAWS} tries"
+        impulse = impulse * (1.0 + ε)
+    if item.direction is not None:
+        rng = _generator(d.seed, index, f"{key}.impulse_direction")
+        tilt = item.direction.isotropic(rng, 2)
+        e1, e2 = basis_across(values["impulse"] / np.linalg.norm(values["impulse"]))
+        impulse = Rotation.from_rotvec(tilt[0] * e1 + tilt[1] * e2).apply(impulse)
+    _record(parameters, f"{key}.impulse_{{}}_N_m_s", impulse)
+    if ε is not None:
+        parameters[f"{key}.impulse_relative_error"] = ε
+        parameters[f"{key}.impulse_draws"] = float(draws)
+    if tilt is not None:
+        parameters[f"{key}.impulse_tilt_deg"] = math.degrees(float(np.linalg.norm(tilt)))
+    event["impulse"] = _floats(impulse)
+    return error
+
+
+def _draw_tle_epoch(
+    d: Dispersions, index: int, pointing: dict[str, Any], parameters: dict[str, float]
+) -> None:
+    """The TLE epoch moved by s seconds (rounded to the 1e-8 day the line writes)."""
+    shift = float(d.tle_epoch.components(_generator(d.seed, index, "pointing.tle_epoch"), 1)[0])
+    tle = d.nominal["tle"]
+    line1, applied = shifted_tle_epoch(tle[0], shift)
+    pointing["tle"] = [line1, tle[1]]
+    parameters["pointing.tle_epoch_shift_s"] = applied
 
 
 def _physical(moments: NDArray[np.float64]) -> bool:

@@ -713,11 +713,7 @@ def simulate(
     started = time.perf_counter()
     nominal, sample_s = _nominal(mc)
     stage(f"nominal run: {sample_s:.3g} s a sample")
-    seconds = mc.plan.scenario.output_seconds()
-    envelope = Envelope(mc.vectors, seconds)
     job = Job.of(mc)
-    rows: list[dict[str, Any]] = []
-    failed = 0
     with connect(scheduler, workers) as client:
         threads = _check_workers(client)
         overhead = _task_overhead_s(client)
@@ -727,43 +723,11 @@ def simulate(
             f"{mc.samples} samples on {threads} workers: {len(batches)} tasks of {size} "
             f"(Dask: {1e3 * overhead:.2g} ms a task)"
         )
-        from distributed import as_completed
-
-        shared = client.scatter(job, broadcast=True, hash=False)
-        futures = client.map(
-            evaluate_batch,
-            [shared] * len(batches),
-            [a for a, _ in batches],
-            [b for _, b in batches],
-            pure=False,
-        )
-        span = {future.key: batch for future, batch in zip(futures, batches, strict=True)}
-        done = compute_s = 0.0
-        result_bytes = []
-        if progress:
-            progress(0, mc.samples, 0)
-        finished = as_completed(futures, client.loop, with_results=True, raise_errors=False)
-        for future, result in finished:
-            first, stop = span[future.key]
-            if isinstance(result, BatchResult):
-                rows += result.rows
-                envelope.add(result.extremes)
-                compute_s += result.compute_s
-                failed += sum(row["status"] != "ok" for row in result.rows)
-                if len(result_bytes) < 20:
-                    result_bytes.append(len(pickle.dumps(result, protocol=5)))
-            else:  # the task itself died (a worker killed, say): its samples failed
-                error = f"the task of samples {first}-{stop - 1} failed: {_error_text(result)}"
-                for index in range(first, stop):
-                    sample = draw_sample(mc.dispersions, mc.loaded.document, index)
-                    rows.append(_failure(index, sample.parameters, error))
-                failed += stop - first
-            done += stop - first
-            if progress:
-                progress(int(done), mc.samples, failed)
-            future.release()
+        gathered = _run_batches(client, mc, job, batches, progress)
     wall = time.perf_counter() - started
-    table = pandas.DataFrame(rows, columns=mc.columns).sort_values("sample", ignore_index=True)
+    table = pandas.DataFrame(gathered.rows, columns=mc.columns)
+    table = table.sort_values("sample", ignore_index=True)
+    result_bytes = gathered.result_bytes
     execution = {
         "scheduler": scheduler or f"local cluster ({threads} processes, one thread each)",
         "workers": threads,
@@ -771,12 +735,78 @@ def simulate(
         "tasks": len(batches),
         "nominal_sample_s": sample_s,
         "task_overhead_s": overhead,
-        "compute_s": compute_s,
+        "compute_s": gathered.compute_s,
         "wall_s": wall,
         "job_bytes": len(pickle.dumps(job, protocol=5)),
         "result_bytes_per_task": float(np.mean(result_bytes)) if result_bytes else None,
     }
-    return MonteCarloResult(mc, table, envelope, nominal, execution)
+    return MonteCarloResult(mc, table, gathered.envelope, nominal, execution)
+
+
+@dataclass
+class _Gathered:
+    """The finished tasks' rows and envelope, summed as they come in, in any order."""
+
+    envelope: Envelope
+    rows: list[dict[str, Any]] = field(default_factory=list)
+    failed: int = 0
+    compute_s: float = 0.0
+    result_bytes: list[int] = field(default_factory=list)  # of the first 20 results
+
+    def add(self, result: BatchResult) -> None:
+        self.rows += result.rows
+        self.envelope.add(result.extremes)
+        self.compute_s += result.compute_s
+        self.failed += sum(row["status"] != "ok" for row in result.rows)
+        if len(self.result_bytes) < 20:
+            self.result_bytes.append(len(pickle.dumps(result, protocol=5)))
+
+    def add_dead_task(self, mc: MonteCarloPlan, first: int, stop: int, exc: Any) -> None:
+        """A task that died (a worker killed, say): its samples failed, each with the
+        parameters it drew (drawn again here: the draws are the sample's own)."""
+        error = f"the task of samples {first}-{stop - 1} failed: {_error_text(exc)}"
+        for index in range(first, stop):
+            sample = draw_sample(mc.dispersions, mc.loaded.document, index)
+            self.rows.append(_failure(index, sample.parameters, error))
+        self.failed += stop - first
+
+
+def _run_batches(
+    client,
+    mc: MonteCarloPlan,
+    job: Job,
+    batches: list[tuple[int, int]],
+    progress: Callable[[int, int, int], None] | None,
+) -> _Gathered:
+    """Send the job once to every worker, one task per batch, and gather the tasks as
+    they finish (each released as soon as it is read)."""
+    from distributed import as_completed
+
+    shared = client.scatter(job, broadcast=True, hash=False)
+    futures = client.map(
+        evaluate_batch,
+        [shared] * len(batches),
+        [a for a, _ in batches],
+        [b for _, b in batches],
+        pure=False,
+    )
+    span = {future.key: batch for future, batch in zip(futures, batches, strict=True)}
+    gathered = _Gathered(Envelope(mc.vectors, mc.plan.scenario.output_seconds()))
+    done = 0
+    if progress:
+        progress(0, mc.samples, 0)
+    finished = as_completed(futures, client.loop, with_results=True, raise_errors=False)
+    for future, result in finished:
+        first, stop = span[future.key]
+        if isinstance(result, BatchResult):
+            gathered.add(result)
+        else:
+            gathered.add_dead_task(mc, first, stop, result)
+        done += stop - first
+        if progress:
+            progress(done, mc.samples, gathered.failed)
+        future.release()
+    return gathered
 
 
 def _load(scenario: str | Path | ScenarioFile) -> ScenarioFile:

@@ -85,20 +85,6 @@ def statistics(result: MonteCarloResult) -> dict[str, Any]:
     mc, table = result.plan, result.table
     ok = table[table["status"] == "ok"]
     scenario = mc.plan.scenario
-    failures = []
-    for _, row in result.failed.head(_MAX_LISTED_FAILURES).iterrows():
-        failures.append(
-            {
-                "sample": int(row["sample"]),
-                "error": row["error"],
-                "parameters": {n: row[n] for n in mc.parameters if not _missing(row[n])},
-            }
-        )
-    categories = {
-        name: {str(k): int(v) for k, v in ok[name].value_counts().sort_index().items()}
-        for name in mc.metrics
-        if table[name].dtype.kind not in "fiu"
-    }
     return {
         "attitude_version": __version__,
         "scenario": {
@@ -114,41 +100,74 @@ def statistics(result: MonteCarloResult) -> dict[str, Any]:
             "dispersed": mc.dispersions.describe(),
         },
         "samples": {"total": len(table), "ok": len(ok), "failed": len(table) - len(ok)},
-        "method": {
-            "percentiles": f"{list(PERCENTILES)}: numpy.percentile, linear interpolation",
-            "std": "sample standard deviation (ddof = 1)",
-            "bounds": (
-                f"one-sided, distribution-free: the r-th largest (smallest) of n samples bounds "
-                f"the {COVERAGE:g} ({1 - COVERAGE:.2g}) quantile from above (below) with "
-                f"confidence P(Binomial(n, {1 - COVERAGE:.2g}) >= r); r is the largest with "
-                f"confidence >= {CONFIDENCE:g} (Wilks 1941, doi:10.1214/aoms/1177731788)"
-            ),
-            "over": "the samples that ran, and the finite values of each column (n)",
-            "metrics": (
-                "each sample's numbers as summary.json of attitude run reports them: the "
-                "pointing's extrema and intervals found on the sample's exact motion "
-                "(attitude.pointing.pointing_analysis), the largest rate on the output grid"
-            ),
-        },
+        "method": _method(),
         "nominal": result.nominal,
         "metrics": {n: describe(ok[n].to_numpy(float)) for n in _numeric(table, mc.metrics)},
-        "categories": categories,
+        "categories": _categories(mc, table, ok),
         "parameters": {
             n: describe(table[n].to_numpy(float)) for n in _numeric(table, mc.parameters)
         },
-        "failures": failures,
-        "envelopes": None
-        if not mc.vectors
-        else {
-            "file": "sun_angle_envelopes.csv",
-            "method": (
-                "each sample's Sun angle on the output grid is reduced, on the workers, to "
-                "its smallest and largest value in each time bin, rounded to "
-                f"{ANGLE_STEP_DEG} deg; the percentiles over the samples come from the "
-                "histograms of these values (numpy's inverted_cdf on the rounded values)"
-            ),
-        },
+        "failures": _failures(result),
+        "envelopes": _envelopes_method(mc),
         "execution": result.execution,
+    }
+
+
+def _method() -> dict[str, str]:
+    """How the statistics are computed, in words (statistics.json's ``method``)."""
+    return {
+        "percentiles": f"{list(PERCENTILES)}: numpy.percentile, linear interpolation",
+        "std": "sample standard deviation (ddof = 1)",
+        "bounds": (
+            f"one-sided, distribution-free: the r-th largest (smallest) of n samples bounds "
+            f"the {COVERAGE:g} ({1 - COVERAGE:.2g}) quantile from above (below) with "
+            f"confidence P(Binomial(n, {1 - COVERAGE:.2g}) >= r); r is the largest with "
+            f"confidence >= {CONFIDENCE:g} (Wilks 1941, doi:10.1214/aoms/1177731788)"
+        ),
+        "over": "the samples that ran, and the finite values of each column (n)",
+        "metrics": (
+            "each sample's numbers as summary.json of attitude run reports them: the "
+            "pointing's extrema and intervals found on the sample's exact motion "
+            "(attitude.pointing.pointing_analysis), the largest rate on the output grid"
+        ),
+    }
+
+
+def _categories(mc: MonteCarloPlan, table, ok) -> dict[str, dict[str, int]]:
+    """Per non-numeric metric (the kind of motion), how many samples that ran had each value."""
+    return {
+        name: {str(k): int(v) for k, v in ok[name].value_counts().sort_index().items()}
+        for name in mc.metrics
+        if table[name].dtype.kind not in "fiu"
+    }
+
+
+def _failures(result: MonteCarloResult) -> list[dict[str, Any]]:
+    """The first failed samples, each with its error and the parameters it drew."""
+    failures = []
+    for _, row in result.failed.head(_MAX_LISTED_FAILURES).iterrows():
+        failures.append(
+            {
+                "sample": int(row["sample"]),
+                "error": row["error"],
+                "parameters": {n: row[n] for n in result.plan.parameters if not _missing(row[n])},
+            }
+        )
+    return failures
+
+
+def _envelopes_method(mc: MonteCarloPlan) -> dict[str, str] | None:
+    """Where the Sun angle envelopes are and how they are made (None without body vectors)."""
+    if not mc.vectors:
+        return None
+    return {
+        "file": "sun_angle_envelopes.csv",
+        "method": (
+            "each sample's Sun angle on the output grid is reduced, on the workers, to "
+            "its smallest and largest value in each time bin, rounded to "
+            f"{ANGLE_STEP_DEG} deg; the percentiles over the samples come from the "
+            "histograms of these values (numpy's inverted_cdf on the rounded values)"
+        ),
     }
 
 
@@ -264,7 +283,6 @@ def _plot_envelopes(result: MonteCarloResult, path: Path) -> str:
 
     envelope = result.envelope
     values = envelope.percentiles_deg(PERCENTILES)  # (p, vectors, 2, bins)
-    p = {q: i for i, q in enumerate(PERCENTILES)}
     centres = 0.5 * (envelope.bin_start_s + envelope.bin_end_s)
     t, label = time_axis(centres)
     limits = {
@@ -275,41 +293,7 @@ def _plot_envelopes(result: MonteCarloResult, path: Path) -> str:
     panels = figure.subplots(count, 1, squeeze=False)[:, 0]
     ran = int((result.table["status"] == "ok").sum())
     for v, (axes, name) in enumerate(zip(panels, envelope.vectors, strict=True)):
-        low, high = values[:, v, 0], values[:, v, 1]
-        axes.fill_between(
-            t,
-            low[p[1]],
-            high[p[99]],
-            step="mid",
-            color="C0",
-            alpha=0.2,
-            label="1 % of min to 99 % of max",
-        )
-        axes.fill_between(
-            t,
-            low[p[5]],
-            high[p[95]],
-            step="mid",
-            color="C0",
-            alpha=0.35,
-            label="5 % of min to 95 % of max",
-        )
-        axes.step(t, low[p[50]], where="mid", color="C0", linewidth=1.0, label="median min, max")
-        axes.step(t, high[p[50]], where="mid", color="C0", linewidth=1.0)
-        if limits.get(name) is not None:
-            axes.axhline(
-                limits[name],
-                color="C3",
-                linestyle="--",
-                linewidth=1.0,
-                label=f"exclusion ({limits[name]:g}°)",
-            )
-        axes.set_ylim(0.0, 180.0)
-        axes.set_yticks(np.arange(0, 181, 30))
-        axes.set_ylabel(f"{name}: Sun angle (deg)")
-        axes.set_xlabel(label)
-        axes.grid(alpha=0.3)
-        axes.legend(loc="upper right", fontsize="x-small", ncols=2)
+        _envelope_panel(axes, t, label, name, values[:, v, 0], values[:, v, 1], limits.get(name))
     figure.suptitle(
         f"Sun angle over {ran} samples: percentiles of each sample's smallest and largest "
         "angle in each time bin",
@@ -320,6 +304,38 @@ def _plot_envelopes(result: MonteCarloResult, path: Path) -> str:
     return path.name
 
 
+def _envelope_panel(axes, t, label: str, name: str, low, high, limit_deg: float | None) -> None:
+    """One body vector's panel: the bands between percentiles of the bins' smallest
+    (``low``) and largest (``high``) Sun angles, their medians, its exclusion limit."""
+    p = {q: i for i, q in enumerate(PERCENTILES)}
+    for below, above, alpha in ((1, 99, 0.2), (5, 95, 0.35)):
+        axes.fill_between(
+            t,
+            low[p[below]],
+            high[p[above]],
+            step="mid",
+            color="C0",
+            alpha=alpha,
+            label=f"{below} % of min to {above} % of max",
+        )
+    axes.step(t, low[p[50]], where="mid", color="C0", linewidth=1.0, label="median min, max")
+    axes.step(t, high[p[50]], where="mid", color="C0", linewidth=1.0)
+    if limit_deg is not None:
+        axes.axhline(
+            limit_deg,
+            color="C3",
+            linestyle="--",
+            linewidth=1.0,
+            label=f"exclusion ({limit_deg:g}°)",
+        )
+    axes.set_ylim(0.0, 180.0)
+    axes.set_yticks(np.arange(0, 181, 30))
+    axes.set_ylabel(f"{name}: Sun angle (deg)")
+    axes.set_xlabel(label)
+    axes.grid(alpha=0.3)
+    axes.legend(loc="upper right", fontsize="x-small", ncols=2)
+
+
 def _bound(entry: dict[str, Any], key: str) -> str | None:
     bound = entry.get(key)
     if not bound or bound["value"] is None:
@@ -328,13 +344,25 @@ def _bound(entry: dict[str, Any], key: str) -> str | None:
 
 
 def _page(result: MonteCarloResult, stats, images: dict[str, str], files: list[str]) -> str:
-    scenario = stats["scenario"]
-    title = f"Monte Carlo: {scenario['name']}"
-    execution = stats["execution"]
+    title = f"Monte Carlo: {stats['scenario']['name']}"
     parts = [
         "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
         f"<title>{escape(title)}</title><style>{_STYLE}</style></head><body>",
         f"<h1>{escape(title)}</h1>",
+        *_overview(stats),
+        *_metrics_section(result, stats),
+        *_failures_section(stats),
+        *_figures_and_files(images, files),
+        _execution_note(stats["execution"]),
+        "</body></html>\n",
+    ]
+    return "\n".join(parts)
+
+
+def _overview(stats) -> list[str]:
+    """What ran: the file, the samples and how they ran, and the dispersions."""
+    scenario, execution = stats["scenario"], stats["execution"]
+    return [
         f"<p class='note'>{escape(scenario['file'])}, computed by attitude "
         f"{escape(__version__)} (exact torque-free motion for every sample).</p>",
         _table(
@@ -355,6 +383,12 @@ def _page(result: MonteCarloResult, stats, images: dict[str, str], files: list[s
         "<h2>Dispersions</h2><ul>",
         *[f"<li>{escape(line)}</li>" for line in stats["dispersions"]["dispersed"]],
         "</ul>",
+    ]
+
+
+def _metrics_section(result: MonteCarloResult, stats) -> list[str]:
+    """Per metric: the nominal, mean, std, percentiles and 99 % bounds; the kinds of motion."""
+    parts = [
         "<h2>Metrics</h2>",
         f"<p class='note'>Over the samples that ran. Bounds: one-sided, {100 * COVERAGE:g} % "
         f"of cases, from order statistics (Wilks 1941), with their confidence; "
@@ -403,25 +437,30 @@ def _page(result: MonteCarloResult, stats, images: dict[str, str], files: list[s
                 ],
             )
         )
-    if stats["failures"]:
-        parts.append("<h2>Failed samples</h2>")
-        parts.append(
-            _table(
-                ["sample", "error"],
-                [[f["sample"], f["error"]] for f in stats["failures"][:20]],
-            )
-        )
-        parts.append(
-            "<p class='note'>Their drawn parameters are in samples.csv; "
-            "<code>attitude montecarlo FILE --sample K --emit-scenario DIR</code> writes "
-            "sample K as a scenario to run alone.</p>"
-        )
-    parts += _figures_and_files(images, files)
-    parts.append(
+    return parts
+
+
+def _failures_section(stats) -> list[str]:
+    """The first 20 failed samples with their errors, and how to re-run one alone."""
+    if not stats["failures"]:
+        return []
+    return [
+        "<h2>Failed samples</h2>",
+        _table(
+            ["sample", "error"],
+            [[f["sample"], f["error"]] for f in stats["failures"][:20]],
+        ),
+        "<p class='note'>Their drawn parameters are in samples.csv; "
+        "<code>attitude montecarlo FILE --sample K --emit-scenario DIR</code> writes "
+        "sample K as a scenario to run alone.</p>",
+    ]
+
+
+def _execution_note(execution: dict[str, Any]) -> str:
+    """How the job ran: its tasks, the scheduler, a sample's and a task's cost."""
+    return (
         f"<p class='note'>{execution['tasks']} tasks of {execution['batch_size']} samples on "
         f"{escape(str(execution['scheduler']))}; one sample of the nominal took "
         f"{execution['nominal_sample_s']:.3g} s here, Dask {1e3 * execution['task_overhead_s']:.2g}"
         f" ms a task.</p>"
     )
-    parts.append("</body></html>\n")
-    return "\n".join(parts)

@@ -605,6 +605,9 @@ def scenario_from_document(path: Path, document: dict[str, Any]) -> ScenarioFile
     the errors): a Monte Carlo sample is built from its document through this one path.
 
     A ``[dispersions]`` table is let through unread: ``attitude.dispersions`` reads it.
+    The tables are read in the order their errors are reported: [scenario],
+    [spacecraft], [pointing] (the orbit: an attitude may be given in its frame),
+    [initial_state], [[events]], [torques], [output].
     """
     root = _Table(path, "", document)
     root.allow(
@@ -617,58 +620,64 @@ def scenario_from_document(path: Path, document: dict[str, Any]) -> ScenarioFile
         "torques",
         "dispersions",
     )
+    name, scale, epoch = _scenario_table(root)
+    spacecraft = _spacecraft(root)
+    pointing = _pointing(root, scale, epoch, spacecraft.name)
+    state = _initial_state(root, pointing.orbit, epoch)
+    events = _events(root, scale, epoch, pointing.orbit)
+    torques = _torques(root, scale, pointing.orbit)
+    output = root.table("output")
+    output.allow("start", "stop", "duration", "step", "formats", "aem_tolerance")
+    span = _span(output, scale)
+    try:
+        scenario = Scenario(name, spacecraft, epoch, state, events, **span, torques=torques)
+    except InputError as exc:
+        end = "stop" if span["stop"] is not None else "duration"
+        raise ScenarioFileError(f"{path.name}: {_scenario_key(str(exc), end)}") from None
+    return ScenarioFile(path, scenario, pointing, _outputs(output), document)
 
+
+def _scenario_table(root: _Table) -> tuple[str, str, Any]:
+    """[scenario]: its name, the time scale of the file's epochs, and its epoch."""
     meta = root.table("scenario")
     meta.allow("name", "epoch", "time_scale")
     scale = meta.choice("time_scale", SCALES, default="utc")
     epoch = meta.epoch("epoch", scale)
-    name = meta.string("name")
+    return meta.string("name"), scale, epoch
 
+
+def _spacecraft(root: _Table) -> Spacecraft:
+    """[spacecraft]: its name and its inertia (principal moments or a tensor)."""
     craft = root.table("spacecraft")
     craft.allow("name", "principal_moments", "inertia_tensor")
     craft_name = craft.string("name")
     inertia, key = _inertia(craft)
-    spacecraft = _checked(craft, key, Spacecraft, craft_name, inertia)
+    return _checked(craft, key, Spacecraft, craft_name, inertia)
 
-    # The orbit comes first: an attitude may be given in its frame.
-    pointing = _pointing(root, scale, epoch, craft_name)
 
+def _initial_state(root: _Table, orbit: Orbit | None, epoch) -> InitialState:
+    """[initial_state]: the attitude (in ICRF, from the frame or AEM file it is given
+    in) and the rate (angular velocity or momentum)."""
     initial = root.table("initial_state")
     initial.allow("quaternion", "matrix", "frame", "aem", "angular_velocity", "angular_momentum")
-    attitude = _attitude_in_icrf(initial, pointing.orbit, epoch)
+    attitude = _attitude_in_icrf(initial, orbit, epoch)
     if attitude is None:
         initial.fail("missing quaternion (w, x, y, z, body -> ICRF) or matrix")
     rate = _rate(initial, required=True)
-    state = _checked(initial, None, InitialState, attitude, **rate)
+    return _checked(initial, None, InitialState, attitude, **rate)
 
-    events = _events(root, scale, epoch, pointing.orbit)
-    torques = _torques(root, scale, pointing.orbit)
 
-    output = root.table("output")
-    output.allow("start", "stop", "duration", "step", "formats", "aem_tolerance")
+def _span(output: _Table, scale: str) -> dict[str, Any]:
+    """[output]'s span and step, as :class:`Scenario` takes them: exactly one of stop and
+    duration, and the start and step if given."""
     if output.has("stop") == output.has("duration"):
         output.fail("give exactly one of stop (ISO 8601) and duration (seconds)")
-    stop = output.epoch("stop", scale, required=False)
-    duration = output.positive("duration", "time", required=False)
-    start = output.epoch("start", scale, required=False)
-    step = output.positive("step", "time", required=False)
-    try:
-        scenario = Scenario(
-            name,
-            spacecraft,
-            epoch,
-            state,
-            events,
-            stop=stop,
-            duration=duration,
-            start=start,
-            step=step,
-            torques=torques,
-        )
-    except InputError as exc:
-        end = "stop" if stop is not None else "duration"
-        raise ScenarioFileError(f"{path.name}: {_scenario_key(str(exc), end)}") from None
-    return ScenarioFile(path, scenario, pointing, _outputs(output), document)
+    return {
+        "stop": output.epoch("stop", scale, required=False),
+        "duration": output.positive("duration", "time", required=False),
+        "start": output.epoch("start", scale, required=False),
+        "step": output.positive("step", "time", required=False),
+    }
 
 
 def _outputs(output: _Table) -> OutputChoice:
