@@ -229,7 +229,8 @@ def _checked_run(args, state: dict) -> int:
         loaded = load_scenario(args.scenario)
         state["file"] = loaded.path.name
         outputs = _outputs(args, loaded.outputs)
-        plan = plan_run(loaded.scenario, loaded.pointing, outputs)
+        # A run computes the validity horizon beside its outputs (attitude.report).
+        plan = plan_run(loaded.scenario, loaded.pointing, outputs, horizon=args.command == "check")
         if args.command == "check":
             if args.out is not None:
                 check_fits(plan.budget, args.out)

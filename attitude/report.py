@@ -35,6 +35,7 @@ import contextlib
 import math
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -42,6 +43,7 @@ import numpy as np
 
 from attitude.aem import aem_text
 from attitude.aem_sampling import INTERPOLATION_METHOD, write_planned_aem
+from attitude.beside import Beside
 from attitude.epoch_texts import EpochTexts
 from attitude.exports import (
     QUATERNION_CONVENTION,
@@ -52,6 +54,7 @@ from attitude.exports import (
     write_intervals_csv,
     write_json,
 )
+from attitude.horizon import ValidityHorizon, validity_horizon
 from attitude.orbit import TleOrbit
 from attitude.output_budget import check_fits
 from attitude.output_folder import claim
@@ -167,7 +170,7 @@ def produce(
     progress = progress or Progress()
     pointing = pointing or PointingSpec()
     if plan is None:
-        plan = plan_run(scenario, pointing, outputs)
+        plan = plan_run(scenario, pointing, outputs, horizon=False)
     check_fits(plan.budget, out_dir)
     folder = claim(out_dir, OUTPUT_NAMES)
     written: dict[str, Any] = {}
@@ -280,7 +283,23 @@ def _build(
 
     In order: the output grid streamed into the time series and the figures'
     envelopes; the pointing's exact search (intervals.csv, the summary's pointing); the
-    AEM over its own records; the figures; summary.json and the page."""
+    AEM over its own records; the figures; summary.json and the page.  A validity
+    horizon the plan left to the run is computed meanwhile in a process beside this one
+    (:class:`attitude.beside.Beside`: the machine's other core), for the summary."""
+    if not plan.horizon_deferred:
+        return _build_with(plan, None, tmp, source, progress, chunk_samples)
+    with Beside(validity_horizon, plan.trajectory, plan.pointing.orbit) as horizon:
+        return _build_with(plan, horizon, tmp, source, progress, chunk_samples)
+
+
+def _build_with(
+    plan: RunPlan,
+    horizon: Beside[ValidityHorizon] | None,
+    tmp: Path,
+    source: str,
+    progress: Progress,
+    chunk_samples: int,
+) -> tuple[dict[str, Any], list[str]]:
     outputs = plan.outputs
     texts = EpochTexts(plan.scenario.epoch)
     pointing = None if plan.pointing.is_empty else _Pointing(plan)
@@ -300,6 +319,9 @@ def _build(
     if "plots" in outputs:
         progress("plotting")
         images = _plots(plan, tmp, stream, pointing, analysis)
+    if horizon is not None:
+        # The same key, at the same place in the summary, with the horizon filled in.
+        summary["torques"] = torques_summary(replace(plan, horizon=horizon.result()))
     progress("writing summary.json" + (" and report.html" if "report" in outputs else ""))
     write_json(tmp / "summary.json", summary)
     files.append("summary.json")

@@ -48,12 +48,22 @@ class RunPlan:
     aem: AemPlan | None = None
     search: SearchGrid | None = None  # the pointing's exact search (None without pointing)
     horizon: ValidityHorizon | None = None  # torque-free with an orbit: how long it holds
+    # The horizon is wanted but left for the run to compute (plan_run(horizon=False)).
+    horizon_deferred: bool = False
 
 
 def plan_run(
-    scenario: Scenario, pointing: PointingSpec | None = None, outputs: OutputChoice | None = None
+    scenario: Scenario,
+    pointing: PointingSpec | None = None,
+    outputs: OutputChoice | None = None,
+    horizon: bool = True,
 ) -> RunPlan:
-    """Check ``scenario`` (``pointing``, ``outputs``) as a run would, up to the sampling."""
+    """Check ``scenario`` (``pointing``, ``outputs``) as a run would, up to the sampling.
+
+    ``horizon=False``: the validity horizon, when there is one, is not computed here
+    (``horizon_deferred`` says it is wanted): a run computes it beside its outputs
+    (``attitude.report``), since it checks nothing and takes as long as a day's outputs.
+    """
     pointing = pointing or PointingSpec()
     outputs = outputs or OutputChoice()
     samples = scenario.output_count()
@@ -81,9 +91,10 @@ def plan_run(
             f"torques: the propagation has no finite error estimate ({errors}): "
             "give a smaller step or an accuracy"
         )
-    horizon = None
-    if pointing.orbit is not None and not scenario.torques.any:
-        horizon = validity_horizon(trajectory, pointing.orbit)
+    found = None
+    wanted = pointing.orbit is not None and not scenario.torques.any
+    if wanted and horizon:
+        found = validity_horizon(trajectory, pointing.orbit)
     aem = None
     if "aem" in outputs:
         aem = plan_aem(
@@ -104,5 +115,15 @@ def plan_run(
         pointing_columns=columns,
     )
     return RunPlan(
-        scenario, pointing, trajectory, motion, budget, notes, outputs, aem, search, horizon
+        scenario,
+        pointing,
+        trajectory,
+        motion,
+        budget,
+        notes,
+        outputs,
+        aem,
+        search,
+        found,
+        horizon_deferred=wanted and not horizon,
     )
