@@ -54,7 +54,7 @@ from attitude.exports import (
     write_intervals_csv,
     write_json,
 )
-from attitude.horizon import ValidityHorizon, validity_horizon
+from attitude.horizon import ValidityHorizon
 from attitude.orbit import TleOrbit
 from attitude.output_budget import check_fits
 from attitude.output_folder import claim
@@ -81,7 +81,7 @@ from attitude.report_figures import (
     sun_angle_zoom,
 )
 from attitude.report_page import render_page
-from attitude.run_plan import RunPlan, plan_run
+from attitude.run_plan import RunPlan, horizon_beside, plan_run
 from attitude.scenario import Scenario
 from attitude.summaries import motion_summary, outputs_summary, pointing_summary, scenario_summary
 from attitude.timeseries_parquet import ParquetWriter
@@ -156,6 +156,7 @@ def produce(
     plan: RunPlan | None = None,
     outputs: OutputChoice | None = None,
     chunk_samples: int = CHUNK_SAMPLES,
+    horizon: Beside[ValidityHorizon] | None = None,
 ) -> dict[str, Any]:
     """Propagate ``scenario`` and write its report into ``out_dir``; returns the summary.
 
@@ -163,7 +164,9 @@ def produce(
     name, for the headers; ``plan``: the scenario already checked by
     :func:`attitude.run_plan.plan_run` (checked here otherwise, for ``outputs``: the
     formats and the AEM's tolerance, the defaults when None); ``chunk_samples``:
-    output epochs evaluated and written at a time.  Raises :class:`InputError` (the
+    output epochs evaluated and written at a time; ``horizon``: the plan's deferred
+    validity horizon already started beside (:func:`attitude.run_plan.horizon_beside`;
+    started here otherwise, and closed either way by its owner).  Raises :class:`InputError` (the
     scenario, or an output folder that holds files this tool did not write) before
     anything is computed or written, and ``OSError`` if the files cannot be written.
     """
@@ -176,7 +179,7 @@ def produce(
     written: dict[str, Any] = {}
 
     def build(tmp: Path) -> list[str]:
-        written["summary"], files = _build(plan, tmp, source, progress, chunk_samples)
+        written["summary"], files = _build(plan, tmp, source, progress, chunk_samples, horizon)
         return files
 
     folder.write(build, source, __version__)
@@ -277,7 +280,12 @@ class _Stream:
 
 
 def _build(
-    plan: RunPlan, tmp: Path, source: str, progress: Progress, chunk_samples: int = CHUNK_SAMPLES
+    plan: RunPlan,
+    tmp: Path,
+    source: str,
+    progress: Progress,
+    chunk_samples: int = CHUNK_SAMPLES,
+    horizon: Beside[ValidityHorizon] | None = None,
 ) -> tuple[dict[str, Any], list[str]]:
     """Stream ``plan``'s outputs into ``tmp``: (summary, file names).
 
@@ -286,10 +294,10 @@ def _build(
     AEM over its own records; the figures; summary.json and the page.  A validity
     horizon the plan left to the run is computed meanwhile in a process beside this one
     (:class:`attitude.beside.Beside`: the machine's other core), for the summary."""
-    if not plan.horizon_deferred:
-        return _build_with(plan, None, tmp, source, progress, chunk_samples)
-    with Beside(validity_horizon, plan.trajectory, plan.pointing.orbit) as horizon:
+    if horizon is not None or not plan.horizon_deferred:
         return _build_with(plan, horizon, tmp, source, progress, chunk_samples)
+    with horizon_beside(plan) as started:
+        return _build_with(plan, started, tmp, source, progress, chunk_samples)
 
 
 def _build_with(

@@ -20,6 +20,7 @@ import math
 from dataclasses import dataclass, field
 
 from attitude.aem_sampling import AemPlan, plan_aem
+from attitude.beside import Beside
 from attitude.errors import InputError
 from attitude.exports import pointing_column_count
 from attitude.horizon import ValidityHorizon, validity_horizon
@@ -31,7 +32,7 @@ from attitude.scenario import Scenario
 from attitude.timeseries_parquet import check_span
 from attitude.trajectory import Trajectory, propagate
 
-__all__ = ["RunPlan", "plan_run"]
+__all__ = ["RunPlan", "horizon_beside", "plan_run"]
 
 
 @dataclass
@@ -127,3 +128,14 @@ def plan_run(
         found,
         horizon_deferred=wanted and not horizon,
     )
+
+
+def horizon_beside(plan: RunPlan) -> Beside[ValidityHorizon] | None:
+    """The validity horizon ``plan`` left to the run, started now in a process beside
+    this one (:class:`attitude.beside.Beside`; use it as a context manager), or None
+    when the plan has none to compute.  The command line starts it before it imports
+    the writers and the plots, so that the horizon, the longest single job of a
+    one-day report, starts as early as it can."""
+    if not plan.horizon_deferred:
+        return None
+    return Beside(validity_horizon, plan.trajectory, plan.pointing.orbit)
