@@ -27,7 +27,7 @@ import pickle
 import signal
 import sys
 from collections.abc import Callable
-from typing import Any, Generic, TypeVar
+from typing import Any, Generic, TypeVar, cast
 
 __all__ = ["Beside"]
 
@@ -88,6 +88,7 @@ class Beside(Generic[T]):
             if self._pid is None:
                 self._value = _outcome(self._function, self._args)
             else:
+                assert self._read is not None  # open until the child is reaped
                 data = _receive(self._read)
                 self._reap(kill=False)
                 self._value = (
@@ -98,7 +99,7 @@ class Beside(Generic[T]):
         ok, value = self._value
         if not ok:
             raise value
-        return value
+        return cast(T, value)
 
     def close(self) -> None:
         """Kill and reap the child if it is still there."""

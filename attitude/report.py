@@ -294,9 +294,10 @@ def _build(
     AEM over its own records; the figures; summary.json and the page.  A validity
     horizon the plan left to the run is computed meanwhile in a process beside this one
     (:class:`attitude.beside.Beside`: the machine's other core), for the summary."""
-    if horizon is not None or not plan.horizon_deferred:
+    started = None if horizon is not None else horizon_beside(plan)
+    if started is None:
         return _build_with(plan, horizon, tmp, source, progress, chunk_samples)
-    with horizon_beside(plan) as started:
+    with started:
         return _build_with(plan, started, tmp, source, progress, chunk_samples)
 
 
