@@ -33,6 +33,7 @@ are installed, so that even a Ctrl-C while numpy loads ends with one line.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import signal
 import sys
@@ -243,9 +244,8 @@ def _checked_run(args, state: dict) -> int:
     from attitude.errors import InputError
     from attitude.output_budget import check_fits
     from attitude.output_folder import OutputFolderError, claim
-    from attitude.output_formats import OutputChoice
-    from attitude.report import OUTPUT_NAMES, Progress, write_report
-    from attitude.run_plan import plan_run
+    from attitude.output_formats import OUTPUT_NAMES, OutputChoice
+    from attitude.run_plan import horizon_beside, plan_run
     from attitude.scenario_file import ScenarioFileError, load_scenario
 
     try:
@@ -263,7 +263,8 @@ def _checked_run(args, state: dict) -> int:
 
             return command(args, loaded)
         outputs = _outputs(args, loaded.outputs)
-        plan = plan_run(loaded.scenario, loaded.pointing, outputs)
+        # A run computes the validity horizon beside its outputs (attitude.report).
+        plan = plan_run(loaded.scenario, loaded.pointing, outputs, horizon=args.command == "check")
         montecarlo = None
         if "dispersions" in loaded.document:  # checked by run too: one reading of the file
             from attitude.montecarlo import plan_montecarlo
@@ -280,8 +281,20 @@ def _checked_run(args, state: dict) -> int:
         claim(args.out, OUTPUT_NAMES, dry_run=True)  # a folder that is not ours: say so first
         for note in plan.notes:
             print(f"attitude: note: {loaded.path.name}: {note}", file=sys.stderr, flush=True)
-        progress = Progress(None if args.quiet else lambda line: print(line, file=sys.stderr))
-        write_report(loaded.scenario, args.out, loaded.pointing, loaded.path.name, progress, plan)
+        # The horizon starts beside the run before the writers and plots are imported.
+        with horizon_beside(plan) or contextlib.nullcontext() as horizon:
+            from attitude.report import Progress, write_report
+
+            progress = Progress(None if args.quiet else lambda line: print(line, file=sys.stderr))
+            write_report(
+                loaded.scenario,
+                args.out,
+                loaded.pointing,
+                loaded.path.name,
+                progress,
+                plan,
+                horizon=horizon,
+            )
         return 0
     except (ScenarioFileError, OutputFolderError) as exc:
         _error(str(exc))

@@ -35,6 +35,7 @@ import contextlib
 import math
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -42,6 +43,7 @@ import numpy as np
 
 from attitude.aem import aem_text
 from attitude.aem_sampling import INTERPOLATION_METHOD, write_planned_aem
+from attitude.beside import Beside
 from attitude.csv_files import (
     QUATERNION_CONVENTION,
     CsvWriter,
@@ -51,6 +53,7 @@ from attitude.csv_files import (
     write_intervals_csv,
 )
 from attitude.epoch_texts import EpochTexts
+from attitude.horizon import ValidityHorizon
 from attitude.orbit import TleOrbit
 from attitude.output_budget import check_fits
 from attitude.output_folder import claim
@@ -77,7 +80,7 @@ from attitude.report_figures import (
     sun_angle_zoom,
 )
 from attitude.report_page import render_page
-from attitude.run_plan import RunPlan, plan_run
+from attitude.run_plan import RunPlan, horizon_beside, plan_run
 from attitude.scenario import Scenario
 from attitude.summaries import (
     motion_summary,
@@ -158,6 +161,7 @@ def write_report(
     plan: RunPlan | None = None,
     outputs: OutputChoice | None = None,
     chunk_samples: int = CHUNK_SAMPLES,
+    horizon: Beside[ValidityHorizon] | None = None,
 ) -> dict[str, Any]:
     """Propagate ``scenario`` and write its report into ``out_dir``; returns the summary.
 
@@ -165,20 +169,22 @@ def write_report(
     name, for the headers; ``plan``: the scenario already checked by
     :func:`attitude.run_plan.plan_run` (checked here otherwise, for ``outputs``: the
     formats and the AEM's tolerance, the defaults when None); ``chunk_samples``:
-    output epochs evaluated and written at a time.  Raises :class:`InputError` (the
+    output epochs evaluated and written at a time; ``horizon``: the plan's deferred
+    validity horizon already started beside (:func:`attitude.run_plan.horizon_beside`;
+    started here otherwise, and closed either way by its owner).  Raises :class:`InputError` (the
     scenario, or an output folder that holds files this tool did not write) before
     anything is computed or written, and ``OSError`` if the files cannot be written.
     """
     progress = progress or Progress()
     pointing = pointing or PointingSpec()
     if plan is None:
-        plan = plan_run(scenario, pointing, outputs)
+        plan = plan_run(scenario, pointing, outputs, horizon=False)
     check_fits(plan.budget, out_dir)
     folder = claim(out_dir, OUTPUT_NAMES)
     written: dict[str, Any] = {}
 
     def build(tmp: Path) -> list[str]:
-        written["summary"], files = _build(plan, tmp, source, progress, chunk_samples)
+        written["summary"], files = _build(plan, tmp, source, progress, chunk_samples, horizon)
         return files
 
     folder.write(build, source, __version__)
@@ -279,13 +285,35 @@ class _Stream:
 
 
 def _build(
-    plan: RunPlan, tmp: Path, source: str, progress: Progress, chunk_samples: int = CHUNK_SAMPLES
+    plan: RunPlan,
+    tmp: Path,
+    source: str,
+    progress: Progress,
+    chunk_samples: int = CHUNK_SAMPLES,
+    horizon: Beside[ValidityHorizon] | None = None,
 ) -> tuple[dict[str, Any], list[str]]:
     """Stream ``plan``'s outputs into ``tmp``: (summary, file names).
 
     In order: the output grid streamed into the time series and the figures'
     envelopes; the pointing's exact search (intervals.csv, the summary's pointing); the
-    AEM over its own records; the figures; summary.json and the page."""
+    AEM over its own records; the figures; summary.json and the page.  A validity
+    horizon the plan left to the run is computed meanwhile in a process beside this one
+    (:class:`attitude.beside.Beside`: the machine's other core), for the summary."""
+    started = None if horizon is not None else horizon_beside(plan)
+    if started is None:
+        return _build_with(plan, horizon, tmp, source, progress, chunk_samples)
+    with started:
+        return _build_with(plan, started, tmp, source, progress, chunk_samples)
+
+
+def _build_with(
+    plan: RunPlan,
+    horizon: Beside[ValidityHorizon] | None,
+    tmp: Path,
+    source: str,
+    progress: Progress,
+    chunk_samples: int,
+) -> tuple[dict[str, Any], list[str]]:
     outputs = plan.outputs
     texts = EpochTexts(plan.scenario.epoch)
     pointing = None if plan.pointing.is_empty else _Pointing(plan)
@@ -305,6 +333,9 @@ def _build(
     if "plots" in outputs:
         progress("plotting")
         images = _plots(plan, tmp, stream, pointing, analysis)
+    if horizon is not None:
+        # The same key, at the same place in the summary, with the horizon filled in.
+        summary["torques"] = torques_summary(replace(plan, horizon=horizon.result()))
     progress("writing summary.json" + (" and report.html" if "report" in outputs else ""))
     write_json(tmp / "summary.json", summary)
     files.append("summary.json")

@@ -20,6 +20,7 @@ import math
 from dataclasses import dataclass, field
 
 from attitude.aem_sampling import AemPlan, plan_aem
+from attitude.beside import Beside
 from attitude.csv_files import pointing_column_count
 from attitude.errors import InputError
 from attitude.horizon import ValidityHorizon, validity_horizon
@@ -31,7 +32,7 @@ from attitude.scenario import Scenario
 from attitude.timeseries_parquet import check_span
 from attitude.trajectory import Trajectory, propagate
 
-__all__ = ["RunPlan", "plan_run"]
+__all__ = ["RunPlan", "horizon_beside", "plan_run"]
 
 
 @dataclass
@@ -48,20 +49,22 @@ class RunPlan:
     aem: AemPlan | None = None
     search: SearchGrid | None = None  # the pointing's exact search (None without pointing)
     horizon: ValidityHorizon | None = None  # torque-free with an orbit: how long it holds
+    # The horizon is wanted but left for the run to compute (plan_run(horizon=False)).
+    horizon_deferred: bool = False
 
 
 def plan_run(
     scenario: Scenario,
     pointing: PointingSpec | None = None,
     outputs: OutputChoice | None = None,
-    *,
     horizon: bool = True,
 ) -> RunPlan:
     """Check ``scenario`` (``pointing``, ``outputs``) as a run would, up to the sampling.
 
-    ``horizon=False`` leaves out the validity horizon of a torque-free scenario on an
-    orbit (a torqued propagation beside the exact one: seconds), which Monte Carlo
-    samples do not report."""
+    ``horizon=False``: the validity horizon, when there is one, is not computed here
+    (``horizon_deferred`` says it is wanted): a run computes it beside its outputs
+    (``attitude.report``), since it checks nothing and takes as long as a day's outputs.
+    """
     pointing = pointing or PointingSpec()
     outputs = outputs or OutputChoice()
     samples = scenario.output_count()
@@ -89,9 +92,10 @@ def plan_run(
             f"torques: the propagation has no finite error estimate ({errors}): "
             "give a smaller step or an accuracy"
         )
-    held = None
-    if horizon and pointing.orbit is not None and not scenario.torques.any:
-        held = validity_horizon(trajectory, pointing.orbit)
+    found = None
+    wanted = pointing.orbit is not None and not scenario.torques.any
+    if wanted and horizon:
+        found = validity_horizon(trajectory, pointing.orbit)
     aem = None
     if "aem" in outputs:
         aem = plan_aem(
@@ -112,5 +116,26 @@ def plan_run(
         pointing_columns=columns,
     )
     return RunPlan(
-        scenario, pointing, trajectory, motion, budget, notes, outputs, aem, search, held
+        scenario,
+        pointing,
+        trajectory,
+        motion,
+        budget,
+        notes,
+        outputs,
+        aem,
+        search,
+        found,
+        horizon_deferred=wanted and not horizon,
     )
+
+
+def horizon_beside(plan: RunPlan) -> Beside[ValidityHorizon] | None:
+    """The validity horizon ``plan`` left to the run, started now in a process beside
+    this one (:class:`attitude.beside.Beside`; use it as a context manager), or None
+    when the plan has none to compute.  The command line starts it before it imports
+    the writers and the plots, so that the horizon, the longest single job of a
+    one-day report, starts as early as it can."""
+    if not plan.horizon_deferred:
+        return None
+    return Beside(validity_horizon, plan.trajectory, plan.pointing.orbit)

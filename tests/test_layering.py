@@ -55,6 +55,7 @@ LAYERS = [
         "output_budget",
         "run_plan",
         "torques_summary",
+        "beside",
         "output_folder",
         "report",
     ],
