@@ -390,9 +390,7 @@ def _interval_kinds(analysis: PointingAnalysis) -> list[tuple[str, str, list[Int
 _INTERVAL_ROWS_AT_A_TIME = 16384
 
 
-def write_intervals_csv(
-    path: Path, analysis: PointingAnalysis, iso, preamble: list[str]
-) -> None:
+def write_intervals_csv(path: Path, analysis: PointingAnalysis, iso, preamble: list[str]) -> None:
     """One row per interval: kind, body vector, start and end (ISO and TT s), duration;
     sorted by kind, body vector and start.
 

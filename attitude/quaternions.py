@@ -26,4 +26,3 @@ def right_matrix(b: ArrayLike) -> NDArray[np.float64]:
     """The 4×4 matrix R(b) such that a ⊗ b = R(b) a."""
     w, x, y, z = np.asarray(b, dtype=np.float64)
     return np.array([[w, -x, -y, -z], [x, w, z, -y], [y, -z, w, x], [z, y, -x, w]])
-

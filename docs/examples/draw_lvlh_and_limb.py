@@ -32,16 +32,27 @@ ax.plot(r * np.cos(theta), r * np.sin(theta), color="0.6", lw=1)
 
 def arrow(direction, length, color):
     end = sc + length * np.asarray(direction)
-    ax.add_patch(FancyArrowPatch(sc, end, arrowstyle="-|>", mutation_scale=16, color=color,
-                                 lw=2, zorder=4))
+    ax.add_patch(
+        FancyArrowPatch(sc, end, arrowstyle="-|>", mutation_scale=16, color=color, lw=2, zorder=4)
+    )
     return end
 
 
 def angle_arc(radius, start, stop, color, lw=1.2):
     """An arc about the spacecraft between directions ``start`` and ``stop`` (radians from
     nadir, towards +x of the page)."""
-    ax.add_patch(Arc(sc, 2 * radius, 2 * radius, theta1=-90 + math.degrees(start),
-                     theta2=-90 + math.degrees(stop), color=color, lw=lw, zorder=3))
+    ax.add_patch(
+        Arc(
+            sc,
+            2 * radius,
+            2 * radius,
+            theta1=-90 + math.degrees(start),
+            theta2=-90 + math.degrees(stop),
+            color=color,
+            lw=lw,
+            zorder=3,
+        )
+    )
 
 
 red, blue, green = "#c0392b", "#3f78b5", "#1e8449"
