@@ -379,14 +379,15 @@ def _advance_many(
             (a, b, c), s = _step_in_formula_frame(formula, states.G[picked], τ[picked], np)
             m_frame[picked] = np.stack([a, b, c], axis=-1)
             step[picked] = np.stack(s, axis=-1)
-    rows = np.arange(n)[:, None]
-    m_new = np.zeros((n, 3))
-    m_new[rows, states.index] = states.sign * m_frame
-    v = np.zeros((n, 3))
-    v[rows, states.index] = states.sign * step[:, 1:]
+    # Back to the body, x_body[index[k]] = sign[k] x_frame[k], by flat indices.
+    flat = states.index + 3 * np.arange(n)[:, None]
+    m_new = np.empty((n, 3))
+    m_new.put(flat, states.sign * m_frame)
+    v = np.empty((n, 3))
+    v.put(flat, states.sign * step[:, 1:])
     q_new = np.stack(_hamilton(tuple(q.T), (step[:, 0], *v.T)), axis=-1)
-    finite = np.isfinite(q_new).all(axis=1) & np.isfinite(m_new).all(axis=1)
-    if not finite.all():
+    if not (np.isfinite(q_new).all() and np.isfinite(m_new).all()):
+        finite = np.isfinite(q_new).all(axis=1) & np.isfinite(m_new).all(axis=1)
         bad = int(np.flatnonzero(~finite)[0])
         raise InputError(_too_far(float(τ[bad]), f"[{first + bad}]"))
     return m_new, q_new / np.linalg.norm(q_new, axis=1, keepdims=True)

@@ -197,7 +197,7 @@ def _double_double(m1: Any, m2: Any, m3: Any, c: MomentConstants):
     representable = (m == 0.0) | (np.abs(m) >= _SMALLEST_SCALED)
     valid = representable.all(axis=0) & c.valid
 
-    sq = _two_prod(m, m)  # m_k², exact
+    sq = _two_prod_split(m, _split_float(m))  # m_k², exact (m split once)
     # The six terms m_k² I_kj I_l: m1² I21 I3 and m3² I32 I1 (Δ2), m1² I31 I2 and
     # m2² I32 I1 (−Δ3), m2² I21 I3 and m3² I31 I2 (Δ1), all scaled.
     k = [0, 2, 0, 1, 1, 2]
