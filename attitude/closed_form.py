@@ -60,13 +60,14 @@ from numpy.typing import NDArray
 
 from attitude.elliptic import NEAR_ONE_MC, JacobiParameter, amplitude
 from attitude.float_math import FLOAT
-from attitude.invariants import Invariants, invariants
+from attitude.invariants import Invariants, MomentConstants, invariants
 
 __all__ = [
     "CaseFormula",
     "Elliptic",
     "Rest",
     "Separatrix",
+    "SortedMoments",
     "Steady",
     "p_quaternion",
     "y_times_p",
@@ -501,43 +502,49 @@ class OneState:
 class ManyStates:
     """The case formulas of a batch of states, grouped by case, on numpy arrays.
 
-    ``moments`` (N, 3) and ``momentum`` (N, 3) as in ``OneState``.  ``groups`` lists
+    ``moments`` (N, 3) and ``momentum`` (N, 3) as in ``OneState``; ``sorted_moments``,
+    ``SortedMoments(moments)`` if the caller keeps it.  ``groups`` lists
     (indices, formula) with one formula per case present (the elliptic cases split by
     the regime of their kernels, mc above or below ``NEAR_ONE_MC``); ``index`` and
     ``sign`` (N, 3) are the signed permutations to each state's P-frame.
 
-    In the steps of the module docstring: sorted (``_sorted_rows``, step 1), each
+    In the steps of the module docstring: sorted (``SortedMoments``, step 1), each
     state's case (``_cases``), the preferred flips (``_preferred_flips_per_case``,
     step 2), the formulas (``_group_formulas``: an elliptic rate that underflows makes
     the state steady) and the relabelling into the P-frame (``_relabel``, step 3).
     """
 
-    def __init__(self, moments: np.ndarray, momentum: np.ndarray) -> None:
-        (I1, I2, I3), (m1, m2, m3), order, odd = _sorted_rows(moments, momentum)
-        sorted_signs = np.ones((moments.shape[0], 3))
-        sorted_signs[:, 1] = np.where(odd, -1.0, 1.0)
-        m2 = sorted_signs[:, 1] * m2
+    def __init__(
+        self, moments: np.ndarray, momentum: np.ndarray, sorted_moments: SortedMoments | None = None
+    ) -> None:
+        if sorted_moments is None:
+            sorted_moments = SortedMoments(moments)
+        I1, I2, I3 = sorted_moments.I
+        order, sorted_signs = sorted_moments.order, sorted_moments.sorted_signs
+        m_sorted = momentum.take(sorted_moments.flat_order)  # its rows permuted alike
+        m1, m2, m3 = m_sorted[:, 0], sorted_signs[:, 1] * m_sorted[:, 1], m_sorted[:, 2]
         m = np.stack([m1, m2, m3], axis=-1)
         G = norm(m1, m2, m3, np)
         self.G = G
-        case, inv = _cases(I1, I2, I3, m1, m2, m3, G)
+        case, inv = _cases(I1, I2, I3, m1, m2, m3, G, sorted_moments.constants)
         flips = _preferred_flips_per_case(case, m1, m3)
         m = flips * m
         self.groups = _group_formulas((I1, I2, I3), m, G, inv, case, flips)
         self.index, self.sign = _relabel(case, order, flips, sorted_signs)
 
 
-def _cases(I1: Any, I2: Any, I3: Any, m1: Any, m2: Any, m3: Any, G: Any):
+def _cases(I1: Any, I2: Any, I3: Any, m1: Any, m2: Any, m3: Any, G: Any, constants: Any):
     """Each state's case code (``_CODE``: rest for G = 0, steady for the sphere I1 = I3,
     else i, ii or iii by the sign of Δ2) and its invariants δ1, δ3, mc, log mc (zeros and
-    NaNs where the case has none; ``sign`` left out)."""
+    NaNs where the case has none; ``sign`` left out).  ``constants``: a callable giving
+    the moments' ``MomentConstants`` (``SortedMoments.constants``)."""
     N = G.shape[0]
     case = np.full(N, _CODE["rest"], dtype=np.int8)
     sphere = (G > 0.0) & (I1 == I3)
     general = (G > 0.0) & ~sphere
     case[sphere] = _CODE["steady"]
     if general.all():  # the usual batch: no gather
-        inv = invariants(I1, I2, I3, m1, m2, m3, np)
+        inv = invariants(I1, I2, I3, m1, m2, m3, np, constants())
         case = np.where(
             inv.sign < 0.0, _CODE["i"], np.where(inv.sign > 0.0, _CODE["ii"], _CODE["iii"])
         ).astype(np.int8)
@@ -644,35 +651,50 @@ def _relabel(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Step 3: the signed permutations (N, 3) to each state's P-frame,
     P[k] = r_sign[k] f[r_index[k]] s[r_index[k]] principal[order[r_index[k]]]."""
-    r_index = _RELABEL_INDEX[case]
-    index = np.take_along_axis(order, r_index, axis=1)
-    sign = (
-        _RELABEL_SIGN[case]
-        * np.take_along_axis(flips, r_index, axis=1)
-        * np.take_along_axis(sorted_signs, r_index, axis=1)
-    )
+    # Flat indices into the rows (N, 3): one gather each, cheaper than take_along_axis.
+    flat = _RELABEL_INDEX[case] + 3 * np.arange(case.shape[0])[:, None]
+    index = order.take(flat)
+    sign = _RELABEL_SIGN[case] * flips.take(flat) * sorted_signs.take(flat)
     return index, sign
 
 
-def _sorted_rows(moments: np.ndarray, momentum: np.ndarray):
-    """Each row's moments sorted (stably) and its momentum permuted alike, as columns:
-    (I1, I2, I3), (m1, m2, m3), the permutation (N, 3) and its parity.  A sorting
-    network of three compare-exchanges over columns (bubble sort, stable), several
-    times cheaper than ``argsort`` along rows of three."""
-    Is = [moments[:, 0], moments[:, 1], moments[:, 2]]
-    M = [momentum[:, 0], momentum[:, 1], momentum[:, 2]]
-    N = moments.shape[0]
-    index = [np.zeros(N, np.intp), np.ones(N, np.intp), np.full(N, 2, np.intp)]
-    odd = np.zeros(N, dtype=bool)
-    for a, b in ((0, 1), (1, 2), (0, 1)):
-        swap = Is[a] > Is[b]
-        for column in (Is, M, index):
-            column[a], column[b] = (
-                np.where(swap, column[b], column[a]),
-                np.where(swap, column[a], column[b]),
-            )
-        odd ^= swap
-    return Is, M, np.stack(index, axis=-1), odd
+class SortedMoments:
+    """The moments of a batch sorted, step 1 of the module docstring, with what the case
+    test needs of them alone (``constants``): built once for a batch whose moments stay
+    while its momenta change (attitude.free_flow.UnitBatch), and by ``ManyStates``
+    otherwise.
+
+    ``I``: the sorted moments as columns (I1, I2, I3); ``order`` (N, 3): the stable
+    permutation that sorts each row; ``sorted_signs`` (N, 3): the middle axis reversed
+    for an odd permutation.  A sorting network of three compare-exchanges over columns
+    (bubble sort, stable), several times cheaper than ``argsort`` along rows of three.
+    """
+
+    def __init__(self, moments: np.ndarray) -> None:
+        Is = [moments[:, 0], moments[:, 1], moments[:, 2]]
+        N = moments.shape[0]
+        index = [np.zeros(N, np.intp), np.ones(N, np.intp), np.full(N, 2, np.intp)]
+        odd = np.zeros(N, dtype=bool)
+        for a, b in ((0, 1), (1, 2), (0, 1)):
+            swap = Is[a] > Is[b]
+            for column in (Is, index):
+                column[a], column[b] = (
+                    np.where(swap, column[b], column[a]),
+                    np.where(swap, column[a], column[b]),
+                )
+            odd ^= swap
+        self.I = tuple(Is)
+        self.order = np.stack(index, axis=-1)
+        self.flat_order = self.order + 3 * np.arange(N)[:, None]  # into a flat (N, 3) array
+        self.sorted_signs = np.ones((N, 3))
+        self.sorted_signs[:, 1] = np.where(odd, -1.0, 1.0)
+        self._constants: MomentConstants | None = None
+
+    def constants(self) -> MomentConstants:
+        """The double-double constants of the sorted moments (made on first use)."""
+        if self._constants is None:
+            self._constants = MomentConstants(*self.I)
+        return self._constants
 
 
 # The relabelling of each case as arrays indexed by a small integer code, for batches.

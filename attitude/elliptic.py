@@ -160,15 +160,15 @@ def _agm(mc: Any, xp: Any) -> tuple[list, list, Any, Any]:
     levels = np.zeros(np.shape(mc), dtype=np.intp)
     c_final = np.zeros(np.shape(mc))
     pending = np.ones(np.shape(mc), dtype=bool)
-    for level in range(1, 41):
+    for _ in range(40):
         a_seq.append(a)
         emc = np.sqrt(emc)
         b_seq.append(emc)
         c = 0.5 * (a + emc)
+        levels += pending  # each element counts the levels it runs, its last included
         now = pending & (abs(a - emc) <= _AGM_TOLERANCE * a)
         if now.any():
-            levels[now] = level
-            c_final[now] = c[now] if np.ndim(c) else c
+            np.copyto(c_final, c, where=now)  # masked copies: no gather, no scatter
             pending &= ~now
             if not pending.any():
                 return a_seq, b_seq, c_final, levels
@@ -469,7 +469,7 @@ def _cel(kc: Any, p: Any, a: Any, b: Any, xp: Any = np) -> Any:
     p = sqrt(p)
     a = a + 0.0 * kc
     b = b / p
-    result = pending = None
+    final = pending = None
     for _ in range(40):
         f = a
         a = a + b / p
@@ -483,15 +483,20 @@ def _cel(kc: Any, p: Any, a: Any, b: Any, xp: Any = np) -> Any:
             if converged:
                 return (0.5 * math.pi) * (a * mean + b) / (mean * (mean + p))
         else:
-            # Each element's value at its own convergence, as for one state alone.
-            if result is None:
-                result, pending = np.empty(np.shape(converged)), np.ones(np.shape(converged), bool)
+            # Each element's a, b, mean, p at its own convergence, as for one state
+            # alone; the result is formed from them once, at the end.
+            if final is None:
+                shape = np.shape(converged)
+                final = [np.empty(shape) for _ in range(4)]
+                pending = np.ones(shape, bool)
             now = converged & pending
             if now.any():
-                result[now] = ((0.5 * math.pi) * (a * mean + b) / (mean * (mean + p)))[now]
+                for kept, value in zip(final, (a, b, mean, p), strict=True):
+                    np.copyto(kept, value, where=now)
                 pending &= ~now
                 if not pending.any():
-                    return result
+                    a, b, mean, p = final
+                    return (0.5 * math.pi) * (a * mean + b) / (mean * (mean + p))
         kc = 2.0 * sqrt(e)
         e = kc * mean
     raise ArithmeticError("cel did not converge")  # pragma: no cover  (8 steps at 2^-128)

@@ -30,12 +30,19 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from attitude.closed_form import ManyStates, OneState, Rest, p_quaternion, y_times_p
+from attitude.closed_form import (
+    ManyStates,
+    OneState,
+    Rest,
+    SortedMoments,
+    p_quaternion,
+    y_times_p,
+)
 from attitude.errors import InputError
 from attitude.float_math import FLOAT
 from attitude.quantities import as_si_array
 
-__all__ = ["advance", "advance_floats", "advance_unit_batch"]
+__all__ = ["UnitBatch", "advance", "advance_floats", "advance_unit_batch"]
 
 # Below this many states a batch runs one state at a time on floats (see advance).
 _SMALL_BATCH = 36
@@ -135,32 +142,68 @@ def advance_unit_batch(
     Only the momentum is checked (finite; the rest comes from a previous step), so that
     a step costs the flow itself; the results are those of ``advance`` on the same
     arrays to rounding (``advance`` normalizes the quaternions first).  Fewer than
-    ``_SMALL_BATCH`` states run one by one on floats, as in ``advance``.
+    ``_SMALL_BATCH`` states run one by one on floats, as in ``advance``.  A caller
+    whose moments stay from call to call keeps a ``UnitBatch`` instead (same bits).
     """
-    if not np.isfinite(angular_momentum).all():
-        k = int(np.flatnonzero(~np.isfinite(angular_momentum).all(axis=1))[0])
-        raise InputError(
-            f"the free flow needs a finite state, got angular_momentum[{k}] "
-            f"{angular_momentum[k].tolist()}"
+    return UnitBatch(moments).advance(angular_momentum, quaternion_wxyz, dt)
+
+
+class UnitBatch:
+    """``advance_unit_batch`` for a batch whose moments stay from call to call (the
+    spacecraft of attitude.torqued_solver.propagate_batch, kicked between flows).
+
+    What depends on the moments alone, their sorting and the moment factors of the
+    case test (attitude.closed_form.SortedMoments), is computed once here rather than
+    in every flow; each flow gives the bits of ``advance_unit_batch``.
+    """
+
+    def __init__(self, moments: NDArray[np.float64]) -> None:
+        self.moments = moments  # (N, 3), positive
+        n = moments.shape[0]
+        self._sorted = (
+            None
+            if n < _SMALL_BATCH
+            else [SortedMoments(moments[start : start + _CHUNK]) for start in range(0, n, _CHUNK)]
         )
-    n = moments.shape[0]
-    m_new, q_new = np.empty((n, 3)), np.empty((n, 4))
-    if n < _SMALL_BATCH:  # as in advance: state by state on floats
-        for k in range(n):
-            m_new[k], q_new[k] = _advance_one(
-                tuple(moments[k].tolist()),
-                tuple(angular_momentum[k].tolist()),
-                tuple(quaternion_wxyz[k].tolist()),
-                float(dt[k]),
-                f"[{k}]",
+
+    def advance(
+        self,
+        angular_momentum: NDArray[np.float64],
+        quaternion_wxyz: NDArray[np.float64],
+        dt: NDArray[np.float64],
+    ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The states after their steps: arrays (N, 3), (N, 4) and (N,) as in
+        ``advance_unit_batch``, with this batch's moments."""
+        moments = self.moments
+        if not np.isfinite(angular_momentum).all():
+            k = int(np.flatnonzero(~np.isfinite(angular_momentum).all(axis=1))[0])
+            raise InputError(
+                f"the free flow needs a finite state, got angular_momentum[{k}] "
+                f"{angular_momentum[k].tolist()}"
+            )
+        n = moments.shape[0]
+        m_new, q_new = np.empty((n, 3)), np.empty((n, 4))
+        if self._sorted is None:  # as in advance: state by state on floats
+            for k in range(n):
+                m_new[k], q_new[k] = _advance_one(
+                    tuple(moments[k].tolist()),
+                    tuple(angular_momentum[k].tolist()),
+                    tuple(quaternion_wxyz[k].tolist()),
+                    float(dt[k]),
+                    f"[{k}]",
+                )
+            return m_new, q_new
+        for start, sorted_moments in zip(range(0, n, _CHUNK), self._sorted, strict=True):
+            part = slice(start, start + _CHUNK)  # as in advance
+            m_new[part], q_new[part] = _advance_many(
+                moments[part],
+                angular_momentum[part],
+                quaternion_wxyz[part],
+                dt[part],
+                start,
+                sorted_moments,
             )
         return m_new, q_new
-    for start in range(0, n, _CHUNK):  # as in advance
-        part = slice(start, start + _CHUNK)
-        m_new[part], q_new[part] = _advance_many(
-            moments[part], angular_momentum[part], quaternion_wxyz[part], dt[part], start
-        )
-    return m_new, q_new
 
 
 def _as_floats(value: Any, kind: str | None, name: str) -> NDArray[np.float64]:
@@ -312,10 +355,18 @@ def _advance_one(inertia: tuple, m: tuple, q0: tuple, τ: float, at: str = ""):
     return tuple(m_new), (w / norm, x / norm, y / norm, z / norm)
 
 
-def _advance_many(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray, first: int = 0):
+def _advance_many(
+    inertia: NDArray,
+    m: NDArray,
+    q: NDArray,
+    τ: NDArray,
+    first: int = 0,
+    sorted_moments: SortedMoments | None = None,
+):
     """A batch: each case's formula over all of its states at once (``first``: the
-    index of its first state, for messages)."""
-    states = ManyStates(inertia, m)
+    index of its first state, for messages; ``sorted_moments``: ``SortedMoments`` of
+    ``inertia`` if the caller keeps it)."""
+    states = ManyStates(inertia, m, sorted_moments)
     n = inertia.shape[0]
     m_frame = np.zeros((n, 3))
     step = np.zeros((n, 4))
@@ -328,14 +379,15 @@ def _advance_many(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray, first: 
             (a, b, c), s = _step_in_formula_frame(formula, states.G[picked], τ[picked], np)
             m_frame[picked] = np.stack([a, b, c], axis=-1)
             step[picked] = np.stack(s, axis=-1)
-    rows = np.arange(n)[:, None]
-    m_new = np.zeros((n, 3))
-    m_new[rows, states.index] = states.sign * m_frame
-    v = np.zeros((n, 3))
-    v[rows, states.index] = states.sign * step[:, 1:]
+    # Back to the body, x_body[index[k]] = sign[k] x_frame[k], by flat indices.
+    flat = states.index + 3 * np.arange(n)[:, None]
+    m_new = np.empty((n, 3))
+    m_new.put(flat, states.sign * m_frame)
+    v = np.empty((n, 3))
+    v.put(flat, states.sign * step[:, 1:])
     q_new = np.stack(_hamilton(tuple(q.T), (step[:, 0], *v.T)), axis=-1)
-    finite = np.isfinite(q_new).all(axis=1) & np.isfinite(m_new).all(axis=1)
-    if not finite.all():
+    if not (np.isfinite(q_new).all() and np.isfinite(m_new).all()):
+        finite = np.isfinite(q_new).all(axis=1) & np.isfinite(m_new).all(axis=1)
         bad = int(np.flatnonzero(~finite)[0])
         raise InputError(_too_far(float(τ[bad]), f"[{first + bad}]"))
     return m_new, q_new / np.linalg.norm(q_new, axis=1, keepdims=True)

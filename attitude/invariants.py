@@ -38,7 +38,7 @@ import numpy as np
 
 from attitude.float_math import FLOAT
 
-__all__ = ["Invariants", "invariants"]
+__all__ = ["Invariants", "MomentConstants", "invariants"]
 
 _U2 = 2.0**-106  # u², u = 2^-53 the unit roundoff
 _BOUND = 64.0 * _U2  # relative error allowed for each double-double chain (see above)
@@ -123,27 +123,86 @@ def _dd_over_dd(x: tuple, y: tuple) -> tuple[Any, Any]:
 # ----------------------------------------------------------------- the invariants
 
 
-def _double_double(I1: Any, I2: Any, I3: Any, m1: Any, m2: Any, m3: Any):
+def _split_float(b: Any) -> tuple[Any, Any, Any]:
+    """b with its Veltkamp halves: an operand of ``_two_prod_split``, kept when b is a
+    constant of many products (the moments of a batch)."""
+    return (b, *_split(b))
+
+
+def _two_prod_split(a: Any, b: tuple) -> tuple[Any, Any]:
+    """``_two_prod(a, b[0])`` with b given split (``_split_float``): the same operations."""
+    p = a * b[0]
+    ah, al = _split(a)
+    _, bh, bl = b
+    return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
+
+
+def _dd_times_dd_split(x: tuple, y: tuple, y_split: tuple) -> tuple[Any, Any]:
+    """``_dd_times_dd(x, y)`` with y[0] given split (``y_split``)."""
+    p, e = _two_prod_split(x[0], y_split)
+    return _fast_two_sum(p, e + (x[0] * y[1] + x[1] * y[0]))
+
+
+def _dd_times_float_split(x: tuple, b: tuple) -> tuple[Any, Any]:
+    """``_dd_times_float(x, b[0])`` with b given split (``_split_float``)."""
+    p, e = _two_prod_split(x[0], b)
+    return _fast_two_sum(p, e + x[1] * b[0])
+
+
+class MomentConstants:
+    """What the double-double test needs of the sorted moments alone, for a batch.
+
+    The moments scaled by a power of two, their exact differences and the Veltkamp
+    halves of every moment factor of ``_double_double``: computed once for a batch whose
+    moments stay while its momenta change (the torqued solver's spacecraft), they leave
+    the same operations on the momenta, so the same bits.
+    """
+
+    def __init__(self, I1: Any, I2: Any, I3: Any) -> None:
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            moments = np.ldexp(np.stack([I1, I2, I3]), -np.frexp(I3)[1])
+            self.valid = moments[0] >= _SMALLEST_SCALED
+            I_diff = _two_sum(moments[[1, 2, 2]], -moments[[0, 0, 1]])  # I21, I31, I32, exact
+            # The six terms of Δ's (see _double_double): the difference and the third
+            # moment of each.
+            d, other = [0, 2, 1, 2, 0, 1], [2, 0, 1, 0, 2, 1]
+            self.t_diff = (I_diff[0][d], I_diff[1][d])
+            self.t_diff_split = _split_float(self.t_diff[0])
+            self.t_other = _split_float(moments[other])
+            self.G2_factors = (_split_float(moments[[1, 0]]), _split_float(moments[[2, 1]]))
+            self.I2 = _split_float(moments[1])
+            self.I31 = (I_diff[0][1], I_diff[1][1])
+            self.I31_split = _split_float(I_diff[0][1])
+            # Case (i) and case (ii) factors of mc's denominator: I3 and I21, I1 and I32.
+            self.I_other = (_split_float(moments[2]), _split_float(moments[0]))
+            self.I_d = ((I_diff[0][0], I_diff[1][0]), (I_diff[0][2], I_diff[1][2]))
+            self.I_d_split = (_split_float(I_diff[0][0]), _split_float(I_diff[0][2]))
+
+
+def _select(case_i: Any, when_i: tuple, when_ii: tuple) -> tuple:
+    return tuple(np.where(case_i, a, b) for a, b in zip(when_i, when_ii, strict=True))
+
+
+def _double_double(m1: Any, m2: Any, m3: Any, c: MomentConstants):
     """Δ's in double-double, with the certainty of the sign of Δ2 and of mc's rounding.
 
     Returns (sign, δ1, δ3, mc, log_mc, certain); where ``certain`` is False the other
     values are to be replaced by the exact path.  Arrays of a batch: the like terms are
-    stacked, so that each double-double operation is one numpy call over all of them.
+    stacked, so that each double-double operation is one numpy call over all of them;
+    ``c`` holds what depends on the moments alone.
     """
-    # Exact scaling by powers of two (Δ's ratios are scale-free).
-    moments = np.ldexp(np.stack([I1, I2, I3]), -np.frexp(I3)[1])
+    # Exact scaling by powers of two (Δ's ratios are scale-free); the moments' in ``c``.
     m = np.stack([m1, m2, m3])
     m = np.ldexp(m, -np.frexp(np.max(np.abs(m), axis=0))[1])
     representable = (m == 0.0) | (np.abs(m) >= _SMALLEST_SCALED)
-    valid = representable.all(axis=0) & (moments[0] >= _SMALLEST_SCALED)
+    valid = representable.all(axis=0) & c.valid
 
-    sq = _two_prod(m, m)  # m_k², exact
-    I_diff = _two_sum(moments[[1, 2, 2]], -moments[[0, 0, 1]])  # I21, I31, I32, exact
+    sq = _two_prod_split(m, _split_float(m))  # m_k², exact (m split once)
     # The six terms m_k² I_kj I_l: m1² I21 I3 and m3² I32 I1 (Δ2), m1² I31 I2 and
     # m2² I32 I1 (−Δ3), m2² I21 I3 and m3² I31 I2 (Δ1), all scaled.
-    k, d, other = [0, 2, 0, 1, 1, 2], [0, 2, 1, 2, 0, 1], [2, 0, 1, 0, 2, 1]
-    t = _dd_times_float(
-        _dd_times_dd((sq[0][k], sq[1][k]), (I_diff[0][d], I_diff[1][d])), moments[other]
+    k = [0, 2, 0, 1, 1, 2]
+    t = _dd_times_float_split(
+        _dd_times_dd_split((sq[0][k], sq[1][k]), c.t_diff, c.t_diff_split), c.t_other
     )
     # I1 I3 Δ2 = t3 − t1, I1 I2 (−Δ3) and I2 I3 Δ1: sums of two terms (of one sign for
     # the last two).
@@ -161,22 +220,22 @@ def _double_double(I1: Any, I2: Any, I3: Any, m1: Any, m2: Any, m3: Any):
         # δ1 = Δ1/G² = N1/(I2 I3 G²), δ3 = −P3/(I1 I2 G²): faithful, nearly always the
         # correctly rounded values of the exact path (a few ulps off would be amplified
         # next to the separatrix, where the batch must agree with one state alone).
-        G2_I = _dd_times_float(
-            _dd_times_float((np.stack([G2[0], G2[0]]), np.stack([G2[1], G2[1]])), moments[[1, 0]]),
-            moments[[2, 1]],
+        G2_I = _dd_times_float_split(
+            _dd_times_float_split(
+                (np.stack([G2[0], G2[0]]), np.stack([G2[1], G2[1]])), c.G2_factors[0]
+            ),
+            c.G2_factors[1],
         )
         δ = _dd_over_dd((np.stack([N1[0], P3[0]]), np.stack([N1[1], P3[1]])), G2_I)[0]
         δ1, δ3 = δ[0], -δ[1]
     # mc = |N2| I2 I31 / (I3 P3 I21) in case (i), |N2| I2 I31 / (I1 N1 I32) in case (ii).
     N2_abs = (np.abs(N2[0]), np.copysign(1.0, N2[0]) * N2[1])
-    numerator = _dd_times_dd(_dd_times_float(N2_abs, moments[1]), (I_diff[0][1], I_diff[1][1]))
+    numerator = _dd_times_dd_split(_dd_times_float_split(N2_abs, c.I2), c.I31, c.I31_split)
     D = (np.where(case_i, P3[0], N1[0]), np.where(case_i, P3[1], N1[1]))
-    I_other = np.where(case_i, moments[2], moments[0])
-    I_d = (
-        np.where(case_i, I_diff[0][0], I_diff[0][2]),
-        np.where(case_i, I_diff[1][0], I_diff[1][2]),
-    )
-    denominator = _dd_times_dd(_dd_times_float(D, I_other), I_d)
+    I_other = _select(case_i, *c.I_other)
+    I_d = _select(case_i, *c.I_d)
+    I_d_split = _select(case_i, *c.I_d_split)
+    denominator = _dd_times_dd_split(_dd_times_float_split(D, I_other), I_d, I_d_split)
     with np.errstate(divide="ignore", invalid="ignore"):
         mc, mc_low = _dd_over_dd(numerator, denominator)
         # Relative error: that of N2 plus the chains' (four products, a sum, a quotient).
@@ -189,17 +248,29 @@ def _double_double(I1: Any, I2: Any, I3: Any, m1: Any, m2: Any, m3: Any):
     return sign, δ1, δ3, mc, log_mc, certain
 
 
-def invariants(I1: Any, I2: Any, I3: Any, m1: Any, m2: Any, m3: Any, xp: Any = np) -> Invariants:
+def invariants(
+    I1: Any,
+    I2: Any,
+    I3: Any,
+    m1: Any,
+    m2: Any,
+    m3: Any,
+    xp: Any = np,
+    constants: MomentConstants | None = None,
+) -> Invariants:
     """The invariants of states with sorted moments I1 ≤ I2 ≤ I3 (I1 < I3) and m ≠ 0.
 
-    Floats with ``xp = FLOAT``, 1-D arrays of a batch with ``xp = numpy``.
+    Floats with ``xp = FLOAT``, 1-D arrays of a batch with ``xp = numpy``; ``constants``:
+    ``MomentConstants(I1, I2, I3)`` if the caller keeps it (built here otherwise).
     """
     if xp is FLOAT:
         # On one state in Python, the integers (~8 µs) cost less than the
         # double-double (~18 µs), and they are exact.
         return _ExactΔ(I1, I2, I3, m1, m2, m3).invariants()
+    if constants is None:
+        constants = MomentConstants(I1, I2, I3)
     with np.errstate(over="ignore", under="ignore", invalid="ignore", divide="ignore"):
-        sign, δ1, δ3, mc, log_mc, certain = _double_double(I1, I2, I3, m1, m2, m3)
+        sign, δ1, δ3, mc, log_mc, certain = _double_double(m1, m2, m3, constants)
     for k in np.flatnonzero(~certain):
         exact = _ExactΔ(I1[k], I2[k], I3[k], m1[k], m2[k], m3[k]).invariants()
         sign[k], δ1[k], δ3[k], mc[k], log_mc[k] = (

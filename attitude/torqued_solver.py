@@ -40,7 +40,7 @@ from scipy.spatial.transform import Rotation
 
 from attitude.errors import InputError
 from attitude.euler_solver import EulerSolver
-from attitude.free_flow import advance_floats, advance_unit_batch
+from attitude.free_flow import UnitBatch, advance_floats
 from attitude.inertia import principal_axes
 from attitude.quantities import as_si_array, as_si_scalar, as_vector3
 from attitude.splitting import Composition, composition
@@ -100,6 +100,7 @@ class _Engine:
         self.clock = method.kick_clock
         self.kicks = [j for j, b in enumerate(method.kicks) if b != 0.0]
         self.flows = 0  # free-flow calls made (for benchmarks)
+        self.unit_batch: UnitBatch | None = None  # the batch's free flow (see flow)
 
     # ---- the two maps
 
@@ -110,15 +111,16 @@ class _Engine:
             return advance_floats(self.moment_floats, m, q, dt)
         m_array = np.stack(np.broadcast_arrays(*m), axis=-1)
         n = m_array.shape[0]
+        if self.unit_batch is None or self.unit_batch.moments.shape[0] != n:
+            # The moments stay from flow to flow: what depends on them alone, once.
+            self.unit_batch = UnitBatch(np.broadcast_to(self.moments, (n, 3)))
         # Every argument at its full (N, ...) shape: the free flow need not broadcast.
-        arguments = (
-            np.broadcast_to(self.moments, (n, 3)),
+        # Straight to the flow: its states come from the last step, checked there.
+        m_new, q_new = self.unit_batch.advance(
             m_array,
             np.stack(np.broadcast_arrays(*q), axis=-1),
             np.broadcast_to(np.asarray(dt, dtype=np.float64), (n,)),
         )
-        # Straight to the flow: its states come from the last step, checked there.
-        m_new, q_new = advance_unit_batch(*arguments)
         # Components as contiguous rows: the kicks' arithmetic runs on them.
         return tuple(np.ascontiguousarray(m_new.T)), tuple(np.ascontiguousarray(q_new.T))
 

@@ -7,7 +7,9 @@
   a symmetric body computes no R_J.
 - ``free_flow.advance``: a state alone against the same state in a batch of 1e5, and a
   batch evaluated in slices of any size; ``free_flow.advance_floats`` (tuples) against
-  ``advance`` on the same state.
+  ``advance`` on the same state; ``free_flow.UnitBatch`` (its moments' sorting and
+  case-test constants kept from flow to flow) against ``advance_unit_batch`` (all made
+  again in each call), flow after flow with new momenta.
 (The table of ψ's periodic part, the other fast path: test_phase_table_against_mpmath.py.)
 """
 
@@ -179,3 +181,30 @@ def test_the_float_entry_point_gives_the_bits_of_advance():
 def test_the_float_entry_point_refuses_a_non_finite_momentum(bad):
     with pytest.raises(InputError, match="finite"):
         free_flow.advance_floats((1.0, 2.0, 3.0), (0.1, bad, 0.2), (1.0, 0.0, 0.0, 0.0), 1.0)
+
+
+def test_a_unit_batch_kept_over_many_flows_gives_the_bits_of_fresh_calls(monkeypatch):
+    """``UnitBatch`` keeps what depends on the moments alone (sorting, the moment factors
+    of the double-double case test) across flows, as the torqued solver's batch does
+    between kicks: each flow gives the bits of ``advance_unit_batch``, which makes them
+    all again.  Every kind of state of the mixed batch (near and on the separatrix,
+    symmetric, sphere, rest), with momenta that change between flows (the kicks), so
+    that states cross from one case to another under the same moments; and in slices,
+    each with its own constants."""
+    moments, momentum, q, dt, kinds = _mixed_batch(3000, seed=15)
+    q = q / np.linalg.norm(q, axis=1, keepdims=True)
+    monkeypatch.setattr(free_flow, "_CHUNK", 1100)  # three slices, the last a short one
+    unit_batch = free_flow.UnitBatch(moments)
+    rng = np.random.default_rng(16)
+    for flow in range(4):
+        m_kept, q_kept = unit_batch.advance(momentum, q, dt)
+        m_fresh, q_fresh = free_flow.advance_unit_batch(moments.copy(), momentum, q, dt)
+        np.testing.assert_array_equal(m_kept, m_fresh, err_msg=f"flow {flow}")
+        np.testing.assert_array_equal(q_kept, q_fresh, err_msg=f"flow {flow}")
+        # A kick: the momenta of a third of the states move (those at rest stay so, the
+        # others cross cases: the separatrix ones move off it, generic ones may cross it).
+        kicked = rng.random(len(kinds)) < 1.0 / 3.0
+        momentum = np.where(
+            kicked[:, None], m_kept * (1.0 + 0.3 * rng.normal(size=m_kept.shape)), m_kept
+        )
+        q = q_kept
