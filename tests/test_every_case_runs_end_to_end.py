@@ -10,10 +10,10 @@ integration of Euler's equations from the same state (tests/reference_models.py)
 
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
+from csv_read_back import read_csv
 from reference_models import integrate_dop853
 from scipy.spatial.transform import Rotation
 
@@ -56,14 +56,6 @@ CASES = {
         "separatrix",
     ),
 }
-
-
-def _read_csv(path: Path):
-    text = path.read_text()
-    preamble = sum(1 for line in text.splitlines() if line.startswith("#"))
-    return np.genfromtxt(
-        path, delimiter=",", skip_header=preamble, names=True, dtype=None, encoding="utf-8"
-    )
 
 
 @pytest.fixture(scope="module")
@@ -112,7 +104,7 @@ def test_the_summary_says_what_the_motion_is(runs, case):
 @pytest.mark.parametrize("case", list(CASES))
 def test_the_time_series_agrees_with_numerical_integration(runs, case):
     out, summary = runs[case]
-    data = _read_csv(out / "timeseries.csv")
+    data = read_csv(out / "timeseries.csv")
     moments = np.array(CASES[case][0])
     last = summary["motion"]["segments"][-1]
     inside = data["t_s"] >= last["start_s"]

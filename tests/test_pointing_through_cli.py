@@ -14,6 +14,7 @@ import re
 from pathlib import Path
 
 import numpy as np
+from csv_read_back import read_csv
 
 from attitude.cli import main
 
@@ -35,14 +36,6 @@ angular_velocity = {{ value = [0.0, 0.0, 30.0], unit = "deg/s" }}   # 12 s a tur
 duration = 120.0
 step = {step}
 """
-
-
-def _read_csv(path: Path):
-    text = path.read_text()
-    preamble = sum(1 for line in text.splitlines() if line.startswith("#"))
-    return np.genfromtxt(
-        path, delimiter=",", skip_header=preamble, names=True, dtype=None, encoding="utf-8"
-    )
 
 
 def test_an_undersampling_step_is_said_by_check_and_run(tmp_path, capsys):
@@ -69,7 +62,7 @@ def test_the_nadir_pointing_example(tmp_path, capsys):
     assert "Keplerian elements (two-body, ICRF)" in out
     out_dir = tmp_path / "nadir"
     assert main(["run", str(scenario), "--out", str(out_dir), "--quiet"]) == 0
-    data = _read_csv(out_dir / "timeseries.csv")
+    data = read_csv(out_dir / "timeseries.csv")
     assert np.abs(data["camera_nadir_angle_deg"]).max() < 1e-6
     np.testing.assert_allclose(data["q_body_to_lvlh_w"], 1.0, atol=1e-12)
     for k in (1, 2, 3):
@@ -79,7 +72,7 @@ def test_the_nadir_pointing_example(tmp_path, capsys):
     assert tracker["sun_angle_min_deg"] < 40.0 and tracker["sun_exclusion"]["count"] >= 1
     assert tracker["earth_limb_exclusion"]["count"] == 0
     # The least Sun angle falls inside one of the exclusion intervals.
-    intervals = _read_csv(out_dir / "intervals.csv")
+    intervals = read_csv(out_dir / "intervals.csv")
     exclusions = intervals[intervals["kind"] == "sun_exclusion"]
     times = [i for i in exclusions if i["body_vector"] == "star_tracker"]
     least_at = tracker["sun_angle_min_at"]
@@ -101,7 +94,7 @@ def test_an_attitude_reset_in_lvlh(tmp_path, capsys):
     path = tmp_path / "reset.toml"
     path.write_text(text)
     assert main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
-    data = _read_csv(tmp_path / "out" / "timeseries.csv")
+    data = read_csv(tmp_path / "out" / "timeseries.csv")
     after = data["t_s"] >= 600.0
     assert np.abs(data["camera_nadir_angle_deg"][after]).max() < 1e-6
     assert data["camera_nadir_angle_deg"][~after].max() > 1.0

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from aem_read_back import interpolate_as_declared, read_back, rotation_angle
+from csv_read_back import read_csv
 
 from attitude.cli import main
 from attitude.scenario_file import load_scenario
@@ -23,14 +24,6 @@ from attitude.timescales import tt_seconds
 from attitude.trajectory import propagate
 
 SCENARIO = Path(__file__).parents[1] / "scenarios" / "spinner_thruster_pulse.toml"
-
-
-def _read_csv(path: Path):
-    text = path.read_text()
-    preamble = sum(1 for line in text.splitlines() if line.startswith("#"))
-    return np.genfromtxt(
-        path, delimiter=",", skip_header=preamble, names=True, dtype=None, encoding="utf-8"
-    )
 
 
 @pytest.fixture(scope="module")
@@ -78,14 +71,14 @@ def test_every_file_is_written_and_linked(report):
 
 
 def test_incidence_flags_and_intervals_agree(report):
-    data = _read_csv(report / "timeseries.csv")
+    data = read_csv(report / "timeseries.csv")
     fraction = data["sunlit_fraction"]
     for name in ("top_panel", "side_panel", "star_tracker"):
         angle = np.radians(data[f"{name}_sun_angle_deg"])
         np.testing.assert_allclose(
             data[f"{name}_cos_incidence"], np.maximum(np.cos(angle), 0.0) * fraction, atol=1e-12
         )
-    intervals = _read_csv(report / "intervals.csv")
+    intervals = read_csv(report / "intervals.csv")
     t = data["t_s"]
     violation = intervals[(intervals["kind"] == "sun_exclusion")]
     inside = np.zeros(t.size, dtype=bool)
@@ -126,7 +119,7 @@ def test_aem_holds_the_attitude_for_an_independent_parser(report):
     # ccsds-ndm-py is a declared dependency: without it this fails, it does not skip.
     # read_back also checks the norms, the epoch order and START/STOP_TIME.
     segments, message = read_back(report / "attitude.aem")
-    data = _read_csv(report / "timeseries.csv")
+    data = read_csv(report / "timeseries.csv")
     scenario = load_scenario(SCENARIO).scenario
     epoch, trajectory = scenario.epoch, propagate(scenario)
     assert len(message.segments) == 2  # a new segment at the thruster pulse
