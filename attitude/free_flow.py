@@ -25,16 +25,17 @@ permutation, so S⁻¹ ⊗ x ⊗ S is x with its vector part permuted and signed
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from attitude import compiled_flow
 from attitude.closed_form import (
     ManyStates,
     OneState,
     Rest,
-    SortedMoments,
     p_quaternion,
     y_times_p,
 )
@@ -44,7 +45,11 @@ from attitude.quantities import as_si_array
 
 __all__ = ["UnitBatch", "advance", "advance_floats", "advance_unit_batch"]
 
-# Below this many states a batch runs one state at a time on floats (see advance).
+# numba's dispatchers, typed as the callables they are.
+_flow_one: Callable[..., tuple[Any, ...]] = compiled_flow.flow_one
+_flow_many: Callable[..., None] = compiled_flow.flow_many
+
+# Below this many states, those the compiled flow leaves run one at a time on floats.
 _SMALL_BATCH = 36
 # A larger batch runs in slices of this many states: their temporaries stay in cache.
 _CHUNK = 4096
@@ -87,23 +92,16 @@ def advance(
     q = _as_floats(quaternion_wxyz, None, "quaternion_wxyz")
     τ = _as_floats(dt, "time", "dt")
     if inertia.shape == (3,) and m.shape == (3,) and q.shape == (4,) and τ.ndim == 0:
-        m_new, q_new = _advance_one(*_one_state(inertia, m, q, τ))
+        m_new, q_new = _one_compiled(*_one_state(inertia, m, q, τ))
         return np.array(m_new), np.array(q_new)
     inertia, m, q, τ = _broadcast(inertia, m, q, τ)
-    n = inertia.shape[0]
-    if n < _SMALL_BATCH:
-        # numpy's fixed cost (~1 ms for the few hundred calls of a batch) exceeds that
-        # of this many states on the float path (~40 µs each): one at a time.
-        m_new, q_new = np.empty((n, 3)), np.empty((n, 4))
-        for k in range(n):
-            m_new[k], q_new[k] = _advance_one(*_one_state(inertia[k], m[k], q[k], τ[k], k))
-        return m_new, q_new
     q = _checked_batch(inertia, m, q, τ)
-    m_new, q_new = np.empty((n, 3)), np.empty((n, 4))
-    for start in range(0, n, _CHUNK):  # slices whose temporaries stay in cache
-        part = slice(start, start + _CHUNK)
-        m_new[part], q_new[part] = _advance_many(inertia[part], m[part], q[part], τ[part], start)
-    return m_new, q_new
+    return _many_compiled(
+        np.ascontiguousarray(inertia),
+        np.ascontiguousarray(m),
+        q,
+        np.ascontiguousarray(τ),
+    )
 
 
 def advance_floats(
@@ -121,7 +119,7 @@ def advance_floats(
     non-finite state or result raises an InputError.
     """
     try:
-        return _advance_one(moments, angular_momentum, quaternion_wxyz, dt)
+        return _one_compiled(moments, angular_momentum, quaternion_wxyz, dt)
     except (ValueError, OverflowError):  # a NaN or an infinity met by the exact integers
         raise InputError(
             f"the free flow needs a finite state, got angular_momentum {list(angular_momentum)}"
@@ -141,30 +139,17 @@ def advance_unit_batch(
 
     Only the momentum is checked (finite; the rest comes from a previous step), so that
     a step costs the flow itself; the results are those of ``advance`` on the same
-    arrays to rounding (``advance`` normalizes the quaternions first).  Fewer than
-    ``_SMALL_BATCH`` states run one by one on floats, as in ``advance``.  A caller
-    whose moments stay from call to call keeps a ``UnitBatch`` instead (same bits).
+    arrays to rounding (``advance`` normalizes the quaternions first).
     """
     return UnitBatch(moments).advance(angular_momentum, quaternion_wxyz, dt)
 
 
 class UnitBatch:
     """``advance_unit_batch`` for a batch whose moments stay from call to call (the
-    spacecraft of attitude.torqued_solver.propagate_batch, kicked between flows).
-
-    What depends on the moments alone, their sorting and the moment factors of the
-    case test (attitude.closed_form.SortedMoments), is computed once here rather than
-    in every flow; each flow gives the bits of ``advance_unit_batch``.
-    """
+    spacecraft of attitude.torqued_solver.propagate_batch, kicked between flows)."""
 
     def __init__(self, moments: NDArray[np.float64]) -> None:
-        self.moments = moments  # (N, 3), positive
-        n = moments.shape[0]
-        self._sorted = (
-            None
-            if n < _SMALL_BATCH
-            else [SortedMoments(moments[start : start + _CHUNK]) for start in range(0, n, _CHUNK)]
-        )
+        self.moments = np.ascontiguousarray(moments, dtype=np.float64)  # (N, 3), positive
 
     def advance(
         self,
@@ -174,36 +159,58 @@ class UnitBatch:
     ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """The states after their steps: arrays (N, 3), (N, 4) and (N,) as in
         ``advance_unit_batch``, with this batch's moments."""
-        moments = self.moments
         if not np.isfinite(angular_momentum).all():
             k = int(np.flatnonzero(~np.isfinite(angular_momentum).all(axis=1))[0])
             raise InputError(
                 f"the free flow needs a finite state, got angular_momentum[{k}] "
                 f"{angular_momentum[k].tolist()}"
             )
-        n = moments.shape[0]
-        m_new, q_new = np.empty((n, 3)), np.empty((n, 4))
-        if self._sorted is None:  # as in advance: state by state on floats
-            for k in range(n):
-                m_new[k], q_new[k] = _advance_one(
-                    tuple(moments[k].tolist()),
-                    tuple(angular_momentum[k].tolist()),
-                    tuple(quaternion_wxyz[k].tolist()),
-                    float(dt[k]),
-                    f"[{k}]",
-                )
-            return m_new, q_new
-        for start, sorted_moments in zip(range(0, n, _CHUNK), self._sorted, strict=True):
-            part = slice(start, start + _CHUNK)  # as in advance
-            m_new[part], q_new[part] = _advance_many(
-                moments[part],
-                angular_momentum[part],
-                quaternion_wxyz[part],
-                dt[part],
-                start,
-                sorted_moments,
-            )
+        return _many_compiled(
+            self.moments,
+            np.ascontiguousarray(angular_momentum, dtype=np.float64),
+            np.ascontiguousarray(quaternion_wxyz, dtype=np.float64),
+            np.ascontiguousarray(dt, dtype=np.float64),
+        )
+
+
+def _one_compiled(inertia: tuple, m: tuple, q0: tuple, τ: float, at: str = ""):
+    """One state on floats: the compiled flow (attitude.compiled_flow), or the float
+    path of every case (``_advance_one``) for a state that it leaves."""
+    ok, m1, m2, m3, qw, qx, qy, qz = _flow_one(*inertia, *m, *q0, τ)
+    if ok:
+        return (m1, m2, m3), (qw, qx, qy, qz)
+    return _advance_one(inertia, m, q0, τ, at)
+
+
+def _many_compiled(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray):
+    """A checked batch (C-contiguous float64 arrays): the compiled flow over every
+    state, then the states it leaves (attitude.compiled_flow: the separatrix and its
+    neighbourhood, symmetric and steady bodies, rest, mc < 2^-128) down the numpy path
+    of every case, or one by one on floats if they are few."""
+    n = inertia.shape[0]
+    m_new, q_new = np.empty((n, 3)), np.empty((n, 4))
+    ok = np.empty(n, dtype=np.bool_)
+    _flow_many(inertia, m, q, τ, m_new, q_new, ok)
+    if ok.all():
         return m_new, q_new
+    left = np.flatnonzero(~ok)
+    if left.size < _SMALL_BATCH:
+        # numpy's fixed cost (~1 ms for the few hundred calls of a batch) exceeds that
+        # of this many states on the float path (~40 µs each): one at a time.
+        for k in left.tolist():
+            m_k, q_k = _advance_one(
+                tuple(inertia[k].tolist()),
+                tuple(m[k].tolist()),
+                tuple(q[k].tolist()),
+                float(τ[k]),
+                f"[{k}]",
+            )
+            m_new[k], q_new[k] = m_k, q_k
+        return m_new, q_new
+    for start in range(0, left.size, _CHUNK):  # slices whose temporaries stay in cache
+        part = left[start : start + _CHUNK]
+        m_new[part], q_new[part] = _advance_many(inertia[part], m[part], q[part], τ[part], part)
+    return m_new, q_new
 
 
 def _as_floats(value: Any, kind: str | None, name: str) -> NDArray[np.float64]:
@@ -360,13 +367,11 @@ def _advance_many(
     m: NDArray,
     q: NDArray,
     τ: NDArray,
-    first: int = 0,
-    sorted_moments: SortedMoments | None = None,
+    labels: NDArray,
 ):
-    """A batch: each case's formula over all of its states at once (``first``: the
-    index of its first state, for messages; ``sorted_moments``: ``SortedMoments`` of
-    ``inertia`` if the caller keeps it)."""
-    states = ManyStates(inertia, m, sorted_moments)
+    """A batch on numpy arrays: each case's formula over all of its states at once
+    (``labels``: the indices of the states in the caller's batch, for messages)."""
+    states = ManyStates(inertia, m)
     n = inertia.shape[0]
     m_frame = np.zeros((n, 3))
     step = np.zeros((n, 4))
@@ -389,7 +394,7 @@ def _advance_many(
     if not (np.isfinite(q_new).all() and np.isfinite(m_new).all()):
         finite = np.isfinite(q_new).all(axis=1) & np.isfinite(m_new).all(axis=1)
         bad = int(np.flatnonzero(~finite)[0])
-        raise InputError(_too_far(float(τ[bad]), f"[{first + bad}]"))
+        raise InputError(_too_far(float(τ[bad]), f"[{labels[bad]}]"))
     return m_new, q_new / np.linalg.norm(q_new, axis=1, keepdims=True)
 
 

@@ -11,9 +11,24 @@ PACKAGE = Path(__file__).parents[1] / "attitude"
 
 # In order; a module may import modules of its own layer or of earlier ones.
 LAYERS = [
-    ["version", "errors", "quantities", "quaternions", "vectors", "float_math"],  # shared base
-    ["elliptic", "phase_table"],  # elliptic kernels
-    ["inertia", "invariants", "closed_form", "euler_solver", "free_flow"],  # the Euler solver
+    [  # shared base
+        "version",
+        "errors",
+        "quantities",
+        "quaternions",
+        "vectors",
+        "float_math",
+        "compiled_double_double",
+    ],
+    ["elliptic", "compiled_elliptic", "phase_table"],  # elliptic kernels
+    [  # the Euler solver
+        "inertia",
+        "invariants",
+        "closed_form",
+        "euler_solver",
+        "compiled_flow",
+        "free_flow",
+    ],
     ["torques", "splitting", "torqued_solver"],  # torques and splitting
     [  # scenario and events
         "timescales",

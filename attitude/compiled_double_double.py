@@ -1,0 +1,93 @@
+"""Double-double arithmetic on floats, compiled (numba): a float plus its rounding error.
+
+The building blocks of attitude.invariants for one float at a time (attitude.compiled_flow's
+case test, attitude.compiled_elliptic's K): Knuth's and Dekker's error-free sums and
+products (Dekker, "A floating-point technique for extending the available precision",
+Numer. Math. 18, 1971) and the double-word operations of Joldes, Muller and Popescu,
+"Tight and rigorous error bounds for basic building blocks of double-word arithmetic",
+ACM Trans. Math. Softw. 44(2), 2017, doi:10.1145/3121432 (Algorithms 6, 7 and 10; the
+relative error bounds that attitude.invariants uses are theirs).  A double-double is a
+pair (hi, lo) of floats.  Compiled without fast-math, so that no product and sum are
+fused into one rounding (Dekker's product relies on each rounding).
+"""
+
+from __future__ import annotations
+
+import numba
+
+__all__ = [
+    "dd_over_dd",
+    "dd_plus_dd",
+    "dd_times_dd",
+    "dd_times_float",
+    "fast_two_sum",
+    "split",
+    "two_prod",
+    "two_sum",
+]
+
+_jit = numba.njit(cache=True, error_model="numpy", nogil=True)
+
+
+@_jit
+def two_sum(a, b):
+    """s + e = a + b exactly (Knuth)."""
+    s = a + b
+    bb = s - a
+    return s, (a - (s - bb)) + (b - bb)
+
+
+@_jit
+def fast_two_sum(a, b):
+    """s + e = a + b exactly, for |a| ≥ |b| (Dekker)."""
+    s = a + b
+    return s, b - (s - a)
+
+
+@_jit
+def split(a):
+    """a = hi + lo with 26-bit halves (Veltkamp; |a| < 2^995)."""
+    c = 134217729.0 * a  # 2^27 + 1
+    hi = c - (c - a)
+    return hi, a - hi
+
+
+@_jit
+def two_prod(a, b):
+    """p + e = a b exactly (Dekker), barring underflow."""
+    p = a * b
+    ah, al = split(a)
+    bh, bl = split(b)
+    return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
+
+
+@_jit
+def dd_times_dd(x0, x1, y0, y1):
+    """(x0 + x1)(y0 + y1)."""
+    p, e = two_prod(x0, y0)
+    return fast_two_sum(p, e + (x0 * y1 + x1 * y0))
+
+
+@_jit
+def dd_times_float(x0, x1, b):
+    """(x0 + x1) b."""
+    p, e = two_prod(x0, b)
+    return fast_two_sum(p, e + x1 * b)
+
+
+@_jit
+def dd_plus_dd(x0, x1, y0, y1):
+    """(x0 + x1) + (y0 + y1)."""
+    s, e = two_sum(x0, y0)
+    t, f = two_sum(x1, y1)
+    s, e = fast_two_sum(s, e + t)
+    return fast_two_sum(s, e + f)
+
+
+@_jit
+def dd_over_dd(x0, x1, y0, y1):
+    """(x0 + x1)/(y0 + y1)."""
+    q = x0 / y0
+    p0, p1 = dd_times_float(y0, y1, q)
+    r0, _ = dd_plus_dd(x0, x1, -p0, -p1)
+    return fast_two_sum(q, r0 / y0)
