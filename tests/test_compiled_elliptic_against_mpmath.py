@@ -61,7 +61,8 @@ def test_reduced_sn_cn_dn(mc):
     m = mp_parameter(mc)
     K, levels, c, a_seq, b_seq = _K(mc)
     rng = np.random.default_rng(5)
-    r_values = np.concatenate([[0.0, 1e-9, -3e-5, 2e-4, 0.5, K / 2, K * (1 - 1e-12), -K], rng.uniform(-K, K, 20)])
+    special = [0.0, 1e-9, -3e-5, 2e-4, 0.5, K / 2, K * (1 - 1e-12), -K]
+    r_values = np.concatenate([special, rng.uniform(-K, K, 20)])
     for r in r_values:
         ours = reduced_sn_cn_dn(r, mc, K, levels, c, a_seq, b_seq)
         s, co, d = (mp.ellipfun(f, mp.mpf(r), m=m) for f in ("sn", "cn", "dn"))
