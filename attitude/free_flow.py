@@ -31,13 +31,11 @@ permutation, so S⁻¹ ⊗ x ⊗ S is x with its vector part permuted and signed
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from attitude import compiled_flow
 from attitude.closed_form import (
     ManyStates,
     OneState,
@@ -51,9 +49,20 @@ from attitude.quantities import as_si_array
 
 __all__ = ["UnitBatch", "advance", "advance_floats", "advance_unit_batch"]
 
-# numba's dispatchers, typed as the callables they are.
-_flow_one: Callable[..., tuple[Any, ...]] = compiled_flow.flow_one
-_flow_many: Callable[..., None] = compiled_flow.flow_many
+
+_KERNELS: list[Any] = []  # flow_one and flow_many, once imported
+
+
+def _kernels() -> list[Any]:
+    """attitude.compiled_flow's flow_one and flow_many, imported on first use: numba's
+    import and the loading of the compiled code (~0.6 s) are paid only by a process
+    that flows (a run without torques or orbit does not)."""
+    if not _KERNELS:
+        from attitude import compiled_flow
+
+        _KERNELS[:] = [compiled_flow.flow_one, compiled_flow.flow_many]
+    return _KERNELS
+
 
 # Below this many states, those the compiled flow leaves run one at a time on floats.
 _SMALL_BATCH = 36
@@ -182,7 +191,7 @@ class UnitBatch:
 def _one_compiled(inertia: tuple, m: tuple, q0: tuple, τ: float, at: str = ""):
     """One state on floats: the compiled flow (attitude.compiled_flow), or the float
     path of every case (``_advance_one``) for a state that it leaves."""
-    ok, m1, m2, m3, qw, qx, qy, qz = _flow_one(*inertia, *m, *q0, τ)
+    ok, m1, m2, m3, qw, qx, qy, qz = _kernels()[0](*inertia, *m, *q0, τ)
     if ok:
         return (m1, m2, m3), (qw, qx, qy, qz)
     return _advance_one(inertia, m, q0, τ, at)
@@ -196,7 +205,7 @@ def _many_compiled(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray):
     n = inertia.shape[0]
     m_new, q_new = np.empty((n, 3)), np.empty((n, 4))
     ok = np.empty(n, dtype=np.bool_)
-    _flow_many(inertia, m, q, τ, m_new, q_new, ok)
+    _kernels()[1](inertia, m, q, τ, m_new, q_new, ok)
     if ok.all():
         return m_new, q_new
     left = np.flatnonzero(~ok)
