@@ -614,7 +614,9 @@ def main(argv=None) -> dict:
         "machine": _machine(),
         "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
         "clock": "process CPU time" if args.clock == "cpu" else "wall time",
-        "free_flow": "provisional (one EulerSolver per state)" if provisional else "vectorized",
+        "free_flow": "provisional (one EulerSolver per state)"
+        if provisional
+        else "compiled (numba), numpy for the states it leaves",
     }
     started = time.perf_counter()
     with _LoadSampler() as load:
