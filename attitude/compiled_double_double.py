@@ -7,13 +7,13 @@ Numer. Math. 18, 1971) and the double-word operations of Joldes, Muller and Pope
 "Tight and rigorous error bounds for basic building blocks of double-word arithmetic",
 ACM Trans. Math. Softw. 44(2), 2017, doi:10.1145/3121432 (Algorithms 6, 7 and 10; the
 relative error bounds that attitude.invariants uses are theirs).  A double-double is a
-pair (hi, lo) of floats.  Compiled without fast-math, so that no product and sum are
-fused into one rounding (Dekker's product relies on each rounding).
+pair (hi, lo) of floats.  Compiled by ``attitude.compiled.jit``, without fast-math, so
+that no product and sum are fused into one rounding (Dekker's product relies on each).
 """
 
 from __future__ import annotations
 
-import numba
+from attitude.compiled import jit
 
 __all__ = [
     "dd_over_dd",
@@ -26,10 +26,8 @@ __all__ = [
     "two_sum",
 ]
 
-_jit = numba.njit(cache=True, error_model="numpy", nogil=True)
 
-
-@_jit
+@jit
 def two_sum(a, b):
     """s + e = a + b exactly (Knuth)."""
     s = a + b
@@ -37,14 +35,14 @@ def two_sum(a, b):
     return s, (a - (s - bb)) + (b - bb)
 
 
-@_jit
+@jit
 def fast_two_sum(a, b):
     """s + e = a + b exactly, for |a| ≥ |b| (Dekker)."""
     s = a + b
     return s, b - (s - a)
 
 
-@_jit
+@jit
 def split(a):
     """a = hi + lo with 26-bit halves (Veltkamp; |a| < 2^995)."""
     c = 134217729.0 * a  # 2^27 + 1
@@ -52,7 +50,7 @@ def split(a):
     return hi, a - hi
 
 
-@_jit
+@jit
 def two_prod(a, b):
     """p + e = a b exactly (Dekker), barring underflow."""
     p = a * b
@@ -61,21 +59,21 @@ def two_prod(a, b):
     return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
 
 
-@_jit
+@jit
 def dd_times_dd(x0, x1, y0, y1):
     """(x0 + x1)(y0 + y1)."""
     p, e = two_prod(x0, y0)
     return fast_two_sum(p, e + (x0 * y1 + x1 * y0))
 
 
-@_jit
+@jit
 def dd_times_float(x0, x1, b):
     """(x0 + x1) b."""
     p, e = two_prod(x0, b)
     return fast_two_sum(p, e + x1 * b)
 
 
-@_jit
+@jit
 def dd_plus_dd(x0, x1, y0, y1):
     """(x0 + x1) + (y0 + y1)."""
     s, e = two_sum(x0, y0)
@@ -84,7 +82,7 @@ def dd_plus_dd(x0, x1, y0, y1):
     return fast_two_sum(s, e + f)
 
 
-@_jit
+@jit
 def dd_over_dd(x0, x1, y0, y1):
     """(x0 + x1)/(y0 + y1)."""
     q = x0 / y0

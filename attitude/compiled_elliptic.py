@@ -23,10 +23,8 @@ written for one float:
 They agree with attitude.elliptic to a few ulps; tests/test_compiled_flow_against_numpy_flow.py
 holds the free flow built on them against the numpy one, and the kernels against mpmath.
 
-Every function is ``numba.njit`` with ``error_model="numpy"`` (a division by zero gives
-an IEEE infinity, as in numpy, rather than raising) and no fast-math, so that every
-operation is the IEEE one written.  ``cache=True`` keeps the machine code next to this
-file, so a process compiles it once per installation.
+Every function is compiled by ``attitude.compiled.jit`` (IEEE operations as written,
+no fast-math; machine code cached).
 
 [OLBC10] F. Olver et al., NIST Handbook of Mathematical Functions (the DLMF), 2010.
 """
@@ -35,9 +33,9 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
+from attitude.compiled import jit
 from attitude.compiled_double_double import two_prod
 
 __all__ = [
@@ -68,10 +66,8 @@ _RJ_SPREAD = 2.0**-10
 _HALF_PI = 0.5 * math.pi
 _HALF_PI_LOW = 6.123233995736766e-17
 
-_jit = numba.njit(cache=True, error_model="numpy", nogil=True)
 
-
-@_jit
+@jit
 def agm(mc: float, a_seq: np.ndarray, b_seq: np.ndarray) -> tuple[int, float]:
     """The AGM of 1 and √mc for Bulirsch's recurrence: its levels (written into
     ``a_seq`` and ``b_seq``) and its final mean c = π/(2K); 0 < mc ≤ 1."""
@@ -89,7 +85,7 @@ def agm(mc: float, a_seq: np.ndarray, b_seq: np.ndarray) -> tuple[int, float]:
     return 0, math.nan  # not reached for mc ≥ 2^-1022
 
 
-@_jit
+@jit
 def complete_first_kind(c: float) -> float:
     """K = π/(2 M(1, √mc)) ([OLBC10] 19.8.5) from the final mean c of ``agm``.  π/2
     carried to twice the float precision: its rounding alone would bias K by −0.35 ulp,
@@ -99,7 +95,7 @@ def complete_first_kind(c: float) -> float:
     return q + (((_HALF_PI - p) - e) + _HALF_PI_LOW) / c  # the remainder, then its quotient
 
 
-@_jit
+@jit
 def bulirsch_sn_cn_dn(
     z: float, levels: int, c: float, a_seq: np.ndarray, b_seq: np.ndarray
 ) -> tuple[float, float, float]:
@@ -119,7 +115,7 @@ def bulirsch_sn_cn_dn(
     return s, c * s, d
 
 
-@_jit
+@jit
 def reduced_sn_cn_dn(
     r: float, mc: float, K: float, levels: int, c: float, a_seq: np.ndarray, b_seq: np.ndarray
 ) -> tuple[float, float, float]:
@@ -142,7 +138,7 @@ def reduced_sn_cn_dn(
     return σ * co / d, -σ * sqrt_mc * s / d, sqrt_mc / d
 
 
-@_jit
+@jit
 def cel_pi_minus_k(kc: float, n: float) -> float:
     """Π(n|m) − K(m) = cel(kc, 1 − n, 0, n), kc = √mc > 0, n < 1: Bulirsch's ``cel``
     (``attitude.elliptic._cel`` for one float)."""
@@ -166,7 +162,7 @@ def cel_pi_minus_k(kc: float, n: float) -> float:
     return math.nan  # not reached for kc ≥ 2^-64
 
 
-@_jit
+@jit
 def carlson_rf(x: float, y: float, z: float) -> float:
     """R_F(x, y, z) for x, y, z ≥ 0, at most one of them 0 ([OLBC10] 19.36.1)."""
     mean0 = (x + y + z) / 3.0
@@ -199,7 +195,7 @@ def carlson_rf(x: float, y: float, z: float) -> float:
     return series / math.sqrt(mean)
 
 
-@_jit
+@jit
 def _rc_one_plus(e: float) -> float:
     """R_C(1, 1 + e) for e > −1: arctan(√e)/√e, or artanh(√−e)/√−e ([OLBC10] 19.2.18–19)."""
     if abs(e) < 2.0**-20:  # the series 1 − e/3 + e²/5 − e³/7 (next term below 2^-80)
@@ -211,7 +207,7 @@ def _rc_one_plus(e: float) -> float:
     return math.atanh(r) / r
 
 
-@_jit
+@jit
 def carlson_rj(x: float, y: float, z: float, p: float) -> float:
     """R_J(x, y, z, p) for x, y, z ≥ 0 (at most one 0) and p > 0: Carlson's duplication
     with the sum of R_C terms ([OLBC10] 19.36.2; Carlson 1995, Algorithm for R_J)."""

@@ -36,9 +36,9 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
+from attitude.compiled import jit
 from attitude.compiled_double_double import (
     dd_over_dd,
     dd_plus_dd,
@@ -59,7 +59,6 @@ from attitude.compiled_elliptic import (
 
 __all__ = ["flow_many", "flow_one"]
 
-_jit = numba.njit(cache=True, error_model="numpy", nogil=True)
 
 # As attitude.invariants: the double-double error allowed per chain (64 u²).
 _BOUND = 64.0 * 2.0**-106
@@ -76,14 +75,14 @@ _NEAR_ONE_MC = 2.0**-128
 # ----------------------------------------------------------------- the case test
 
 
-@_jit
+@jit
 def _term(m_hi, m_lo, d_hi, d_lo, other):
     """m_k² (I_k − I_j) I_l in double-double."""
     x0, x1 = dd_times_dd(m_hi, m_lo, d_hi, d_lo)
     return dd_times_float(x0, x1, other)
 
 
-@_jit
+@jit
 def _case_test(I1, I2, I3, m1, m2, m3):
     """``attitude.invariants._double_double`` for one state (sorted moments, I1 < I3):
     (sign of Δ2, δ1, δ3, mc, certain)."""
@@ -147,7 +146,7 @@ def _case_test(I1, I2, I3, m1, m2, m3):
 # ----------------------------------------------------------------- the flow
 
 
-@_jit
+@jit
 def _momentum_and_angle(τ, formula, a_seq, b_seq):
     """m in the P-frame and ψ at τ: ``closed_form.Elliptic._evaluate``, with the
     constants of ``formula`` (see ``_flow``) and the AGM levels in ``a_seq``, ``b_seq``."""
@@ -170,7 +169,7 @@ def _momentum_and_angle(τ, formula, a_seq, b_seq):
     return A_s * parity * sn_r, A_c * parity * cn_r, A_d * dn_r, ψ
 
 
-@_jit
+@jit
 def _p_quaternion(a, b, c, G):
     """P = (p0, p1, p2, 0), taking m = (a, b, c) onto G e3: ``closed_form.p_quaternion``."""
     p0 = math.sqrt(0.5 * (1.0 + c / G))
@@ -178,7 +177,7 @@ def _p_quaternion(a, b, c, G):
     return p0, (b / G) * half_over_p0, -(a / G) * half_over_p0
 
 
-@_jit
+@jit
 def _place(i0, i1, x0, x1, x2):
     """(y0, y1, y2) with y[i0] = x0, y[i1] = x1 and the third one x2 (i0 ≠ i1)."""
     y0 = x0 if i0 == 0 else (x1 if i1 == 0 else x2)
@@ -187,7 +186,7 @@ def _place(i0, i1, x0, x1, x2):
     return y0, y1, y2
 
 
-@_jit
+@jit
 def flow_one(I_a, I_b, I_c, m_a, m_b, m_c, qw, qx, qy, qz, dt):
     """One state (moments and momentum along the principal axes in any order, a unit
     quaternion scalar first) after dt: (ok, m_a, m_b, m_c, qw, qx, qy, qz).  ``ok``
@@ -197,7 +196,7 @@ def flow_one(I_a, I_b, I_c, m_a, m_b, m_c, qw, qx, qy, qz, dt):
     return _flow(I_a, I_b, I_c, m_a, m_b, m_c, qw, qx, qy, qz, dt, a_seq, b_seq)
 
 
-@_jit
+@jit
 def _flow(I_a, I_b, I_c, m_a, m_b, m_c, qw, qx, qy, qz, dt, a_seq, b_seq):
     """``flow_one`` with scratch arrays of ``AGM_LEVELS`` floats for the AGM."""
     nothing = (False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
@@ -312,7 +311,7 @@ def _flow(I_a, I_b, I_c, m_a, m_b, m_c, qw, qx, qy, qz, dt, a_seq, b_seq):
     return out if finite else nothing
 
 
-@_jit
+@jit
 def flow_many(moments, momentum, quaternion, dt, m_out, q_out, ok):
     """``flow_one`` over a batch: arrays (N, 3), (N, 3), (N, 4) and (N,) in, (N, 3),
     (N, 4) and the flags ``ok`` (N,) written."""

@@ -143,3 +143,16 @@ def test_two_threads_give_the_bits_of_one():
     for one, other in zip(serial, threaded, strict=True):
         for a, b in zip(one, other, strict=True):
             np.testing.assert_array_equal(a, b)
+
+
+def test_a_kernel_that_cannot_be_cached_is_still_compiled():
+    """Where numba has no writable cache location it refuses cache=True; ``jit`` then
+    compiles without caching instead of failing the import.  A function with no
+    source file (made by exec) has no cache location either."""
+    from attitude.compiled import jit
+
+    namespace: dict = {}
+    exec("def twice(x):\n    return 2.0 * x / 0.0 if x == 0.0 else 2.0 * x", namespace)
+    compiled = jit(namespace["twice"])
+    assert compiled(1.5) == 3.0
+    assert np.isnan(compiled(0.0))  # error_model="numpy": 0/0 is a NaN, not an exception

@@ -18,6 +18,7 @@ LAYERS = [
         "quaternions",
         "vectors",
         "float_math",
+        "compiled",
         "compiled_double_double",
     ],
     ["elliptic", "compiled_elliptic", "phase_table"],  # elliptic kernels
