@@ -138,7 +138,8 @@ def advance_floats(
     except (ValueError, OverflowError):  # a NaN or an infinity met by the exact integers
         raise InputError(
             f"the free flow needs a finite state, got angular_momentum {list(angular_momentum)}"
-            f" with moments {list(moments)}"
+            f" and quaternion_wxyz {list(quaternion_wxyz)} with moments {list(moments)} "
+            f"and dt {dt!r}"
         ) from None
 
 

@@ -183,6 +183,23 @@ def test_the_float_entry_point_refuses_a_non_finite_momentum(bad):
         free_flow.advance_floats((1.0, 2.0, 3.0), (0.1, bad, 0.2), (1.0, 0.0, 0.0, 0.0), 1.0)
 
 
+@pytest.mark.parametrize(
+    "quaternion, dt",
+    [
+        ((math.nan, 0.0, 0.0, 0.0), 1.0),
+        ((1.0, 0.0, 0.0, 0.0), math.nan),
+        ((1.0, 0.0, 0.0, 0.0), math.inf),
+    ],
+)
+def test_the_float_entry_point_names_a_non_finite_quaternion_or_step(quaternion, dt):
+    """The compiled flow leaves such a state (its result is not finite), and the float
+    path refuses it with every value of the state in the message."""
+    with pytest.raises(InputError, match=r"quaternion_wxyz \[.*\] .* and dt") as refused:
+        free_flow.advance_floats((1.0, 2.0, 3.0), (0.1, 0.2, 0.3), quaternion, dt)
+    message = str(refused.value)
+    assert f"quaternion_wxyz {list(quaternion)}" in message and f"dt {dt!r}" in message
+
+
 def test_a_unit_batch_kept_over_many_flows_gives_the_bits_of_fresh_calls(monkeypatch):
     """``UnitBatch`` keeps what depends on the moments alone (sorting, the moment factors
     of the double-double case test) across flows, as the torqued solver's batch does
