@@ -19,14 +19,15 @@ A state that is not of these cases, or whose case or mc the double-double leaves
 uncertain (within |δ2| ~ 1e-13 of the separatrix), or with mc < 2^-128, or whose
 result is not finite, is returned *unhandled* (``ok`` False): attitude.free_flow
 sends it down the numpy path, which covers every case exactly (the separatrix, the
-symmetric and steady bodies, rest, the exact integers).  So this module is a faster
+sphere and the bodies whose rate underflows, rest, the exact integers).  Symmetric
+bodies (two equal moments) are case (ii) with n = 0, and are taken here.  So this module is a faster
 road to the same numbers, never a second definition of them: the results agree with
 the numpy path to a few ulps (tests/test_compiled_flow_against_numpy_flow.py).
 
-Why compiled: on a batch of 1000 spacecraft, the numpy flow costs ~2.5 µs a state per
-step, nearly all of it in the fixed cost of a few hundred numpy calls over arrays of
-1000, and one state on Python floats ~40 µs; the torque splitting calls the flow about
-ten times per step (docs/benchmarks.md, "The free flow compiled").
+Why compiled: on a batch of 1000 spacecraft, the numpy flow cost 2.2 µs a state per
+step, nearly all of it the fixed cost of a few hundred numpy calls over arrays of 1000,
+and one state on Python floats 23 µs; compiled, 0.87 and 1.7 µs (docs/benchmarks.md,
+"The free flow compiled").  The torque splitting calls the flow about ten times a step.
 
 [Leroy] P. Leroy, "On an Article by Celledoni et al." (2020), in Principia's
     documentation: https://github.com/mockingbirdnest/Principia/blob/master/documentation/Celledoni.pdf

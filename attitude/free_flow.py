@@ -11,7 +11,7 @@ Every state goes first through the compiled flow (attitude.compiled_flow, numba)
 elliptic cases (i) and (ii) with a certain double-double case test and mc ≥ 2^-128,
 nearly every state of a real spacecraft, at about 1 µs a state, one state alone or a
 batch.  The states it leaves (the separatrix and its 1e-13 neighbourhood, the sphere,
-symmetric and steady bodies whose rate underflows, rest, mc < 2^-128) take the path
+bodies whose rate underflows, rest, mc < 2^-128) take the path
 of every case: split by their exact case (attitude.invariants: double-double with an
 error bound, the exact integers where the bound leaves the case or mc in doubt), each
 case's formula once over all of its states on numpy arrays, or a few states one by one
@@ -201,7 +201,7 @@ def _one_compiled(inertia: tuple, m: tuple, q0: tuple, τ: float, at: str = ""):
 def _many_compiled(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray):
     """A checked batch (C-contiguous float64 arrays): the compiled flow over every
     state, then the states it leaves (attitude.compiled_flow: the separatrix and its
-    neighbourhood, symmetric and steady bodies, rest, mc < 2^-128) down the numpy path
+    neighbourhood, the sphere, underflowing rates, rest, mc < 2^-128) down the numpy path
     of every case, or one by one on floats if they are few."""
     n = inertia.shape[0]
     m_new, q_new = np.empty((n, 3)), np.empty((n, 4))
