@@ -1,14 +1,18 @@
-"""How long a torque-free scenario holds: the validity horizon of neglecting gravity gradient.
+"""How long a scenario that neglects gravity gradient holds: its validity horizon.
 
-A torque-free scenario with an orbit neglects the gravity-gradient torque of the
+A scenario with an orbit whose ``[torques]`` leave out the gravity gradient (a
+torque-free one, or one with burns alone) neglects the gravity-gradient torque of the
 Earth.  Its validity horizon is the time until that neglected torque would have moved
 the attitude by a threshold (1° by default, ``[torques] horizon_threshold``): the same
-scenario (the same events) is propagated under gravity gradient
-(``attitude.torqued_segment``) alongside the torque-free trajectory, their attitudes
-are compared every step, and the first crossing is refined by bisection to a
-millisecond (:func:`attitude.torqued_solver.first_crossing`, which
+scenario (the same events, the same burns) is propagated under gravity gradient too
+(``attitude.torqued_segment``) alongside the scenario's own trajectory, their
+attitudes are compared every step, and the first crossing is refined by bisection to
+a millisecond (:func:`attitude.torqued_solver.first_crossing`, which
 ``departure_time`` uses for one solver).  An attitude reset puts both on the same
-attitude again; the horizon is the first crossing.
+attitude again; the horizon is the first crossing.  With burns, both runs are
+splittings at the scenario's step (or accuracy): the comparison also holds their
+difference in splitting error, at most the sum of their errors, which the summary
+states beside it.
 
 The torqued run uses the scenario's ``[torques]`` step or accuracy and order when it
 states one; otherwise order 4 at a step of a fifth of the body's fastest turn (at the
@@ -36,7 +40,8 @@ from attitude.trajectory import Trajectory, propagate
 
 __all__ = ["MAX_HORIZON_STEPS", "ValidityHorizon", "validity_horizon"]
 
-# The torqued run alongside costs about 8 free flows a step: 20,000 steps are ~10 s.
+# The torqued run alongside costs about 8 free flows a step: 20,000 steps are ~1.5 s of
+# CPU for the one-day 5 rpm spinner with the compiled free flow (docs/torques.md).
 MAX_HORIZON_STEPS = 20_000
 _TURN_FRACTION = 0.2
 _ORBIT_FRACTION = 1.0 / 40.0
@@ -68,8 +73,8 @@ class ValidityHorizon:
         if self.within_span:
             return (
                 f"the neglected gravity gradient moves the attitude by {angle} after "
-                f"{self.horizon_s:.6g} s, at {format_epoch(self.horizon_s)}: the torque-free "
-                "motion is valid until then"
+                f"{self.horizon_s:.6g} s, at {format_epoch(self.horizon_s)}: the motion without it "
+                "is valid until then"
             )
         if self.searched_s >= self.span_s:
             return (
@@ -118,8 +123,9 @@ def _step(trajectory: Trajectory, orbit: Any) -> float:
 
 
 def validity_horizon(trajectory: Trajectory, orbit: Any) -> ValidityHorizon:
-    """The validity horizon of the torque-free ``trajectory`` on ``orbit`` (module
-    docstring); its threshold is the scenario's ``torques.horizon_threshold``."""
+    """The validity horizon of ``trajectory`` (torque-free, or under burns alone) on
+    ``orbit`` (module docstring); its threshold is the scenario's
+    ``torques.horizon_threshold``."""
     scenario = trajectory.scenario
     settings = scenario.torques
     threshold = settings.horizon_threshold
@@ -128,6 +134,7 @@ def validity_horizon(trajectory: Trajectory, orbit: Any) -> ValidityHorizon:
     searched = min(scenario.stop_s, MAX_HORIZON_STEPS * step)
     torques = ScenarioTorques(
         gravity_gradient=orbit,
+        burns=settings.burns,
         step=step if not given or settings.step is not None else None,
         accuracy=settings.accuracy,
         order=settings.order if given else 4,

@@ -124,6 +124,9 @@ def _torques_section(torques: dict[str, Any] | None) -> list[str]:
         f"step {escape(how)}; estimated attitude error "
         f"{torques['estimated_error_rad']:.2g} rad over the run (each segment's own below).</p>"
     )
+    horizon = torques.get("validity_horizon")
+    if horizon:  # burns alone, on an orbit: the gravity gradient they leave out
+        parts.append(f"<p>Validity: {escape(horizon['description'])}.</p>")
     if torques["burns"]:
         parts.append(
             _table(

@@ -8,8 +8,9 @@ the exact search), chooses the AEM's records for its tolerance, counts the outpu
 samples and estimates the outputs' sizes and the (constant) memory of the streamed
 run.  It notes an output step that undersamples the motion (more than a tenth of its
 shortest period).  Segments under torques are propagated (their whole grid, and the
-error estimate of their step); a torque-free scenario with an orbit gets its validity
-horizon (``attitude.horizon.validity_horizon``).  What it refuses, a run would have refused
+error estimate of their step); a scenario with an orbit that leaves the gravity
+gradient out (torque-free, or burns alone) gets its validity horizon
+(``attitude.horizon.validity_horizon``).  What it refuses, a run would have refused
 later, after computing; what it returns is what the run uses.  Errors are
 ``attitude.errors.InputError`` whose message starts with the scenario key.
 """
@@ -48,7 +49,7 @@ class RunPlan:
     outputs: OutputChoice = field(default_factory=OutputChoice)
     aem: AemPlan | None = None
     search: SearchGrid | None = None  # the pointing's exact search (None without pointing)
-    horizon: ValidityHorizon | None = None  # torque-free with an orbit: how long it holds
+    horizon: ValidityHorizon | None = None  # on an orbit, no gravity gradient: how long it holds
     # The horizon is wanted but left for the run to compute (plan_run(horizon=False)).
     horizon_deferred: bool = False
 
@@ -93,7 +94,9 @@ def plan_run(
             "give a smaller step or an accuracy"
         )
     found = None
-    wanted = pointing.orbit is not None and not scenario.torques.any
+    # On an orbit, unless the gravity gradient is modelled: a torque-free run, or burns
+    # alone, neglects it.
+    wanted = pointing.orbit is not None and scenario.torques.gravity_gradient is None
     if wanted and horizon:
         found = validity_horizon(trajectory, pointing.orbit)
     aem = None

@@ -70,7 +70,16 @@ def torques_summary(plan: RunPlan) -> dict[str, Any]:
         "estimated_error_note": "segments[].estimated_error_rad: each segment's own, from its "
         "start state; estimated_error_rad: the run's, the scenario rerun at twice each step "
         "through the same events (errors carried into a segment grow with the motion)",
+        "validity_horizon": horizon,
+        "validity_horizon_note": None if horizon is not None else _horizon_note(settings),
     }
+
+
+def _horizon_note(settings: Any) -> str:
+    """Why a run under torques states no validity horizon."""
+    if settings.gravity_gradient is not None:
+        return "the gravity gradient is modelled: there is nothing neglected to bound"
+    return "no orbit: the gravity gradient that the burns-only motion neglects is not known"
 
 
 def torques_lines(plan: RunPlan) -> list[str]:
@@ -96,6 +105,8 @@ def torques_lines(plan: RunPlan) -> list[str]:
     lines.append(
         f"  estimated error of the run, through the events: {entry['estimated_error_rad']:.2g} rad"
     )
+    if plan.horizon is not None:  # burns alone, on an orbit: the gravity gradient left out
+        lines.append(f"horizon     {plan.horizon.describe(plan.scenario.format_epoch)}")
     return lines
 
 

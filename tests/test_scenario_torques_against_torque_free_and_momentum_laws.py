@@ -9,9 +9,12 @@
 - **The orbit.** Gravity gradient on the scenario's orbit (a KeplerianOrbit, read at
   two-part TT dates) is the TorquedSolver's on the same circle written by hand.
 - **The validity horizon** of a torque-free scenario against a direct comparison of
-  TorquedSolver and EulerSolver from the same state (``departure_time``).
+  TorquedSolver and EulerSolver from the same state (``departure_time``); that of a
+  scenario with a burn alone against DOP853 on the burn with and without the gravity
+  gradient (torqued_reference, none of the package's code).
 - Through files and the command line: ``check`` and ``summary.json`` state the torques,
-  the step and the estimated error, and the horizon of a torque-free scenario.
+  the step and the estimated error, and the horizon of a scenario that neglects the
+  gravity gradient (torque-free, or burns alone); one that models it states why none.
 """
 
 import json
@@ -20,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import torqued_reference as ref
 from scipy.spatial.transform import Rotation
 
 from attitude.cli import main
@@ -179,6 +183,39 @@ def test_the_validity_horizon_against_torqued_and_exact_solvers_side_by_side():
     assert not short.within_span and "beyond the span" in short.describe(scenario.format_epoch)
 
 
+def test_the_validity_horizon_of_a_burn_alone_against_dop853_with_and_without_gravity_gradient():
+    """A scenario with a burn and no gravity gradient neglects the latter: its horizon is
+    where DOP853 on the burn alone and on the burn with the gravity gradient part by 1°."""
+    τ = np.array([0.002, -0.001, 0.003])
+    burn = Burn(100.0, 400.0, τ, "inertial")
+    scenario = _scenario(ScenarioTorques(burns=[burn], step=2.0), duration=1500.0)
+    horizon = validity_horizon(propagate(scenario), circle)
+    orbit = ref.circular_orbit(A, mu=MU)
+    gradient = ref.gravity_gradient(orbit, np.diag(I_TUMBLER))
+
+    def burning(t, q, m, t_mid):
+        on = 100.0 <= t_mid <= 500.0
+        return ref.matrix_body_to_inertial(q).T @ τ if on else np.zeros(3)
+
+    def both(t, q, m, t_mid):
+        return burning(t, q, m, t_mid) + gradient(t, q, m)
+
+    t = np.arange(0.25, 1500.0, 0.25)
+    q0 = R0.as_quat(scalar_first=True)
+    runs = [
+        ref.integrate_dop853(
+            I_TUMBLER, I_TUMBLER * W_TUMBLER, q0, torque, t, (100.0, 500.0), 1e-11
+        )[1]
+        for torque in (burning, both)
+    ]
+    angle = ref.angle(*runs)
+    k = int(np.flatnonzero(angle >= math.radians(1.0))[0])
+    # Linear between the two samples around the crossing (0.25 s apart).
+    crossing = t[k - 1] + (math.radians(1.0) - angle[k - 1]) / (angle[k] - angle[k - 1]) * 0.25
+    assert 100.0 < crossing < 1500.0 and horizon.within_span
+    assert abs(horizon.horizon_s - crossing) < 0.02, (horizon.horizon_s, crossing)
+
+
 SCENARIO = """
 [scenario]
 name = "tumbler"
@@ -256,6 +293,9 @@ label = "burn"
     assert torques["burns"][0]["duration_s"] == 120.0 and torques["order"] == 4
     (segment,) = torques["segments"]
     assert 0.0 < segment["estimated_error_rad"] <= 1e-7 and segment["step_s"] > 0.0
+    # The gravity gradient is modelled: no horizon, and the summary says why.
+    assert torques["validity_horizon"] is None
+    assert "gravity gradient is modelled" in torques["validity_horizon_note"]
     assert summary["motion"]["segments"][0]["motion"] == "torqued"
     # The run is the scenario's torqued motion: against the solver on the same circle.
     csv = tmp_path / "out" / "timeseries.csv"
@@ -277,6 +317,39 @@ label = "burn"
     assert np.max(angles_between(q, direct.attitude_quaternion(data["t_s"]))) < 1e-6
     page = (tmp_path / "out" / "report.html").read_text()
     assert "<h2>Torques</h2>" in page and "splitting with the exact free flow" in page
+
+
+def test_a_file_with_burns_alone_on_an_orbit_states_its_validity_horizon(tmp_path, capsys):
+    text = (
+        SCENARIO
+        + """
+[torques]
+step = 2.0
+
+[[torques.burns]]
+offset = 100.0
+duration = 400.0
+torque = [0.002, -0.001, 0.003]
+frame = "inertial"
+"""
+    )
+    path = tmp_path / "burn.toml"
+    path.write_text(text, encoding="utf-8")
+    assert main(["check", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "torques     1 burn; order 4, step 2 s" in out
+    assert "horizon     the neglected gravity gradient moves the attitude by 1 deg after" in out
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    horizon = summary["torques"]["validity_horizon"]
+    # The horizon of the same burn without a file (the DOP853 test above): 307.62 s.
+    scenario = _scenario(
+        ScenarioTorques(burns=[Burn(100.0, 400.0, [0.002, -0.001, 0.003], "inertial")], step=2.0),
+        duration=1200.0,
+    )
+    direct = validity_horizon(propagate(scenario), circle).horizon_s
+    assert abs(horizon["horizon_s"] - direct) < 0.01 and horizon["threshold_deg"] == 1.0
+    assert "valid until then" in (tmp_path / "out" / "report.html").read_text()
 
 
 @pytest.mark.parametrize(
