@@ -245,21 +245,29 @@ mean_anomaly = { value = 0.0, unit = "deg" }
 """
 
 
-def test_a_torque_free_file_with_an_orbit_states_its_validity_horizon(tmp_path, capsys):
-    path = tmp_path / "free.toml"
-    path.write_text(SCENARIO, encoding="utf-8")
+def _horizon_through_the_cli(tmp_path, capsys, text, torques_line):
+    """``check`` and ``run`` of the scenario ``text``: both state the horizon (and
+    ``check`` the torques as ``torques_line``); returns summary.json's horizon entry."""
+    path = tmp_path / "scenario.toml"
+    path.write_text(text, encoding="utf-8")
     assert main(["check", str(path)]) == 0
     out = capsys.readouterr().out
-    assert "torques     none: the exact torque-free solver" in out
+    assert torques_line in out
     assert "horizon     the neglected gravity gradient moves the attitude by 1 deg after" in out
     assert main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
-    horizon = summary["torques"]["validity_horizon"]
+    assert "valid until then" in (tmp_path / "out" / "report.html").read_text()
+    return summary["torques"]["validity_horizon"]
+
+
+def test_a_torque_free_file_with_an_orbit_states_its_validity_horizon(tmp_path, capsys):
+    horizon = _horizon_through_the_cli(
+        tmp_path, capsys, SCENARIO, "torques     none: the exact torque-free solver"
+    )
     direct = departure_time(
         I_TUMBLER, I_TUMBLER * W_TUMBLER, R0, 0.0, [GravityGradient(circle)], 1200.0, step=5.0
     )
     assert abs(horizon["horizon_s"] - direct) < 0.01 and horizon["threshold_deg"] == 1.0
-    assert "valid until then" in (tmp_path / "out" / "report.html").read_text()
 
 
 def test_a_file_with_torques_states_them_with_the_step_and_the_error(tmp_path, capsys):
@@ -333,15 +341,9 @@ torque = [0.002, -0.001, 0.003]
 frame = "inertial"
 """
     )
-    path = tmp_path / "burn.toml"
-    path.write_text(text, encoding="utf-8")
-    assert main(["check", str(path)]) == 0
-    out = capsys.readouterr().out
-    assert "torques     1 burn; order 4, step 2 s" in out
-    assert "horizon     the neglected gravity gradient moves the attitude by 1 deg after" in out
-    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
-    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
-    horizon = summary["torques"]["validity_horizon"]
+    horizon = _horizon_through_the_cli(
+        tmp_path, capsys, text, "torques     1 burn; order 4, step 2 s"
+    )
     # The horizon of the same burn without a file (the DOP853 test above): 307.62 s.
     scenario = _scenario(
         ScenarioTorques(burns=[Burn(100.0, 400.0, [0.002, -0.001, 0.003], "inertial")], step=2.0),
@@ -349,7 +351,6 @@ frame = "inertial"
     )
     direct = validity_horizon(propagate(scenario), circle).horizon_s
     assert abs(horizon["horizon_s"] - direct) < 0.01 and horizon["threshold_deg"] == 1.0
-    assert "valid until then" in (tmp_path / "out" / "report.html").read_text()
 
 
 @pytest.mark.parametrize(
