@@ -100,9 +100,19 @@ def _refuse_a_long_search(state: State, t0: float, span: float, torques) -> None
 
     The search (``TorquedSolver``) first runs the span at half a quarter turn of the
     body (at most a fortieth of the orbit) and at twice that; the body's fastest turn
-    is bounded by |ω| ≤ √(2T/I_min).
+    is bounded by |ω| ≤ √(2T/I_min) at the start, and by |ω| ≤ |m|/I_min with
+    |m| ≤ |m0| + ∫|τ| dt later: the burns within the span may spin the body up.
     """
-    rate = math.sqrt(2.0 * state.kinetic_energy / float(np.min(state.inertia.moments)))
+    I_min = float(np.min(state.inertia.moments))
+    rate = math.sqrt(2.0 * state.kinetic_energy / I_min)
+    impulse = sum(
+        float(np.linalg.norm(torque.torque))
+        * max(0.0, min(torque.stop, t0 + span) - max(torque.start, t0))
+        for torque in torques
+        if isinstance(torque, ConstantTorque)
+    )
+    if impulse > 0.0:
+        rate = max(rate, (float(np.linalg.norm(state.angular_momentum)) + impulse) / I_min)
     first = [0.5 * 2.0 * math.pi / rate / 4.0] if rate > 0.0 else []
     for torque in torques:
         if isinstance(torque, GravityGradient):

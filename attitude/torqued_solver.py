@@ -64,6 +64,10 @@ _DENSE_CHUNK = 8192
 _SLIVER = 1e-6
 # More steps than this in one request (hours of computing) is refused as a mistake.
 _MAX_STEPS = 1e8
+# A step search that would try a step with more than this many steps over its span is
+# refused (each try runs the span twice): torques that turn the body faster and faster
+# (a runaway spin-up) would otherwise halve the step for hours before failing.
+_SEARCH_MAX_STEPS = 1e7
 
 
 # ----------------------------------------------------------------- the step engine
@@ -430,6 +434,17 @@ class TorquedSolver:
         bad = math.inf
         tried = []
         for _ in range(10):
+            if span / step > _SEARCH_MAX_STEPS:
+                last = (
+                    f"; the estimate was {tried[-1][1]:.3g} rad at {tried[-1][0]:.3g} s"
+                    if tried
+                    else ""
+                )
+                raise InputError(
+                    f"tolerance {tolerance:g} rad over {span:g} s would need a step below "
+                    f"{step:.3g} s, more than {_SEARCH_MAX_STEPS:g} steps{last}: give a step, "
+                    "a looser tolerance or a shorter span"
+                )
             error, propagation = estimate(step)
             tried.append((step, error))
             if error <= tolerance:

@@ -116,8 +116,13 @@ BAD = {
         r"angular impulse of 2e\+300 N m s, beyond what floats hold",
     ),
     "burn: a torque that spins the body beyond what TT seconds follow": (
-        _torques("", BURN.replace("[0.0, 0.0, 0.01]", "[1e150, 0.0, 0.0]")),
+        _torques("step = 1.0", BURN.replace("[0.0, 0.0, 0.01]", "[1e150, 0.0, 0.0]")),
         r"initial_state: the body turns in .* too fast for TT seconds",
+    ),
+    "burn: the same with the step chosen for an accuracy": (
+        _torques("", BURN.replace("[0.0, 0.0, 0.01]", "[1e150, 0.0, 0.0]")),
+        r"initial_state: torques\.accuracy: choosing the step over 5 s would start with "
+        r"1\.91e\+150 steps of 3\.93e-150 s \(more than 1e\+07\)",
     ),
     "burn: after the span": (
         _torques("", BURN.replace("offset = 1.0", "offset = 10.0")),
@@ -183,7 +188,15 @@ BAD = {
         ).replace("duration = 10.0", "duration = 1e10"),
         r"the state after events\[0\] .*: torques\.accuracy: choosing the step over "
         r"1e\+10 s would start with "
-        r"[\d.e+]+ steps of [\d.]+ s \(more than 1e\+07\): give torques\.step",
+        r"[\d.e+]+ steps of [\d.e+-]+ s \(more than 1e\+07\): give torques\.step",
+    ),
+    "torques: an accuracy for a burn that spins the body up to 1e8 rad/s": (
+        _torques(
+            'accuracy = { value = 1e-6, unit = "rad" }',
+            BURN.replace("[0.0, 0.0, 0.01]", "[1e9, 0.0, 0.0]"),
+        ),
+        r"initial_state: torques\.accuracy: choosing the step over 5 s would start with "
+        r"[\d.e+]+ steps of [\d.e+-]+ s \(more than 1e\+07\): give torques\.step",
     ),
     "torques: negative step": (
         _torques("step = -1.0", BURN),

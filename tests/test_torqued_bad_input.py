@@ -145,6 +145,26 @@ def test_tolerance_needs_a_span_and_excludes_a_step():
         TorquedSolver(INERTIA, M0, torques=[gg], tolerance=1e-6, span=-5.0)
 
 
+def test_a_step_search_that_would_run_away_is_refused(monkeypatch):
+    """A torque that spins the body up to 3e5 rad/s: the search shrinks the step try
+    after try, and each try runs the span twice.  Past the search's cap of steps over
+    the span it refuses, naming the tolerance, the step and the last estimate, instead
+    of running for hours (the cap lowered here so that the test is quick; the scenario
+    layer refuses such a burn before any search, test_check_refuses_what_run_refuses)."""
+    import attitude.torqued_solver as torqued_solver
+
+    monkeypatch.setattr(torqued_solver, "_SEARCH_MAX_STEPS", 2e3)
+    spin_up = ConstantTorque([0.0, 0.0, 1e4], 0.0, math.inf)
+    message = (
+        r"tolerance 1e-06 rad over 100 s would need a step below [\d.e-]+ s, more than "
+        r"2000 steps; the estimate was [\d.e+-]+ rad at [\d.e-]+ s: give a step"
+    )
+    with pytest.raises(InputError, match=message):
+        TorquedSolver(
+            [1.0, 2.0, 3.0], [0.1, 0.2, 0.3], None, 0.0, [spin_up], tolerance=1e-6, span=100.0
+        )
+
+
 def test_times_before_t0_and_bad_times():
     solver = TorquedSolver(INERTIA, M0, t0=100.0, torques=[GravityGradient(circular)])
     with pytest.raises(InputError, match="t0"):
