@@ -432,7 +432,7 @@ class TorquedSolver:
         step = min(0.5 * span, 0.5 * self._initial_step())
         good: tuple[float, float, _Propagation] | None = None
         bad = math.inf
-        tried = []
+        tried: list[tuple[float, float]] = []
         for _ in range(10):
             if span / step > _SEARCH_MAX_STEPS:
                 last = (
