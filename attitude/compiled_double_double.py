@@ -28,7 +28,7 @@ __all__ = [
 
 
 @jit
-def two_sum(a, b):
+def two_sum(a: float, b: float) -> tuple[float, float]:
     """s + e = a + b exactly (Knuth)."""
     s = a + b
     bb = s - a
@@ -36,14 +36,14 @@ def two_sum(a, b):
 
 
 @jit
-def fast_two_sum(a, b):
+def fast_two_sum(a: float, b: float) -> tuple[float, float]:
     """s + e = a + b exactly, for |a| ≥ |b| (Dekker)."""
     s = a + b
     return s, b - (s - a)
 
 
 @jit
-def split(a):
+def split(a: float) -> tuple[float, float]:
     """a = hi + lo with 26-bit halves (Veltkamp; |a| < 2^995)."""
     c = 134217729.0 * a  # 2^27 + 1
     hi = c - (c - a)
@@ -51,7 +51,7 @@ def split(a):
 
 
 @jit
-def two_prod(a, b):
+def two_prod(a: float, b: float) -> tuple[float, float]:
     """p + e = a b exactly (Dekker), barring underflow."""
     p = a * b
     ah, al = split(a)
@@ -60,21 +60,21 @@ def two_prod(a, b):
 
 
 @jit
-def dd_times_dd(x0, x1, y0, y1):
+def dd_times_dd(x0: float, x1: float, y0: float, y1: float) -> tuple[float, float]:
     """(x0 + x1)(y0 + y1)."""
     p, e = two_prod(x0, y0)
     return fast_two_sum(p, e + (x0 * y1 + x1 * y0))
 
 
 @jit
-def dd_times_float(x0, x1, b):
+def dd_times_float(x0: float, x1: float, b: float) -> tuple[float, float]:
     """(x0 + x1) b."""
     p, e = two_prod(x0, b)
     return fast_two_sum(p, e + x1 * b)
 
 
 @jit
-def dd_plus_dd(x0, x1, y0, y1):
+def dd_plus_dd(x0: float, x1: float, y0: float, y1: float) -> tuple[float, float]:
     """(x0 + x1) + (y0 + y1)."""
     s, e = two_sum(x0, y0)
     t, f = two_sum(x1, y1)
@@ -83,7 +83,7 @@ def dd_plus_dd(x0, x1, y0, y1):
 
 
 @jit
-def dd_over_dd(x0, x1, y0, y1):
+def dd_over_dd(x0: float, x1: float, y0: float, y1: float) -> tuple[float, float]:
     """(x0 + x1)/(y0 + y1)."""
     q = x0 / y0
     p0, p1 = dd_times_float(y0, y1, q)

@@ -188,7 +188,19 @@ def _place(i0, i1, x0, x1, x2):
 
 
 @jit
-def flow_one(I_a, I_b, I_c, m_a, m_b, m_c, qw, qx, qy, qz, dt):
+def flow_one(
+    I_a: float,
+    I_b: float,
+    I_c: float,
+    m_a: float,
+    m_b: float,
+    m_c: float,
+    qw: float,
+    qx: float,
+    qy: float,
+    qz: float,
+    dt: float,
+) -> tuple[bool, float, float, float, float, float, float, float]:
     """One state (moments and momentum along the principal axes in any order, a unit
     quaternion scalar first) after dt: (ok, m_a, m_b, m_c, qw, qx, qy, qz).  ``ok``
     False: not handled here (module docstring), the other values meaningless."""
@@ -313,7 +325,15 @@ def _flow(I_a, I_b, I_c, m_a, m_b, m_c, qw, qx, qy, qz, dt, a_seq, b_seq):
 
 
 @jit
-def flow_many(moments, momentum, quaternion, dt, m_out, q_out, ok):
+def flow_many(
+    moments: np.ndarray,
+    momentum: np.ndarray,
+    quaternion: np.ndarray,
+    dt: np.ndarray,
+    m_out: np.ndarray,
+    q_out: np.ndarray,
+    ok: np.ndarray,
+) -> None:
     """``flow_one`` over a batch: arrays (N, 3), (N, 3), (N, 4) and (N,) in, (N, 3),
     (N, 4) and the flags ``ok`` (N,) written."""
     a_seq = np.empty(AGM_LEVELS)
