@@ -502,8 +502,7 @@ class OneState:
 class ManyStates:
     """The case formulas of a batch of states, grouped by case, on numpy arrays.
 
-    ``moments`` (N, 3) and ``momentum`` (N, 3) as in ``OneState``; ``sorted_moments``,
-    ``SortedMoments(moments)`` if the caller keeps it.  ``groups`` lists
+    ``moments`` (N, 3) and ``momentum`` (N, 3) as in ``OneState``.  ``groups`` lists
     (indices, formula) with one formula per case present (the elliptic cases split by
     the regime of their kernels, mc above or below ``NEAR_ONE_MC``); ``index`` and
     ``sign`` (N, 3) are the signed permutations to each state's P-frame.
@@ -514,11 +513,8 @@ class ManyStates:
     the state steady) and the relabelling into the P-frame (``_relabel``, step 3).
     """
 
-    def __init__(
-        self, moments: np.ndarray, momentum: np.ndarray, sorted_moments: SortedMoments | None = None
-    ) -> None:
-        if sorted_moments is None:
-            sorted_moments = SortedMoments(moments)
+    def __init__(self, moments: np.ndarray, momentum: np.ndarray) -> None:
+        sorted_moments = SortedMoments(moments)
         I1, I2, I3 = sorted_moments.I
         order, sorted_signs = sorted_moments.order, sorted_moments.sorted_signs
         m_sorted = momentum.take(sorted_moments.flat_order)  # its rows permuted alike
@@ -660,9 +656,7 @@ def _relabel(
 
 class SortedMoments:
     """The moments of a batch sorted, step 1 of the module docstring, with what the case
-    test needs of them alone (``constants``): built once for a batch whose moments stay
-    while its momenta change (attitude.free_flow.UnitBatch), and by ``ManyStates``
-    otherwise.
+    test needs of them alone (``constants``, made only if a state needs the test).
 
     ``I``: the sorted moments as columns (I1, I2, I3); ``order`` (N, 3): the stable
     permutation that sorts each row; ``sorted_signs`` (N, 3): the middle axis reversed

@@ -20,9 +20,10 @@ uncertain (within |δ2| ~ 1e-13 of the separatrix), or with mc < 2^-128, or whos
 result is not finite, is returned *unhandled* (``ok`` False): attitude.free_flow
 sends it down the numpy path, which covers every case exactly (the separatrix, the
 sphere and the bodies whose rate underflows, rest, the exact integers).  Symmetric
-bodies (two equal moments) are case (ii) with n = 0, and are taken here.  So this module is a faster
-road to the same numbers, never a second definition of them: the results agree with
-the numpy path to a few ulps (tests/test_compiled_flow_against_numpy_flow.py).
+bodies (two equal moments) are case (ii) with n = 0, and are taken here.  So this
+module is a faster road to the same numbers, never a second definition of them: the
+results agree with the numpy path to a few ulps
+(tests/test_compiled_flow_against_numpy_flow.py).
 
 Why compiled: on a batch of 1000 spacecraft, the numpy flow cost 2.2 µs a state per
 step, nearly all of it the fixed cost of a few hundred numpy calls over arrays of 1000,
@@ -98,18 +99,17 @@ def _case_test(I1, I2, I3, m1, m2, m3):
         valid = valid and (M == 0.0 or abs(M) >= _SMALLEST)
     if not valid:
         return 0.0, 0.0, 0.0, 0.0, False
-    J1, J2, J3, M1, M2, M3 = I1, I2, I3, m1, m2, m3
-    J21 = two_sum(J2, -J1)  # exact differences
-    J31 = two_sum(J3, -J1)
-    J32 = two_sum(J3, -J2)
-    s1, s2, s3 = two_prod(M1, M1), two_prod(M2, M2), two_prod(M3, M3)  # exact squares
+    I21 = two_sum(I2, -I1)  # exact differences
+    I31 = two_sum(I3, -I1)
+    I32 = two_sum(I3, -I2)
+    s1, s2, s3 = two_prod(m1, m1), two_prod(m2, m2), two_prod(m3, m3)  # exact squares
     # The six terms m_k² I_kj I_l, as in attitude.invariants._double_double.
-    t0 = _term(s1[0], s1[1], J21[0], J21[1], J3)
-    t1 = _term(s3[0], s3[1], J32[0], J32[1], J1)
-    t2 = _term(s1[0], s1[1], J31[0], J31[1], J2)
-    t3 = _term(s2[0], s2[1], J32[0], J32[1], J1)
-    t4 = _term(s2[0], s2[1], J21[0], J21[1], J3)
-    t5 = _term(s3[0], s3[1], J31[0], J31[1], J2)
+    t0 = _term(s1[0], s1[1], I21[0], I21[1], I3)
+    t1 = _term(s3[0], s3[1], I32[0], I32[1], I1)
+    t2 = _term(s1[0], s1[1], I31[0], I31[1], I2)
+    t3 = _term(s2[0], s2[1], I32[0], I32[1], I1)
+    t4 = _term(s2[0], s2[1], I21[0], I21[1], I3)
+    t5 = _term(s3[0], s3[1], I31[0], I31[1], I2)
     N2 = dd_plus_dd(t1[0], t1[1], -t0[0], -t0[1])  # I1 I3 Δ2
     P3 = dd_plus_dd(t2[0], t2[1], t3[0], t3[1])  # I1 I2 (−Δ3)
     N1 = dd_plus_dd(t4[0], t4[1], t5[0], t5[1])  # I2 I3 Δ1
@@ -119,21 +119,21 @@ def _case_test(I1, I2, I3, m1, m2, m3):
     G2 = dd_plus_dd(G2a[0], G2a[1], s3[0], s3[1])
     case_i = N2[0] < 0.0
     sign = -1.0 if case_i else 1.0
-    G2_23a = dd_times_float(G2[0], G2[1], J2)
-    G2_23 = dd_times_float(G2_23a[0], G2_23a[1], J3)
-    G2_12a = dd_times_float(G2[0], G2[1], J1)
-    G2_12 = dd_times_float(G2_12a[0], G2_12a[1], J2)
+    G2_23a = dd_times_float(G2[0], G2[1], I2)
+    G2_23 = dd_times_float(G2_23a[0], G2_23a[1], I3)
+    G2_12a = dd_times_float(G2[0], G2[1], I1)
+    G2_12 = dd_times_float(G2_12a[0], G2_12a[1], I2)
     δ1 = dd_over_dd(N1[0], N1[1], G2_23[0], G2_23[1])[0]
     δ3 = -dd_over_dd(P3[0], P3[1], G2_12[0], G2_12[1])[0]
     # mc = |N2| I2 I31 / (I3 P3 I21) in case (i), |N2| I2 I31 / (I1 N1 I32) in case (ii).
-    a0, a1 = dd_times_float(abs(N2[0]), math.copysign(1.0, N2[0]) * N2[1], J2)
-    num = dd_times_dd(a0, a1, J31[0], J31[1])
+    a0, a1 = dd_times_float(abs(N2[0]), math.copysign(1.0, N2[0]) * N2[1], I2)
+    num = dd_times_dd(a0, a1, I31[0], I31[1])
     if case_i:
-        b0, b1 = dd_times_float(P3[0], P3[1], J3)
-        den = dd_times_dd(b0, b1, J21[0], J21[1])
+        b0, b1 = dd_times_float(P3[0], P3[1], I3)
+        den = dd_times_dd(b0, b1, I21[0], I21[1])
     else:
-        b0, b1 = dd_times_float(N1[0], N1[1], J1)
-        den = dd_times_dd(b0, b1, J32[0], J32[1])
+        b0, b1 = dd_times_float(N1[0], N1[1], I1)
+        den = dd_times_dd(b0, b1, I32[0], I32[1])
     mc, mc_low = dd_over_dd(num[0], num[1], den[0], den[1])
     error = mc * (N2_error / abs(N2[0]) + 4.0 * _BOUND)
     fraction, exponent = math.frexp(mc)

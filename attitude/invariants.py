@@ -153,9 +153,9 @@ class MomentConstants:
     """What the double-double test needs of the sorted moments alone, for a batch.
 
     The moments scaled by a power of two, their exact differences and the Veltkamp
-    halves of every moment factor of ``_double_double``: computed once for a batch whose
-    moments stay while its momenta change (the torqued solver's spacecraft), they leave
-    the same operations on the momenta, so the same bits.
+    halves of every moment factor of ``_double_double``, each computed once for the
+    batch rather than in every product that takes it (the same operations, so the same
+    bits).
     """
 
     def __init__(self, I1: Any, I2: Any, I3: Any) -> None:
@@ -261,7 +261,7 @@ def invariants(
     """The invariants of states with sorted moments I1 ≤ I2 ≤ I3 (I1 < I3) and m ≠ 0.
 
     Floats with ``xp = FLOAT``, 1-D arrays of a batch with ``xp = numpy``; ``constants``:
-    ``MomentConstants(I1, I2, I3)`` if the caller keeps it (built here otherwise).
+    ``MomentConstants(I1, I2, I3)`` if the caller has it (built here otherwise).
     """
     if xp is FLOAT:
         # On one state in Python, the integers (~8 µs) cost less than the

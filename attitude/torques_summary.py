@@ -87,9 +87,9 @@ def torques_lines(plan: RunPlan) -> list[str]:
     entry = torques_summary(plan)
     if not entry["modelled"]:
         lines = ["torques     none: the exact torque-free solver"]
-        horizon = plan.horizon
+        horizon = horizon_text(plan)
         if horizon is not None:
-            lines.append(f"horizon     {horizon.describe(plan.scenario.format_epoch)}")
+            lines.append(f"horizon     {horizon}")
         return lines
     how = (
         f"step {plan.scenario.torques.step:g} s"
@@ -105,8 +105,9 @@ def torques_lines(plan: RunPlan) -> list[str]:
     lines.append(
         f"  estimated error of the run, through the events: {entry['estimated_error_rad']:.2g} rad"
     )
-    if plan.horizon is not None:  # burns alone, on an orbit: the gravity gradient left out
-        lines.append(f"horizon     {plan.horizon.describe(plan.scenario.format_epoch)}")
+    horizon = horizon_text(plan)
+    if horizon is not None:  # burns alone, on an orbit: the gravity gradient left out
+        lines.append(f"horizon     {horizon}")
     return lines
 
 

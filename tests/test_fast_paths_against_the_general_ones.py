@@ -201,13 +201,12 @@ def test_the_float_entry_point_names_a_non_finite_quaternion_or_step(quaternion,
 
 
 def test_a_unit_batch_kept_over_many_flows_gives_the_bits_of_fresh_calls(monkeypatch):
-    """``UnitBatch`` keeps what depends on the moments alone (sorting, the moment factors
-    of the double-double case test) across flows, as the torqued solver's batch does
-    between kicks: each flow gives the bits of ``advance_unit_batch``, which makes them
-    all again.  Every kind of state of the mixed batch (near and on the separatrix,
-    symmetric, sphere, rest), with momenta that change between flows (the kicks), so
-    that states cross from one case to another under the same moments; and in slices,
-    each with its own constants."""
+    """One ``UnitBatch`` reused across flows, as the torqued solver's batch is between
+    kicks: each flow gives the bits of ``advance_unit_batch``, which starts afresh.
+    Every kind of state of the mixed batch (near and on the separatrix, symmetric,
+    sphere, rest), with momenta that change between flows (the kicks), so that states
+    cross from one case to another under the same moments; the states the compiled
+    flow leaves take the numpy path in slices."""
     moments, momentum, q, dt, kinds = _mixed_batch(3000, seed=15)
     q = q / np.linalg.norm(q, axis=1, keepdims=True)
     monkeypatch.setattr(free_flow, "_CHUNK", 1100)  # three slices, the last a short one
