@@ -259,7 +259,7 @@ def _checked_run(args, state: dict) -> int:
         loaded = load_scenario(args.scenario)
         state["file"] = loaded.path.name
         if args.command == "montecarlo":
-            from attitude.montecarlo import command
+            from attitude.cli_montecarlo import command
 
             return command(args, loaded)
         outputs = _outputs(args, loaded.outputs)
@@ -267,7 +267,7 @@ def _checked_run(args, state: dict) -> int:
         plan = plan_run(loaded.scenario, loaded.pointing, outputs, horizon=args.command == "check")
         montecarlo = None
         if "dispersions" in loaded.document:  # checked by run too: one reading of the file
-            from attitude.montecarlo import plan_montecarlo
+            from attitude.montecarlo_plan import plan_montecarlo
 
             montecarlo = plan_montecarlo(loaded, plan)
         if args.command == "check":

@@ -25,7 +25,9 @@ from typing import Any
 
 import numpy as np
 
-from attitude.montecarlo import ANGLE_STEP_DEG, MonteCarloPlan, MonteCarloResult
+from attitude.montecarlo_metrics import ANGLE_STEP_DEG
+from attitude.montecarlo_plan import MonteCarloPlan
+from attitude.montecarlo_simulation import MonteCarloResult
 from attitude.montecarlo_statistics import (
     CONFIDENCE,
     COVERAGE,

@@ -102,13 +102,13 @@ def _uptime() -> str:
 def sample_stages(path: Path) -> dict:
     """One sample's cost in this process, stage by stage (best of 3, warm)."""
     from attitude.dispersions import draw_sample
-    from attitude.montecarlo import (
+    from attitude.montecarlo_metrics import (
         METRICS_ONLY,
         grid_rates,
-        plan_montecarlo,
         pointing_outcome,
         sun_angles_deg,
     )
+    from attitude.montecarlo_plan import plan_montecarlo
     from attitude.run_plan import plan_run
     from attitude.scenario_file import load_scenario, scenario_from_document
 
@@ -159,7 +159,8 @@ def attitude_run(path: Path, folder: Path) -> float:
 
 
 def montecarlo(path: Path, samples: int, workers: int) -> tuple[dict, object]:
-    from attitude.montecarlo import plan_montecarlo, simulate
+    from attitude.montecarlo_plan import plan_montecarlo
+    from attitude.montecarlo_simulation import simulate
     from attitude.scenario_file import load_scenario
 
     marks: dict[str, float] = {}

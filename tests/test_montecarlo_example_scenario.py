@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from attitude.cli import main
-from attitude.montecarlo import Job, evaluate_batch, plan_montecarlo
+from attitude.montecarlo_plan import Job, evaluate_batch, plan_montecarlo
 from attitude.scenario_file import load_scenario
 
 EXAMPLE = Path(__file__).parents[1] / "scenarios" / "spinner_dispersions.toml"

@@ -19,7 +19,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from attitude.cli import main
-from attitude.montecarlo import Job, evaluate_batch, plan_montecarlo
+from attitude.montecarlo_plan import Job, evaluate_batch, plan_montecarlo
 from attitude.scenario_file import load_scenario
 
 ROOT = Path(__file__).parents[1]

@@ -11,7 +11,8 @@ import numpy as np
 from montecarlo_scenarios import write_spinner
 from pandas.testing import assert_frame_equal
 
-from attitude.montecarlo import Job, evaluate_batch, plan_montecarlo, simulate
+from attitude.montecarlo_plan import Job, evaluate_batch, plan_montecarlo
+from attitude.montecarlo_simulation import simulate
 from attitude.scenario_file import load_scenario
 
 

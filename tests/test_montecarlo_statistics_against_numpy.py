@@ -19,7 +19,9 @@ import pytest
 from montecarlo_scenarios import write_spinner
 
 from attitude.dispersions import draw_sample
-from attitude.montecarlo import ANGLE_STEP_DEG, plan_montecarlo, sample_metrics, simulate
+from attitude.montecarlo_metrics import ANGLE_STEP_DEG, sample_metrics
+from attitude.montecarlo_plan import plan_montecarlo
+from attitude.montecarlo_simulation import simulate
 from attitude.montecarlo_report import statistics
 from attitude.montecarlo_statistics import PERCENTILES, describe, order_statistic_rank
 from attitude.run_plan import plan_run

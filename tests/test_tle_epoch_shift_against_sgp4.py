@@ -10,7 +10,8 @@ from sgp4.api import Satrec
 from sgp4.io import compute_checksum
 
 from attitude.dispersions import draw_sample, read_dispersions, shifted_tle_epoch
-from attitude.montecarlo import Job, evaluate_batch, metric_names
+from attitude.montecarlo_metrics import metric_names
+from attitude.montecarlo_plan import Job, evaluate_batch
 from attitude.scenario_file import load_scenario
 
 LINE1 = "1 59001U 27042A   27171.50000000  .00000120  00000-0  18000-4 0  9999"
