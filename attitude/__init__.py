@@ -1,23 +1,22 @@
 """attitude: exact spacecraft attitude.
 
-The layers, each importing only the ones above it in this list (README "Layout"):
+The layers are the subpackages, in the order data flows; each imports only its own
+layer and the ones before it, with no loop between modules (``tests/test_layering.py``
+checks it, and that the README's "Layout" table lists the same layers and modules):
 
-- ``attitude.elliptic``: Jacobi functions and elliptic integrals in mc = 1 − m
-- ``attitude.euler_solver``: ``EulerSolver``, the closed-form torque-free rigid body
-- ``attitude.torques``, ``splitting``, ``torqued_solver``: ``TorquedSolver``, torques
-  (gravity gradient, constant torques, user torques) by splitting with the exact free flow
-- ``attitude.spacecraft``, ``events``, ``scenario_torques``, ``scenario``, ``timescales``:
-  the scenario layer
-- ``attitude.torqued_segment``, ``trajectory``, ``horizon``, ``motion_analysis``:
-  the propagated motion
-- ``attitude.ephemeris``, ``earth``, ``frames``, ``orbit``, ``keplerian``, ``oem``,
-  ``aem_input``, ``intervals``, ``extrema``, ``eclipse``, ``pointing_spec``,
-  ``surroundings``, ``pointing_sampling``, ``pointing_search``, ``pointing``: pointing
-- ``attitude.csv_files``, ``aem``, ``summaries``, ``plots``, ``report_page``, ``report``: reports
-  and exports
-- ``attitude.scenario_file``, ``cli``: scenario files and the command line; beside them,
-  ``dispersions``, ``scenario_writer`` and ``montecarlo`` (``run_montecarlo``): Monte
-  Carlo jobs on Dask, which drive the scenario layer from above
+1. ``attitude.base``: errors, units, quaternions, vectors, the compile policy
+2. ``attitude.elliptic``: Jacobi elliptic functions and elliptic integrals, the phase table
+3. ``attitude.solver``: the exact torque-free solver (``EulerSolver``) and its free flow
+4. ``attitude.torques``: torques by splitting with the exact free flow (``TorquedSolver``)
+5. ``attitude.environment``: time scales, the Sun and Moon, the Earth, frames, orbits
+6. ``attitude.scenario``: the spacecraft, its initial state, events, a scenario's torques
+7. ``attitude.trajectory``: the propagated motion, its validity horizon, its analysis
+8. ``attitude.pointing``: the Sun, Moon and Earth on the body vectors; the exact search
+9. ``attitude.outputs``: CSV, Parquet and AEM files, the output budget and folder
+10. ``attitude.report``: a run's plan, summaries, figures, page and streamed writing
+11. ``attitude.files``: scenario files read and written
+12. ``attitude.montecarlo``: Monte Carlo dispersions on Dask
+13. ``attitude.cli``: the command line
 
 The names below are importable from ``attitude`` directly; all but the errors are
 loaded on first use, so that ``import attitude`` stays light (numpy, scipy, astropy,
@@ -33,60 +32,62 @@ scalar first and say so.
 from importlib import import_module
 from typing import TYPE_CHECKING, Any
 
-from attitude.errors import AttitudeError, InertiaWarning, InputError
-from attitude.version import __version__
+from attitude.base.errors import AttitudeError, InertiaWarning, InputError
+from attitude.base.version import __version__
 
 if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and IDEs
-    from attitude.aem import write_aem
-    from attitude.euler_solver import EulerSolver
-    from attitude.events import AngularImpulse, AttitudeReset, InertiaChange
-    from attitude.horizon import validity_horizon
-    from attitude.keplerian import KeplerianOrbit
-    from attitude.montecarlo import run_montecarlo
-    from attitude.motion_analysis import analyze
-    from attitude.oem import OemOrbit
-    from attitude.orbit import TleOrbit
-    from attitude.pointing import BodyVector, PointingSpec, pointing_analysis, pointing_samples
-    from attitude.report import write_report
-    from attitude.scenario import InitialState, Scenario
-    from attitude.scenario_file import load_scenario
-    from attitude.scenario_torques import Burn, ScenarioTorques
-    from attitude.spacecraft import Spacecraft
-    from attitude.torqued_solver import TorquedSolver, departure_time, propagate_batch
-    from attitude.torques import ConstantTorque, GravityGradient, UserTorque
-    from attitude.trajectory import Trajectory, propagate
+    from attitude.environment.keplerian import KeplerianOrbit
+    from attitude.environment.oem import OemOrbit
+    from attitude.environment.orbit import TleOrbit
+    from attitude.files.scenario_reader import load_scenario
+    from attitude.montecarlo.job import run_montecarlo
+    from attitude.outputs.aem_writer import write_aem
+    from attitude.pointing.sampling import pointing_samples
+    from attitude.pointing.search import pointing_analysis
+    from attitude.pointing.spec import BodyVector, PointingSpec
+    from attitude.report.run import write_report
+    from attitude.scenario.events import AngularImpulse, AttitudeReset, InertiaChange
+    from attitude.scenario.scenario import InitialState, Scenario
+    from attitude.scenario.spacecraft import Spacecraft
+    from attitude.scenario.torques import Burn, ScenarioTorques
+    from attitude.solver.euler_solver import EulerSolver
+    from attitude.torques.models import ConstantTorque, GravityGradient, UserTorque
+    from attitude.torques.solver import TorquedSolver, departure_time, propagate_batch
+    from attitude.trajectory.horizon import validity_horizon
+    from attitude.trajectory.motion import analyze
+    from attitude.trajectory.trajectory import Trajectory, propagate
 
 _LAZY = {
-    "EulerSolver": "attitude.euler_solver",
-    "TorquedSolver": "attitude.torqued_solver",
-    "propagate_batch": "attitude.torqued_solver",
-    "departure_time": "attitude.torqued_solver",
-    "GravityGradient": "attitude.torques",
-    "ConstantTorque": "attitude.torques",
-    "UserTorque": "attitude.torques",
-    "Spacecraft": "attitude.spacecraft",
-    "InitialState": "attitude.scenario",
-    "Scenario": "attitude.scenario",
-    "ScenarioTorques": "attitude.scenario_torques",
-    "Burn": "attitude.scenario_torques",
-    "validity_horizon": "attitude.horizon",
-    "AngularImpulse": "attitude.events",
-    "InertiaChange": "attitude.events",
-    "AttitudeReset": "attitude.events",
-    "propagate": "attitude.trajectory",
-    "Trajectory": "attitude.trajectory",
-    "analyze": "attitude.motion_analysis",
-    "BodyVector": "attitude.pointing",
-    "PointingSpec": "attitude.pointing",
-    "pointing_samples": "attitude.pointing",
-    "pointing_analysis": "attitude.pointing",
-    "TleOrbit": "attitude.orbit",
-    "KeplerianOrbit": "attitude.keplerian",
-    "OemOrbit": "attitude.oem",
-    "write_aem": "attitude.aem",
-    "load_scenario": "attitude.scenario_file",
-    "write_report": "attitude.report",
-    "run_montecarlo": "attitude.montecarlo",
+    "EulerSolver": "attitude.solver.euler_solver",
+    "TorquedSolver": "attitude.torques.solver",
+    "propagate_batch": "attitude.torques.solver",
+    "departure_time": "attitude.torques.solver",
+    "GravityGradient": "attitude.torques.models",
+    "ConstantTorque": "attitude.torques.models",
+    "UserTorque": "attitude.torques.models",
+    "Spacecraft": "attitude.scenario.spacecraft",
+    "InitialState": "attitude.scenario.scenario",
+    "Scenario": "attitude.scenario.scenario",
+    "ScenarioTorques": "attitude.scenario.torques",
+    "Burn": "attitude.scenario.torques",
+    "validity_horizon": "attitude.trajectory.horizon",
+    "AngularImpulse": "attitude.scenario.events",
+    "InertiaChange": "attitude.scenario.events",
+    "AttitudeReset": "attitude.scenario.events",
+    "propagate": "attitude.trajectory.trajectory",
+    "Trajectory": "attitude.trajectory.trajectory",
+    "analyze": "attitude.trajectory.motion",
+    "BodyVector": "attitude.pointing.spec",
+    "PointingSpec": "attitude.pointing.spec",
+    "pointing_samples": "attitude.pointing.sampling",
+    "pointing_analysis": "attitude.pointing.search",
+    "TleOrbit": "attitude.environment.orbit",
+    "KeplerianOrbit": "attitude.environment.keplerian",
+    "OemOrbit": "attitude.environment.oem",
+    "write_aem": "attitude.outputs.aem_writer",
+    "load_scenario": "attitude.files.scenario_reader",
+    "write_report": "attitude.report.run",
+    "run_montecarlo": "attitude.montecarlo.job",
 }
 
 # Spelled out (not built from _LAZY) so that linters and IDEs read it statically;

@@ -1,7 +1,7 @@
-"""``python -m attitude``: the command line (``attitude.cli``)."""
+"""``python -m attitude``: the command line (``attitude.cli.main``)."""
 
 import sys
 
-from attitude.cli import main
+from attitude.cli.main import main
 
 sys.exit(main())

@@ -1,4 +1,4 @@
-"""Benchmark: the free-flow map ``attitude.free_flow.advance``, against scipy's ellipj.
+"""Benchmark: the free-flow map ``attitude.solver.free_flow.advance``, against scipy's ellipj.
 
 In one run, as ratios to peers timed side by side (absolute times depend on the load,
 which is printed):
@@ -38,7 +38,7 @@ from scipy import special
 from scipy.spatial.transform import Rotation
 
 from attitude import EulerSolver
-from attitude.free_flow import UnitBatch, advance, advance_floats
+from attitude.solver.free_flow import UnitBatch, advance, advance_floats
 
 RESULTS = Path(__file__).parent / "results"
 

@@ -101,23 +101,23 @@ def _uptime() -> str:
 
 def sample_stages(path: Path) -> dict:
     """One sample's cost in this process, stage by stage (best of 3, warm)."""
-    from attitude.dispersions import draw_sample
-    from attitude.montecarlo_metrics import (
+    from attitude.files.scenario_reader import load_scenario, scenario_from_document
+    from attitude.montecarlo.dispersions import draw_sample
+    from attitude.montecarlo.metrics import (
         METRICS_ONLY,
         grid_rates,
         pointing_outcome,
         sun_angles_deg,
     )
-    from attitude.montecarlo_plan import plan_montecarlo
-    from attitude.run_plan import plan_run
-    from attitude.scenario_file import load_scenario, scenario_from_document
+    from attitude.montecarlo.plan import plan_montecarlo
+    from attitude.report.plan import plan_run
 
     loaded = load_scenario(path)
     mc = plan_montecarlo(loaded)
     d, document = mc.dispersions, loaded.document
     sample = draw_sample(d, document, 0)
     sample_loaded = scenario_from_document(path, sample.document)
-    # As the job plans a sample (attitude.montecarlo): no validity horizon.
+    # As the job plans a sample (attitude.montecarlo.job): no validity horizon.
     plan = plan_run(sample_loaded.scenario, sample_loaded.pointing, METRICS_ONLY, horizon=False)
     seconds = plan.scenario.output_seconds()
     pointing_outcome(plan)  # warm: the ephemeris
@@ -159,9 +159,9 @@ def attitude_run(path: Path, folder: Path) -> float:
 
 
 def montecarlo(path: Path, samples: int, workers: int) -> tuple[dict, object]:
-    from attitude.montecarlo_plan import plan_montecarlo
-    from attitude.montecarlo_simulation import simulate
-    from attitude.scenario_file import load_scenario
+    from attitude.files.scenario_reader import load_scenario
+    from attitude.montecarlo.plan import plan_montecarlo
+    from attitude.montecarlo.simulation import simulate
 
     marks: dict[str, float] = {}
 
@@ -229,7 +229,7 @@ def main(argv: list[str] | None = None) -> dict:
             "mc_sample_on_1_worker_over_in_process_sample": (1.0 / one["samples_per_s"])
             / report["sample_in_process"]["total_s"],
         }
-        from attitude.montecarlo_report import write_report
+        from attitude.montecarlo.report import write_report
 
         start = time.perf_counter()
         write_report(two_result, folder / "mc")

@@ -26,8 +26,8 @@ DAYS = (0.25, 1.0, 4.0)
 _CHILD = """
 import json, re, resource, sys, time
 from pathlib import Path
-from attitude.scenario_file import load_scenario
-from attitude.trajectory import propagate
+from attitude.files.scenario_reader import load_scenario
+from attitude.trajectory.trajectory import propagate
 from attitude.pointing import pointing_analysis
 days = float(sys.argv[1])
 text = (Path(sys.argv[2]) / "scenarios" / "spinner_thruster_pulse.toml").read_text()

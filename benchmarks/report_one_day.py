@@ -58,7 +58,7 @@ def export_peer(commit: str, folder: Path) -> Path:
 
 
 def run_once(
-    tree: Path, scenario: Path, out: Path, extra: list[str], module: str = "attitude.cli"
+    tree: Path, scenario: Path, out: Path, extra: list[str], module: str = "attitude.cli.main"
 ) -> dict:
     """One ``attitude run`` of ``tree``'s package: wall time, peak RSS, stages, sizes."""
     environment = dict(os.environ, PYTHONPATH=os.pathsep.join([str(tree), str(ROOT)]))

@@ -3,11 +3,11 @@
 On the one-day spinner's time series (86 401 rows, 41 columns: trajectory and
 pointing), in one process, alternately, best of ``--repeat``:
 
-- the CSV: ``attitude.csv_files.CsvWriter`` (Arrow's C++ formatter, shortest round-trip
+- the CSV: ``attitude.outputs.csv.CsvWriter`` (Arrow's C++ formatter, shortest round-trip
   text) against numpy's fastest text path, ``np.savetxt`` with ``%.17g`` on the same
   numbers (without the epoch column, which savetxt cannot mix in: the peer has less
   to write);
-- the epoch texts: ``attitude.epoch_texts.EpochTexts`` against astropy's ``isot``
+- the epoch texts: ``attitude.environment.epoch_texts.EpochTexts`` against astropy's ``isot``
   (``Scenario.iso``), UTC;
 - the AEM records: ``AemWriter.write_records`` with those texts against
   ``write_aem`` with astropy times (its per-segment path);
@@ -50,13 +50,13 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args(argv)
 
-    from attitude.aem import AemSegment, AemWriter, write_aem
-    from attitude.csv_files import CsvWriter, pointing_columns, sample, trajectory_columns
-    from attitude.epoch_texts import EpochTexts
-    from attitude.pointing import pointing_samples
-    from attitude.scenario_file import load_scenario
-    from attitude.timeseries_parquet import ParquetWriter
-    from attitude.trajectory import propagate
+    from attitude.environment.epoch_texts import EpochTexts
+    from attitude.files.scenario_reader import load_scenario
+    from attitude.outputs.aem_writer import AemSegment, AemWriter, write_aem
+    from attitude.outputs.csv import CsvWriter, pointing_columns, sample, trajectory_columns
+    from attitude.outputs.parquet import ParquetWriter
+    from attitude.pointing.sampling import pointing_samples
+    from attitude.trajectory.trajectory import propagate
 
     text = (ROOT / "scenarios" / "spinner_thruster_pulse.toml").read_text()
     text = re.sub(r"(?m)^duration = .*$", "duration = 86400.0", text)

@@ -606,7 +606,7 @@ def main(argv=None) -> dict:
     def log(message: str) -> None:
         print(message, flush=True)
 
-    from attitude import free_flow
+    from attitude.solver import free_flow
 
     provisional = "PROVISIONAL" in (free_flow.__doc__ or "")
     have_basilisk = basilisk_availability()

@@ -16,8 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from attitude.scenario_file import load_scenario
-from attitude.trajectory import propagate
+from attitude.files.scenario_reader import load_scenario
+from attitude.trajectory.trajectory import propagate
 
 RESULTS = Path(__file__).parent / "results"
 SCENARIO = Path(__file__).parents[1] / "scenarios" / "spinner_thruster_pulse.toml"

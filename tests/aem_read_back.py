@@ -20,7 +20,7 @@ import ccsds_ndm
 import numpy as np
 from astropy.time import Time
 
-from attitude.timescales import offline_time, tt_seconds
+from attitude.environment.timescales import offline_time, tt_seconds
 
 # Our inputs come from scipy's Rotation (norm within a few 1e-16) and are written with 16
 # significant digits: the norm read back is 1 to well within this.
@@ -126,7 +126,7 @@ def interpolate_as_declared(segment: Segment, t_s: np.ndarray, epoch: Time) -> n
     (shifted to stay inside the segment), then normalized.  Returns (w, x, y, z).
 
     Written apart from the package (which has its own reading in
-    ``attitude.aem_sampling``): Neville's recurrence, vectorized over the epochs.
+    ``attitude.outputs.aem_sampling``): Neville's recurrence, vectorized over the epochs.
     """
     meta = segment.metadata
     assert meta.interpolation_method == "LAGRANGE", meta.interpolation_method

@@ -210,7 +210,7 @@ def astropy_apparent_sun(times):
         solar_system_ephemeris,
     )
 
-    from attitude.timescales import offline_time
+    from attitude.environment.timescales import offline_time
 
     with offline_time(), solar_system_ephemeris.set("builtin"):
         earth = get_body_barycentric("earth", times)

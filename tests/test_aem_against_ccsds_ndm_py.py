@@ -25,9 +25,9 @@ from aem_read_back import parse, read_back
 from astropy.time import Time
 from scipy.spatial.transform import Rotation
 
-from attitude.aem import QUATERNION_COMMENT, AemSegment, write_aem
-from attitude.errors import InputError
-from attitude.timescales import offline_time, time_from_tt_seconds, tt_seconds
+from attitude.base.errors import InputError
+from attitude.environment.timescales import offline_time, time_from_tt_seconds, tt_seconds
+from attitude.outputs.aem_writer import QUATERNION_COMMENT, AemSegment, write_aem
 
 CREATED = "2026-11-22T12:00:00"
 # A quaternion component |x| < 1 written with 16 significant digits comes back within

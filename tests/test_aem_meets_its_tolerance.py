@@ -19,10 +19,10 @@ import numpy as np
 import pytest
 from aem_read_back import interpolate_as_declared, read_back, rotation_angle
 
-from attitude.cli import main
-from attitude.scenario_file import load_scenario
-from attitude.timescales import tt_seconds
-from attitude.trajectory import propagate
+from attitude.cli.main import main
+from attitude.environment.timescales import tt_seconds
+from attitude.files.scenario_reader import load_scenario
+from attitude.trajectory.trajectory import propagate
 
 ROOT = Path(__file__).parents[1]
 

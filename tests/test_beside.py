@@ -1,4 +1,4 @@
-"""The validity horizon computed in a process beside the run (attitude.beside).
+"""The validity horizon computed in a process beside the run (attitude.report.beside).
 
 Against the same computation in the process itself: the same value (bit for bit)
 and the same exception; a child still running when the block is left (an error, a
@@ -18,13 +18,13 @@ from pathlib import Path
 
 import pytest
 
-import attitude.beside
-from attitude.beside import Beside
-from attitude.horizon import validity_horizon
-from attitude.output_formats import OutputChoice
-from attitude.report import write_report
-from attitude.run_plan import plan_run
-from attitude.scenario_file import load_scenario
+import attitude.report.beside
+from attitude.files.scenario_reader import load_scenario
+from attitude.outputs.formats import OutputChoice
+from attitude.report.beside import Beside
+from attitude.report.plan import plan_run
+from attitude.report.run import write_report
+from attitude.trajectory.horizon import validity_horizon
 
 ROOT = Path(__file__).parents[1]
 linux_only = pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="needs /proc")
@@ -69,7 +69,7 @@ def test_an_exception_is_raised_in_the_parent():
 
 
 def test_without_fork_it_computes_in_the_parent(monkeypatch):
-    monkeypatch.delattr(attitude.beside.os, "fork")
+    monkeypatch.delattr(attitude.report.beside.os, "fork")
     with Beside(os.getpid) as beside:
         assert beside.result() == os.getpid()
 

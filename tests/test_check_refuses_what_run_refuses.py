@@ -1,6 +1,6 @@
 """`attitude check` refuses whatever `attitude run` refuses, with the same one line.
 
-Both go through one path up to the sampling (attitude.run_plan).  Each file below
+Both go through one path up to the sampling (attitude.report.plan).  Each file below
 was accepted by `check` and refused by `run` after computing, or crashed `run` with a
 traceback: a bad TLE, an epoch outside the ephemeris (with the margins the pointing
 adds), a far TLE epoch, wrong types, absurd magnitudes, outputs that cannot fit on
@@ -14,7 +14,7 @@ import re
 
 import pytest
 
-from attitude.cli import main
+from attitude.cli.main import main
 
 BASE = """
 [scenario]

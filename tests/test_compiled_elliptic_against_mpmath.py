@@ -1,4 +1,4 @@
-"""The compiled elliptic kernels (attitude.compiled_elliptic) against mpmath.
+"""The compiled elliptic kernels (attitude.elliptic.compiled) against mpmath.
 
 mpmath evaluates the same functions at the same float arguments with 40 digits.  The
 tolerances are ulps of the value, as in test_elliptic_against_mpmath.py for the numpy
@@ -12,7 +12,7 @@ import mpmath as mp
 import numpy as np
 import pytest
 
-from attitude.compiled_elliptic import (
+from attitude.elliptic.compiled import (
     AGM_LEVELS,
     agm,
     carlson_rf,

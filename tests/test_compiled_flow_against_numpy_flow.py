@@ -1,4 +1,4 @@
-"""The compiled free flow (attitude.compiled_flow) against the numpy one (free_flow's
+"""The compiled free flow (attitude.solver.compiled_flow) against the numpy one (free_flow's
 ``_advance_many``, the path of every case) on the same states.
 
 - Both are the exact flow to rounding, from different kernels (numba's against
@@ -21,8 +21,8 @@ import numpy as np
 from reference_models import state_with_delta2
 from scipy.spatial.transform import Rotation
 
-from attitude.compiled_flow import flow_many, flow_one
-from attitude.free_flow import _advance_many, advance
+from attitude.solver.compiled_flow import flow_many, flow_one
+from attitude.solver.free_flow import _advance_many, advance
 
 EPS = np.finfo(float).eps
 
@@ -149,7 +149,7 @@ def test_a_kernel_that_cannot_be_cached_is_still_compiled():
     """Where numba has no writable cache location it refuses cache=True; ``jit`` then
     compiles without caching instead of failing the import.  A function with no
     source file (made by exec) has no cache location either."""
-    from attitude.compiled import jit
+    from attitude.base.jit import jit
 
     namespace: dict = {}
     exec("def twice(x):\n    return 2.0 * x / 0.0 if x == 0.0 else 2.0 * x", namespace)

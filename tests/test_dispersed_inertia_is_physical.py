@@ -13,8 +13,8 @@ import warnings
 import numpy as np
 import pytest
 
-from attitude.dispersions import draw_sample, read_dispersions
-from attitude.scenario_file import ScenarioFileError, load_scenario, scenario_from_document
+from attitude.files.scenario_reader import ScenarioFileError, load_scenario, scenario_from_document
+from attitude.montecarlo.dispersions import draw_sample, read_dispersions
 
 BODY = """
 [scenario]

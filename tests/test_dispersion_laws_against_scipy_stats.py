@@ -17,9 +17,9 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from attitude.dispersions import draw_sample, read_dispersions
-from attitude.scenario_file import load_scenario
-from attitude.vectors import angle_between
+from attitude.base.vectors import angle_between
+from attitude.files.scenario_reader import load_scenario
+from attitude.montecarlo.dispersions import draw_sample, read_dispersions
 
 SCENARIO = """
 [scenario]

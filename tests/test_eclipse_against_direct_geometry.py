@@ -21,8 +21,11 @@ import pytest
 from astropy.time import Time
 from scipy.optimize import brentq
 
-from attitude.earth import EARTH_EQUATORIAL_RADIUS_M as EARTH_RADIUS_M
-from attitude.eclipse import (
+from attitude.environment.earth import EARTH_EQUATORIAL_RADIUS_M as EARTH_RADIUS_M
+from attitude.environment.ephemeris import _ephemeris, sun_position_from_earth, timescale
+from attitude.environment.orbit import TleOrbit
+from attitude.environment.timescales import offline_time, time_from_tt_seconds, tt_seconds
+from attitude.pointing.eclipse import (
     SUN_RADIUS_M,
     EclipseState,
     eclipse_intervals,
@@ -30,9 +33,6 @@ from attitude.eclipse import (
     shadow_angles,
     sunlit_fraction,
 )
-from attitude.ephemeris import _ephemeris, sun_position_from_earth, timescale
-from attitude.orbit import TleOrbit
-from attitude.timescales import offline_time, time_from_tt_seconds, tt_seconds
 
 # ISS (ZARYA), a real element set (as printed in the skyfield documentation).
 LINE1 = "1 25544U 98067A   14020.93268519  .00009878  00000-0  18200-3 0  5082"

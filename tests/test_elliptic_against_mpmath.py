@@ -14,7 +14,7 @@ import mpmath as mp
 import numpy as np
 import pytest
 
-from attitude.elliptic import (
+from attitude.elliptic.functions import (
     NEAR_ONE_MC,
     complete_first_kind,
     complete_first_kind_near_one,

@@ -1,4 +1,4 @@
-"""ISO epoch texts written from integers (attitude.epoch_texts) against astropy's own.
+"""ISO epoch texts written from integers (attitude.environment.epoch_texts) against astropy's own.
 
 The authority is astropy: ``Time`` of the epoch plus TT seconds, converted to the
 scenario's scale, written with ``isot`` at precision 9, as ``Scenario.iso`` does.  Over
@@ -16,8 +16,8 @@ import erfa
 import numpy as np
 import pytest
 
-from attitude.epoch_texts import EpochTexts
-from attitude.timescales import as_time, iso_texts, offline_time, time_from_tt_seconds
+from attitude.environment.epoch_texts import EpochTexts
+from attitude.environment.timescales import as_time, iso_texts, offline_time, time_from_tt_seconds
 
 
 def _astropy(epoch, seconds):

@@ -20,11 +20,11 @@ from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
 from attitude import EulerSolver
-from attitude.events import AngularImpulse, AttitudeReset, InertiaChange
-from attitude.scenario import InitialState, Scenario
-from attitude.spacecraft import Spacecraft
-from attitude.timescales import as_time
-from attitude.trajectory import propagate
+from attitude.environment.timescales import as_time
+from attitude.scenario.events import AngularImpulse, AttitudeReset, InertiaChange
+from attitude.scenario.scenario import InitialState, Scenario
+from attitude.scenario.spacecraft import Spacecraft
+from attitude.trajectory.trajectory import propagate
 
 EPOCH = "2027-05-01T00:00:00"
 ATTITUDE0 = Rotation.from_euler("ZYX", [30.0, -20.0, 75.0], degrees=True)

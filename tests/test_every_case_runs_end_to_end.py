@@ -17,7 +17,7 @@ from csv_read_back import read_csv
 from reference_models import integrate_dop853
 from scipy.spatial.transform import Rotation
 
-from attitude.cli import main
+from attitude.cli.main import main
 
 TEMPLATE = """
 [scenario]

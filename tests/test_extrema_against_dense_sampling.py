@@ -24,10 +24,12 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from attitude.pointing import BodyVector, PointingSpec, pointing_analysis, pointing_samples
-from attitude.scenario import InitialState, Scenario
-from attitude.spacecraft import Spacecraft
-from attitude.trajectory import propagate
+from attitude.pointing.sampling import pointing_samples
+from attitude.pointing.search import pointing_analysis
+from attitude.pointing.spec import BodyVector, PointingSpec
+from attitude.scenario.scenario import InitialState, Scenario
+from attitude.scenario.spacecraft import Spacecraft
+from attitude.trajectory.trajectory import propagate
 
 TLE = (
     "1 59001U 27042A   27171.50000000  .00000120  00000-0  18000-4 0  9999",
@@ -160,7 +162,7 @@ def test_the_output_grid_alone_would_be_wrong(cubesat):
 def test_nothing_depends_on_the_chunks(cubesat, monkeypatch):
     # The search runs in chunks of CHUNK_POINTS grid points: with chunks of 1000 the
     # intervals are the same (joined at the chunks' ends), and so are the extrema.
-    import attitude.pointing_search as pointing_search
+    import attitude.pointing.search as pointing_search
 
     analysis, _, _, trajectory, spec = cubesat
     monkeypatch.setattr(pointing_search, "CHUNK_POINTS", 1000)
@@ -190,8 +192,8 @@ def test_vector_rate_bounds_against_finite_differences(name):
     # bound is within 5 % of the fastest chord (it is meant to prune).
     from pathlib import Path
 
-    from attitude.pointing_search import search_grid
-    from attitude.scenario_file import load_scenario
+    from attitude.files.scenario_reader import load_scenario
+    from attitude.pointing.search import search_grid
 
     file = load_scenario(Path(__file__).parents[1] / "scenarios" / f"{name}.toml")
     vectors = file.pointing.body_vectors or [BodyVector("x", [1.0, 0.0, 0.0])]
@@ -218,7 +220,7 @@ def test_least_against_scipy_bounded_minimization(lipschitz):
     # (3.95) and with none (inf: every bracket refined).
     from scipy.optimize import minimize_scalar
 
-    from attitude.extrema import least
+    from attitude.pointing.extrema import least
 
     def f(t):
         return np.cos(3.0 * t) + 0.1 * t + 0.05 * np.sin(17.0 * t)

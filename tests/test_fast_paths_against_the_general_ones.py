@@ -19,11 +19,11 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-import attitude.euler_solver as euler_solver
-import attitude.free_flow as free_flow
+import attitude.solver.euler_solver as euler_solver
+import attitude.solver.free_flow as free_flow
 from attitude import EulerSolver
-from attitude.errors import InputError
-from attitude.euler_solver import _TABLE_MIN_SAMPLES, _one_rotation
+from attitude.base.errors import InputError
+from attitude.solver.euler_solver import _TABLE_MIN_SAMPLES, _one_rotation
 
 ATTITUDE0 = Rotation.from_euler("ZYX", [10.0, 20.0, 30.0], degrees=True)
 STATES = {
@@ -115,7 +115,7 @@ def test_the_one_quaternion_rotation_is_the_public_constructors():
 
 def test_a_symmetric_body_computes_no_elliptic_integral_of_the_third_kind(monkeypatch):
     """I1 = I2 (or I2 = I3): n = 0, so Π − F = 0; R_J would only be multiplied by zero."""
-    import attitude.elliptic as elliptic
+    import attitude.elliptic.functions as elliptic
 
     def refuse(*args, **kwargs):
         raise AssertionError("R_J computed for a symmetric body")

@@ -12,9 +12,9 @@ from pathlib import Path
 
 import pytest
 
-import attitude.csv_files
-import attitude.timeseries_parquet
-from attitude.cli import main
+import attitude.outputs.csv
+import attitude.outputs.parquet
+from attitude.cli.main import main
 
 SCENARIO = """
 [scenario]
@@ -161,8 +161,8 @@ def test_a_disk_full_in_the_middle_of_the_stream_leaves_nothing(
     (out / "notes.txt").write_text("mine\n")
     before = {p.name: p.read_bytes() for p in out.iterdir()}
     target = {
-        "csv": attitude.csv_files.CsvWriter,
-        "parquet": attitude.timeseries_parquet.ParquetWriter,
+        "csv": attitude.outputs.csv.CsvWriter,
+        "parquet": attitude.outputs.parquet.ParquetWriter,
     }[failing]
     write = target.write
     calls = []

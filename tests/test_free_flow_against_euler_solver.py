@@ -1,4 +1,4 @@
-"""attitude.free_flow.advance (many states, one step each) against EulerSolver, itself.
+"""attitude.solver.free_flow.advance (many states, one step each) against EulerSolver, itself.
 
 - Every case in one batch (both sides of the separatrix and on it, states 1e-154 G
   from it, symmetric bodies, the sphere, rest, spin about each axis, moments in any
@@ -16,7 +16,7 @@ from reference_models import state_with_delta2
 from scipy.spatial.transform import Rotation
 
 from attitude import EulerSolver, InputError
-from attitude.free_flow import advance
+from attitude.solver.free_flow import advance
 
 
 def _mixed_states(count, seed):

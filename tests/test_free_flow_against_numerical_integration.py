@@ -1,4 +1,4 @@
-"""attitude.free_flow.advance against scipy's DOP853 at rtol 1e-13, state by state.
+"""attitude.solver.free_flow.advance against scipy's DOP853 at rtol 1e-13, state by state.
 
 One batch of 60 random bodies and states (moments in any order, both sides of the
 separatrix with |Δ2|/G² ≥ 1e-3, where DOP853 is itself within 1e-10: see
@@ -11,7 +11,7 @@ import numpy as np
 from reference_models import integrate_dop853, mp_invariants
 from scipy.spatial.transform import Rotation
 
-from attitude.free_flow import advance
+from attitude.solver.free_flow import advance
 
 
 def _states(count=60, seed=31):

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from attitude.cli import main
+from attitude.cli.main import main
 
 HOSTILE = sorted((Path(__file__).parent / "hostile").glob("*.toml"))
 # The OEM and AEM files the hostile scenarios read (beside them, as a user keeps them).

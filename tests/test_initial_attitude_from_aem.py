@@ -17,12 +17,12 @@ import pytest
 from astropy.time import Time
 from scipy.spatial.transform import Rotation
 
-from attitude.aem import AemSegment, write_aem
-from attitude.aem_input import attitude_from_aem
-from attitude.errors import InputError
-from attitude.euler_solver import EulerSolver
-from attitude.frames import eme2000_to_icrf
-from attitude.timescales import time_from_tt_seconds
+from attitude.base.errors import InputError
+from attitude.environment.frames import eme2000_to_icrf
+from attitude.environment.timescales import time_from_tt_seconds
+from attitude.files.aem_reader import attitude_from_aem
+from attitude.outputs.aem_writer import AemSegment, write_aem
+from attitude.solver.euler_solver import EulerSolver
 
 EPOCH = Time("2027-06-21T00:00:00", scale="utc")
 SOLVER = EulerSolver.from_angular_velocity([10.0, 20.0, 30.0], [0.05, 0.3, 0.02])
@@ -126,8 +126,8 @@ def test_an_epoch_outside_the_file_is_refused(tmp_path, aem_text):
 def test_a_scenario_starts_from_the_aem(tmp_path, aem_text):
     # [initial_state] aem = "spin.aem": the scenario's first attitude is the file's at its
     # epoch (2027-06-21T00:00:13.37, between records), relative to the scenario file.
-    from attitude.scenario_file import load_scenario
-    from attitude.trajectory import propagate
+    from attitude.files.scenario_reader import load_scenario
+    from attitude.trajectory.trajectory import propagate
 
     (tmp_path / "spin.aem").write_text(aem_text)
     (tmp_path / "start.toml").write_text(

@@ -16,11 +16,11 @@ import pytest
 from astropy import units as u
 from scipy.integrate import solve_ivp
 
-from attitude.earth import GM_EARTH_M3_S2
-from attitude.errors import InputError
-from attitude.frames import eme2000_to_icrf
-from attitude.keplerian import KeplerianOrbit, solve_kepler
-from attitude.timescales import time_from_tt_seconds
+from attitude.base.errors import InputError
+from attitude.environment.earth import GM_EARTH_M3_S2
+from attitude.environment.frames import eme2000_to_icrf
+from attitude.environment.keplerian import KeplerianOrbit, solve_kepler
+from attitude.environment.timescales import time_from_tt_seconds
 
 EPOCH = "2027-06-21T00:00:00"
 ORBITS = {

@@ -1,135 +1,131 @@
-"""The package's layers import only the layers before them.
+"""The package's layers are its folders, and data flows one way through them.
 
-Data flows one way: elliptic kernels → the Euler solver → ... (see README "Layout").
-A module that is not listed here fails the test, so a new module must be placed.
+The order is the one ``attitude/__init__.py`` lists (README "Layout" shows the same):
+a module imports only modules of its own folder or of earlier folders, and no import
+loop exists at any level: not between modules (same folder included, lazy imports
+included), hence not between folders either.
 """
 
 import ast
+import re
 from pathlib import Path
 
 PACKAGE = Path(__file__).parents[1] / "attitude"
-
-# In order; a module may import modules of its own layer or of earlier ones.
-LAYERS = [
-    [  # shared base
-        "version",
-        "errors",
-        "quantities",
-        "quaternions",
-        "vectors",
-        "float_math",
-        "compiled",
-        "compiled_double_double",
-    ],
-    ["elliptic", "compiled_elliptic", "phase_table"],  # elliptic kernels
-    [  # the Euler solver
-        "inertia",
-        "invariants",
-        "closed_form",
-        "euler_solver",
-        "compiled_flow",
-        "free_flow",
-    ],
-    ["torques", "splitting", "torqued_solver"],  # torques and splitting
-    [  # scenario and events
-        "timescales",
-        "epoch_texts",
-        "spacecraft",
-        "events",
-        "scenario_torques",
-        "scenario",
-    ],
-    ["torqued_segment", "trajectory", "horizon", "motion_analysis"],  # trajectory
-    [  # pointing (skyfield)
-        "ephemeris",
-        "earth",
-        "frames",
-        "orbit",
-        "keplerian",
-        "ccsds_files",
-        "oem",
-        "aem_input",
-        "intervals",
-        "extrema",
-        "eclipse",
-        "pointing_spec",
-        "surroundings",
-        "pointing_sampling",
-        "pointing_search",
-        "pointing",
-    ],
-    [  # reports and exports
-        "csv_files",
-        "timeseries_parquet",
-        "aem",
-        "aem_sampling",
-        "summaries",
-        "plots",
-        "report_figures",
-        "report_page",
-        "output_formats",
-        "output_budget",
-        "run_plan",
-        "torques_summary",
-        "beside",
-        "output_folder",
-        "report",
-    ],
-    [  # command line, and Monte Carlo beside it (it drives the scenario layer from above)
-        "scenario_file",
-        "dispersions",
-        "scenario_writer",
-        "montecarlo_metrics",
-        "montecarlo_plan",
-        "montecarlo_cluster",
-        "montecarlo_simulation",
-        "montecarlo_statistics",
-        "montecarlo_report",
-        "montecarlo",
-        "cli_montecarlo",
-        "cli",
-        "__main__",
-    ],
-]
+TOP_LEVEL = {"__init__", "__main__"}  # the public names, and ``python -m attitude``
 
 
-def _layer_of(module: str) -> int:
-    for index, modules in enumerate(LAYERS):
-        if module in modules:
-            return index
-    raise AssertionError(f"attitude.{module} is in no layer of tests/test_layering.py")
+def _layers() -> list[str]:
+    """The layer folders in order, as ``attitude/__init__.py`` lists them."""
+    docstring = ast.get_docstring(ast.parse((PACKAGE / "__init__.py").read_text()))
+    return re.findall(r"^\d+\. ``attitude\.(\w+)``", docstring, flags=re.MULTILINE)
 
 
-def _attitude_imports(path: Path) -> set[str]:
-    tree = ast.parse(path.read_text())
-    found = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("attitude"):
-            parts = node.module.split(".")
-            if len(parts) > 1:
-                found.add(parts[1])
-            else:
-                found.update(alias.name for alias in node.names)
-        elif isinstance(node, ast.Import):
-            for alias in node.names:
-                if alias.name.startswith("attitude."):
-                    found.add(alias.name.split(".")[1])
+def _module_names() -> dict[str, Path]:
+    """Every module as ``folder.module`` (``__main__`` for the top-level one)."""
+    found = {}
+    for path in sorted(PACKAGE.rglob("*.py")):
+        parts = path.relative_to(PACKAGE).with_suffix("").parts
+        if parts == ("__init__",):
+            continue
+        found[".".join(parts)] = path
     return found
 
 
-def _modules():
-    for path in sorted(PACKAGE.rglob("*.py")):
-        relative = path.relative_to(PACKAGE).with_suffix("")
-        if relative.name == "__init__" and relative.parent == Path("."):
+def _imports(path: Path, modules: dict[str, Path]) -> set[str]:
+    """The package modules ``path`` imports, wherever the import statement stands.
+
+    ``from attitude.solver import free_flow`` is the module ``solver.free_flow``; an
+    import of a folder's ``__init__`` counts as an import of that folder.
+    """
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            if node.module != "attitude" and not node.module.startswith("attitude."):
+                continue
+            base = node.module.removeprefix("attitude").lstrip(".")
+            for alias in node.names:
+                candidate = f"{base}.{alias.name}".lstrip(".")
+                found.add(candidate if candidate in modules else base or alias.name)
+        elif isinstance(node, ast.Import):
+            for alias in node.names:
+                if alias.name.startswith("attitude."):
+                    found.add(alias.name.removeprefix("attitude."))
+        elif isinstance(node, ast.ImportFrom) and node.level > 0:
+            raise AssertionError(f"{path}: relative import (the package uses absolute ones)")
+    return found
+
+
+def _graph() -> dict[str, set[str]]:
+    modules = _module_names()
+    return {name: _imports(path, modules) for name, path in modules.items()}
+
+
+def test_every_module_lives_in_a_layer_folder():
+    layers = _layers()
+    assert layers, "attitude/__init__.py lists no layers"
+    folders = sorted(p.name for p in PACKAGE.iterdir() if (p / "__init__.py").exists())
+    assert sorted(layers) == folders, f"layers {layers} against folders {folders}"
+    for name in _module_names():
+        folder = name.split(".")[0]
+        assert folder in layers or name in TOP_LEVEL, f"attitude/{name}.py is in no layer"
+        assert name.count(".") <= 1, f"attitude.{name}: one folder level per layer"
+
+
+def test_every_module_imports_only_its_own_and_earlier_layers():
+    layers = _layers()
+    rank = {folder: index for index, folder in enumerate(layers)}
+    for name, imported in _graph().items():
+        if name in TOP_LEVEL:
             continue
-        yield relative.parts[0], path
+        own = rank[name.split(".")[0]]
+        for target in imported:
+            folder = target.split(".")[0]
+            assert folder in rank, f"attitude.{name} imports attitude.{target}: no such layer"
+            assert rank[folder] <= own, f"attitude.{name} imports attitude.{target} (a later layer)"
 
 
-def test_every_module_imports_only_earlier_layers():
-    for module, path in _modules():
-        own = _layer_of(module)
-        for imported in _attitude_imports(path):
-            assert _layer_of(imported) <= own, f"attitude.{module} imports attitude.{imported}"
+def test_no_import_loop_between_modules():
+    graph = _graph()
+    state: dict[str, int] = {}  # 1 on the path being walked, 2 done
+
+    def walk(node: str, path: list[str]) -> None:
+        state[node] = 1
+        for target in sorted(graph.get(node, ())):
+            if target not in graph:  # a folder's __init__: imports nothing
+                continue
+            if state.get(target) == 1:
+                loop = [*path[path.index(target) :], target] if target in path else [node, target]
+                raise AssertionError("import loop: " + " -> ".join(loop))
+            if state.get(target) is None:
+                walk(target, [*path, target])
+        state[node] = 2
+
+    for node in sorted(graph):
+        if state.get(node) is None:
+            walk(node, [node])
+
+
+def test_the_loop_check_finds_a_loop(monkeypatch):
+    """The check above can fail: a same-folder loop planted in a copy of the graph."""
+    graph = _graph()
+    graph["solver.free_flow"] = {*graph["solver.free_flow"], "solver.compiled_flow"}
+    graph["solver.compiled_flow"] = {*graph["solver.compiled_flow"], "solver.free_flow"}
+    monkeypatch.setitem(globals(), "_graph", lambda: graph)
+    try:
+        test_no_import_loop_between_modules()
+    except AssertionError as error:
+        assert "solver.free_flow" in str(error) and "solver.compiled_flow" in str(error)
+    else:
+        raise AssertionError("a planted loop was not found")
+
+
+def test_each_folder_lists_its_modules():
+    """Each layer's ``__init__`` docstring names every module of its folder, once."""
+    for folder in _layers():
+        docstring = ast.get_docstring(ast.parse((PACKAGE / folder / "__init__.py").read_text()))
+        listed = re.findall(r"^- ``(\w+)``", docstring or "", flags=re.MULTILINE)
+        present = sorted(p.stem for p in (PACKAGE / folder).glob("*.py") if p.stem != "__init__")
+        assert sorted(listed) == present, f"attitude/{folder}/__init__.py lists {listed}"
 
 
 def test_ci_runs_the_readme_test_command():
@@ -156,22 +152,24 @@ def test_every_public_name_resolves_and_import_stays_light():
     assert run.stdout.strip() == "[]"
 
 
-def _readme_layout() -> list[list[str]]:
-    """The modules of each row of the README's "Layout" table, in order."""
-    import re
-
+def _readme_layout() -> list[tuple[str, list[str]]]:
+    """(folder, its modules) of each row of the README's "Layout" table, in order."""
     readme = (PACKAGE.parent / "README.md").read_text()
     section = readme.split("\n## Layout\n", 1)[1].split("\n## ", 1)[0]
-    rows = [line for line in section.splitlines() if line.startswith("| ")][1:]  # no header
-    return [re.findall(r"`(\w+)\.py`", row.split("|")[2]) for row in rows]
+    rows = [line for line in section.splitlines() if line.startswith("| `")]
+    table = []
+    for row in rows:
+        cells = row.split("|")
+        table.append((cells[1].strip(" `/"), re.findall(r"`(\w+)\.py`", cells[3])))
+    return table
 
 
 def test_readme_layout_table_matches_the_layers():
     table = _readme_layout()
-    assert table, "README.md has no Layout table"
-    for index, (row, layer) in enumerate(zip(table, LAYERS, strict=False)):
-        assert sorted(row) == sorted(layer), f"README Layout row {index}: {row} vs LAYERS {layer}"
-    assert len(table) == len(LAYERS), f"README has {len(table)} layers, LAYERS {len(LAYERS)}"
+    assert [folder for folder, _ in table] == _layers(), "README Layout rows against __init__"
+    for folder, modules in table:
+        present = sorted(p.stem for p in (PACKAGE / folder).glob("*.py") if p.stem != "__init__")
+        assert sorted(modules) == present, f"README Layout row {folder}: {modules}"
 
 
 def test_lazy_names_are_declared_for_type_checkers_and_dir():

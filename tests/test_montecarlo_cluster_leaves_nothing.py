@@ -19,7 +19,7 @@ import time
 import psutil
 from montecarlo_scenarios import write_spinner
 
-from attitude.montecarlo_cluster import connect
+from attitude.montecarlo.cluster import connect
 
 
 def _listening_ports(processes) -> set[int]:

@@ -10,9 +10,9 @@ from pathlib import Path
 
 import numpy as np
 
-from attitude.cli import main
-from attitude.montecarlo_plan import Job, evaluate_batch, plan_montecarlo
-from attitude.scenario_file import load_scenario
+from attitude.cli.main import main
+from attitude.files.scenario_reader import load_scenario
+from attitude.montecarlo.plan import Job, evaluate_batch, plan_montecarlo
 
 EXAMPLE = Path(__file__).parents[1] / "scenarios" / "spinner_dispersions.toml"
 

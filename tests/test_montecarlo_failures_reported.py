@@ -13,7 +13,7 @@ import json
 import pandas
 from montecarlo_scenarios import write_spinner
 
-from attitude.cli import main
+from attitude.cli.main import main
 
 
 def test_failed_samples_are_rows_with_parameters_and_error(tmp_path, capsys):

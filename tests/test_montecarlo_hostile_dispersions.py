@@ -2,13 +2,13 @@
 and the value, the same from `check`, `run` and `montecarlo`, before anything runs.
 
 `check` and `run` read the table through the path `montecarlo` uses
-(attitude.montecarlo.plan_montecarlo), so what one refuses, all refuse.
+(attitude.montecarlo.job.plan_montecarlo), so what one refuses, all refuse.
 """
 
 import pytest
 from montecarlo_scenarios import SPINNER
 
-from attitude.cli import main
+from attitude.cli.main import main
 
 GOOD = """
 [dispersions]

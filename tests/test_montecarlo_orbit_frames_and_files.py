@@ -18,9 +18,9 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from attitude.cli import main
-from attitude.montecarlo_plan import Job, evaluate_batch, plan_montecarlo
-from attitude.scenario_file import load_scenario
+from attitude.cli.main import main
+from attitude.files.scenario_reader import load_scenario
+from attitude.montecarlo.plan import Job, evaluate_batch, plan_montecarlo
 
 ROOT = Path(__file__).parents[1]
 HOSTILE = Path(__file__).parent / "hostile"
@@ -101,7 +101,7 @@ def test_an_attitude_in_lvlh_is_dispersed_in_lvlh(tmp_path, capsys):
     state = document["initial_state"]
     assert state["frame"] == "lvlh"
     table = plan_montecarlo(load_scenario(path))
-    from attitude.dispersions import draw_sample
+    from attitude.montecarlo.dispersions import draw_sample
 
     drawn = draw_sample(table.dispersions, table.loaded.document, 1).parameters
     δ = np.radians([drawn[f"initial_state.attitude_error_{c}_deg"] for c in "xyz"])

@@ -11,9 +11,9 @@ import numpy as np
 from montecarlo_scenarios import write_spinner
 from pandas.testing import assert_frame_equal
 
-from attitude.montecarlo_plan import Job, evaluate_batch, plan_montecarlo
-from attitude.montecarlo_simulation import simulate
-from attitude.scenario_file import load_scenario
+from attitude.files.scenario_reader import load_scenario
+from attitude.montecarlo.plan import Job, evaluate_batch, plan_montecarlo
+from attitude.montecarlo.simulation import simulate
 
 
 def test_same_seed_same_table_on_1_and_2_workers_and_any_batch_size(tmp_path):

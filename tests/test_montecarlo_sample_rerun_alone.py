@@ -19,8 +19,8 @@ import pytest
 from montecarlo_scenarios import write_spinner
 from scipy.spatial.transform import Rotation
 
-from attitude.cli import main
-from attitude.scenario_file import load_scenario
+from attitude.cli.main import main
+from attitude.files.scenario_reader import load_scenario
 
 SAMPLES = 8
 

@@ -18,14 +18,14 @@ import numpy as np
 import pytest
 from montecarlo_scenarios import write_spinner
 
-from attitude.dispersions import draw_sample
-from attitude.montecarlo_metrics import ANGLE_STEP_DEG, sample_metrics
-from attitude.montecarlo_plan import plan_montecarlo
-from attitude.montecarlo_simulation import simulate
-from attitude.montecarlo_report import statistics
-from attitude.montecarlo_statistics import PERCENTILES, describe, order_statistic_rank
-from attitude.run_plan import plan_run
-from attitude.scenario_file import load_scenario, scenario_from_document
+from attitude.files.scenario_reader import load_scenario, scenario_from_document
+from attitude.montecarlo.dispersions import draw_sample
+from attitude.montecarlo.metrics import ANGLE_STEP_DEG, sample_metrics
+from attitude.montecarlo.plan import plan_montecarlo
+from attitude.montecarlo.report import statistics
+from attitude.montecarlo.simulation import simulate
+from attitude.montecarlo.statistics import PERCENTILES, describe, order_statistic_rank
+from attitude.report.plan import plan_run
 
 
 @pytest.fixture(scope="module")

@@ -34,13 +34,14 @@ from astropy.coordinates import (
 from astropy.time import Time
 from scipy.spatial.transform import Rotation
 
-from attitude.ephemeris import moon_position_from_earth, moon_position_from_observer
-from attitude.keplerian import KeplerianOrbit
-from attitude.pointing import BodyVector, PointingSpec, pointing_samples
-from attitude.scenario import InitialState, Scenario
-from attitude.spacecraft import Spacecraft
-from attitude.timescales import offline_time, time_from_tt_seconds
-from attitude.trajectory import propagate
+from attitude.environment.ephemeris import moon_position_from_earth, moon_position_from_observer
+from attitude.environment.keplerian import KeplerianOrbit
+from attitude.environment.timescales import offline_time, time_from_tt_seconds
+from attitude.pointing.sampling import pointing_samples
+from attitude.pointing.spec import BodyVector, PointingSpec
+from attitude.scenario.scenario import InitialState, Scenario
+from attitude.scenario.spacecraft import Spacecraft
+from attitude.trajectory.trajectory import propagate
 
 MAS = math.radians(1 / 3.6e6)
 C_M_S = 299_792_458.0

@@ -5,8 +5,8 @@ A guard replaces every way of reaching the network (``socket.socket.connect`` an
 records the attempt and raises.  Under it, with warnings as errors, the test takes
 a UTC epoch in 2029 (past the 2028-12-31 from which ERFA warns "dubious year", and
 past the expiry of astropy's bundled leap-second file), Sun vectors, and a TLE orbit
-with a 2029 epoch through ``attitude.timescales``, ``attitude.ephemeris``,
-``attitude.orbit`` and ``attitude.eclipse``.
+with a 2029 epoch through ``attitude.environment.timescales``, ``attitude.environment.ephemeris``,
+``attitude.environment.orbit`` and ``attitude.pointing.eclipse``.
 
 Loading DE421 and astropy's leap-second check happen once per process, so the same
 code also runs in a fresh interpreter (``-X dev -W error``), where it is the first
@@ -25,15 +25,15 @@ EXERCISE = textwrap.dedent(
     import numpy as np
     from sgp4.io import fix_checksum
 
-    from attitude.eclipse import eclipse_intervals, sunlit_fraction
-    from attitude.ephemeris import (
+    from attitude.pointing.eclipse import eclipse_intervals, sunlit_fraction
+    from attitude.environment.ephemeris import (
         moon_position_from_earth,
         sun_direction_from_earth,
         sun_position_from_earth,
         sun_position_from_observer,
     )
-    from attitude.orbit import TleOrbit
-    from attitude.timescales import as_time, time_from_tt_seconds, tt_seconds
+    from attitude.environment.orbit import TleOrbit
+    from attitude.environment.timescales import as_time, time_from_tt_seconds, tt_seconds
 
     # The ISS elements moved to 2029-06-15 12:00 UTC (day 166.5), checksums redone.
     LINE1 = fix_checksum(

@@ -17,12 +17,12 @@ import numpy as np
 import pytest
 from astropy.time import Time
 
-from attitude.errors import InputError
-from attitude.frames import eme2000_to_icrf
-from attitude.keplerian import KeplerianOrbit
-from attitude.oem import OemOrbit
-from attitude.orbit import TleOrbit
-from attitude.timescales import offline_time, time_from_tt_seconds
+from attitude.base.errors import InputError
+from attitude.environment.frames import eme2000_to_icrf
+from attitude.environment.keplerian import KeplerianOrbit
+from attitude.environment.oem import OemOrbit
+from attitude.environment.orbit import TleOrbit
+from attitude.environment.timescales import offline_time, time_from_tt_seconds
 
 LINE1 = "1 25544U 98067A   14020.93268519  .00009878  00000-0  18200-3 0  5082"
 LINE2 = "2 25544  51.6498 109.4756 0003572  55.9686 274.8005 15.49815350868473"

@@ -19,10 +19,10 @@ import numpy as np
 import pytest
 from astropy.time import Time
 
-from attitude.earth import EARTH_EQUATORIAL_RADIUS_M, angular_radius
-from attitude.ephemeris import _ephemeris, sun_position_from_observer, timescale
-from attitude.orbit import TleOrbit
-from attitude.timescales import offline_time, time_from_tt_seconds
+from attitude.environment.earth import EARTH_EQUATORIAL_RADIUS_M, angular_radius
+from attitude.environment.ephemeris import _ephemeris, sun_position_from_observer, timescale
+from attitude.environment.orbit import TleOrbit
+from attitude.environment.timescales import offline_time, time_from_tt_seconds
 
 # ISS (ZARYA), a real element set (as printed in the skyfield documentation).
 LINE1 = "1 25544U 98067A   14020.93268519  .00009878  00000-0  18200-3 0  5082"

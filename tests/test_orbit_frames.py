@@ -18,11 +18,16 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from attitude.errors import InputError
-from attitude.frames import euler_angles_deg, lvlh_to_icrf, orbit_frame_to_icrf, rtn_to_icrf
-from attitude.pointing import pointing_samples
-from attitude.scenario_file import ScenarioFileError, load_scenario
-from attitude.trajectory import propagate
+from attitude.base.errors import InputError
+from attitude.environment.frames import (
+    euler_angles_deg,
+    lvlh_to_icrf,
+    orbit_frame_to_icrf,
+    rtn_to_icrf,
+)
+from attitude.files.scenario_reader import ScenarioFileError, load_scenario
+from attitude.pointing.sampling import pointing_samples
+from attitude.trajectory.trajectory import propagate
 
 
 def test_lvlh_and_rtn_axes_by_hand():

@@ -19,9 +19,9 @@ from pathlib import Path
 
 import pytest
 
-import attitude.output_folder
-import attitude.report
-from attitude.cli import main
+import attitude.outputs.folder
+import attitude.report.run
+from attitude.cli.main import main
 
 SCENARIO = """
 [scenario]
@@ -151,7 +151,7 @@ def test_an_empty_folder_of_the_user_is_used_and_left_as_it_was_on_failure(
     def fail(*args, **kwargs):
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(attitude.report, "write_json", fail)
+    monkeypatch.setattr(attitude.report.run, "write_json", fail)
     assert main(["run", str(scenario), "--out", str(empty), "--quiet"]) == 1
     assert len(capsys.readouterr().err.splitlines()) == 1
     assert empty.is_dir() and list(empty.iterdir()) == []
@@ -197,7 +197,7 @@ def test_a_failed_rename_leaves_a_folder_the_next_run_recognizes(user_folder, ca
                 raise PermissionError(13, "Permission denied", str(dst))
         return real_replace(src, dst)
 
-    monkeypatch.setattr(attitude.output_folder.os, "replace", replace)
+    monkeypatch.setattr(attitude.outputs.folder.os, "replace", replace)
     scenario.write_text(SCENARIO.replace("DURATION", "30.0"))
     assert main(["run", str(scenario), "--out", str(out), "--quiet"]) == 1
     assert len(capsys.readouterr().err.splitlines()) == 1
@@ -215,7 +215,7 @@ def test_a_folder_that_cannot_be_written_leaves_nothing(user_folder, capsys, mon
     def refuse(self, *args, **kwargs):
         raise OSError(30, "Read-only file system", str(self))
 
-    monkeypatch.setattr(attitude.output_folder.Path, "mkdir", refuse)
+    monkeypatch.setattr(attitude.outputs.folder.Path, "mkdir", refuse)
     before = _snapshot(folder)
     assert main(["run", str(scenario), "--out", str(folder / "new"), "--quiet"]) == 1
     err = capsys.readouterr().err

@@ -18,9 +18,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from attitude.cli import main
-from attitude.csv_files import right_ascension_deg
-from attitude.version import __version__
+from attitude.base.version import __version__
+from attitude.cli.main import main
+from attitude.outputs.csv import right_ascension_deg
 
 SCENARIO = """
 [scenario]
@@ -164,7 +164,7 @@ def test_the_aem_names_the_tles_international_designator():
     # 1998-067A; a TLE that leaves them blank has none (the AEM then says UNKNOWN).
     from sgp4.io import compute_checksum
 
-    from attitude.orbit import TleOrbit
+    from attitude.environment.orbit import TleOrbit
 
     line1 = "1 25544U 98067A   14020.93268519  .00009878  00000-0  18200-3 0  5082"
     line2 = "2 25544  51.6498 109.4756 0003572  55.9686 274.8005 15.49815350868473"

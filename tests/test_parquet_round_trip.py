@@ -14,8 +14,8 @@ import pyarrow.parquet as pq
 import pytest
 from astropy.time import Time, TimeDelta
 
-from attitude.cli import main
-from attitude.timescales import iso_texts, offline_time
+from attitude.cli.main import main
+from attitude.environment.timescales import iso_texts, offline_time
 
 SCENARIO = """
 [scenario]
@@ -112,10 +112,10 @@ def test_the_schema_states_frames_units_scale_and_convention(run):
 
 def test_a_row_group_per_chunk(tmp_path):
     (tmp_path / "s.toml").write_text(SCENARIO.split("[pointing]")[0])
-    from attitude.output_formats import OutputChoice
-    from attitude.report import write_report
-    from attitude.run_plan import plan_run
-    from attitude.scenario_file import load_scenario
+    from attitude.files.scenario_reader import load_scenario
+    from attitude.outputs.formats import OutputChoice
+    from attitude.report.plan import plan_run
+    from attitude.report.run import write_report
 
     loaded = load_scenario(tmp_path / "s.toml")
     plan = plan_run(loaded.scenario, loaded.pointing, OutputChoice(("parquet",)))

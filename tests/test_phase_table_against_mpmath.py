@@ -1,4 +1,4 @@
-"""The table of ψ's periodic part (attitude.phase_table) against mpmath and the formula.
+"""The table of ψ's periodic part (attitude.elliptic.phase_table) against mpmath and the formula.
 
 ``EulerSolver`` takes the periodic part of ψ from a piecewise Chebyshev table when a
 call asks for many times (``euler_solver._TABLE_MIN_SAMPLES``).  A table is only
@@ -24,9 +24,9 @@ from reference_models import integrate_mpmath, state_with_delta2
 from scipy.spatial.transform import Rotation
 
 from attitude import EulerSolver
-from attitude.closed_form import Elliptic
-from attitude.euler_solver import _TABLE_MIN_SAMPLES
-from attitude.phase_table import PiecewiseChebyshev
+from attitude.elliptic.phase_table import PiecewiseChebyshev
+from attitude.solver.closed_form import Elliptic
+from attitude.solver.euler_solver import _TABLE_MIN_SAMPLES
 
 ATTITUDE0 = Rotation.from_euler("ZYX", [10.0, 20.0, 30.0], degrees=True)
 

@@ -22,12 +22,12 @@ import numpy as np
 import pytest
 from matplotlib.lines import Line2D
 
-import attitude.plots
-from attitude.cli import main
-from attitude.plots import Envelope
-from attitude.report_figures import angular_velocity_envelope, polhode_paths
-from attitude.run_plan import plan_run
-from attitude.scenario_file import load_scenario
+import attitude.report.plots
+from attitude.cli.main import main
+from attitude.files.scenario_reader import load_scenario
+from attitude.report.figures import angular_velocity_envelope, polhode_paths
+from attitude.report.plan import plan_run
+from attitude.report.plots import Envelope
 
 ROOT = Path(__file__).parents[1]
 
@@ -62,13 +62,13 @@ def _spinner(tmp_path: Path, duration: float) -> Path:
 
 def test_no_figure_draws_the_samples_of_a_long_run(tmp_path, monkeypatch):
     figures = {}
-    save = attitude.plots._save
+    save = attitude.report.plots._save
 
     def capture(figure, path):
         figures[path.name] = figure
         return save(figure, path)
 
-    monkeypatch.setattr(attitude.plots, "_save", capture)
+    monkeypatch.setattr(attitude.report.plots, "_save", capture)
     path = _spinner(tmp_path, 6 * 3600.0)  # 21601 samples, 13 turns a minute, 4 eclipses
     out = tmp_path / "out"
     assert main(["run", str(path), "--out", str(out), "--formats", "plots", "--quiet"]) == 0
@@ -151,16 +151,18 @@ def test_the_zoom_shades_its_eclipse_on_its_own_time_axis(tmp_path, monkeypatch)
     the time since the epoch); its eclipse, 5100-5200 s, must be shaded at 85-86.7 min
     on that axis, inside the panel, not at 5100 "min"."""
     figures = []
-    save = attitude.plots._save
-    monkeypatch.setattr(attitude.plots, "_save", lambda f, p: figures.append(f) or save(f, p))
+    save = attitude.report.plots._save
+    monkeypatch.setattr(
+        attitude.report.plots, "_save", lambda f, p: figures.append(f) or save(f, p)
+    )
     envelope = Envelope(0.0, 10_000.0, ["panel"], columns=100, keep=0)
     t = np.linspace(0.0, 10_000.0, 1001)
     envelope.add(t, {"panel": 90.0 + 30.0 * np.sin(t / 500.0)})
     seconds = np.linspace(5000.0, 5300.0, 301)
-    zoom = attitude.plots.Zoom(
+    zoom = attitude.report.plots.Zoom(
         seconds, {"panel": 90.0 + 0.0 * seconds}, "Zoom", shaded_s=[(5100.0, 5200.0)]
     )
-    attitude.plots.plot_sun_angles(
+    attitude.report.plots.plot_sun_angles(
         tmp_path / "sun.png", envelope, {"panel": 30.0}, [(5100.0, 5200.0)], zoom
     )
     [figure] = figures

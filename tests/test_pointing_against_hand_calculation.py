@@ -21,13 +21,15 @@ from astropy.coordinates import CartesianRepresentation, SkyCoord
 from reference_models import astropy_apparent_sun
 from scipy.spatial.transform import Rotation
 
-from attitude.eclipse import sunlit_fraction
-from attitude.ephemeris import sun_position_from_earth, timescale
-from attitude.orbit import Orbit
-from attitude.pointing import BodyVector, PointingSpec, pointing_analysis, pointing_samples
-from attitude.scenario import InitialState, Scenario
-from attitude.spacecraft import Spacecraft
-from attitude.trajectory import propagate
+from attitude.environment.ephemeris import sun_position_from_earth, timescale
+from attitude.environment.orbit import Orbit
+from attitude.pointing.eclipse import sunlit_fraction
+from attitude.pointing.sampling import pointing_samples
+from attitude.pointing.search import pointing_analysis
+from attitude.pointing.spec import BodyVector, PointingSpec
+from attitude.scenario.scenario import InitialState, Scenario
+from attitude.scenario.spacecraft import Spacecraft
+from attitude.trajectory.trajectory import propagate
 
 ARCSEC = math.radians(1 / 3600)
 TLE = (

@@ -5,10 +5,10 @@ import pytest
 from astropy import units as u
 from sgp4.io import fix_checksum
 
-from attitude.eclipse import eclipse_intervals, eclipse_state, sunlit_fraction
-from attitude.ephemeris import sun_position_from_observer
-from attitude.errors import InputError
-from attitude.orbit import TleOrbit
+from attitude.base.errors import InputError
+from attitude.environment.ephemeris import sun_position_from_observer
+from attitude.environment.orbit import TleOrbit
+from attitude.pointing.eclipse import eclipse_intervals, eclipse_state, sunlit_fraction
 
 LINE1 = "1 25544U 98067A   14020.93268519  .00009878  00000-0  18200-3 0  5082"
 LINE2 = "2 25544  51.6498 109.4756 0003572  55.9686 274.8005 15.49815350868473"

@@ -16,7 +16,7 @@ from pathlib import Path
 import numpy as np
 from csv_read_back import read_csv
 
-from attitude.cli import main
+from attitude.cli.main import main
 
 ROOT = Path(__file__).parents[1]
 SPINNER = """

@@ -32,9 +32,9 @@ from attitude import (
     propagate_batch,
     write_report,
 )
-from attitude.aem import QUATERNION_COMMENT, AemSegment, write_aem
-from attitude.free_flow import advance
-from attitude.output_formats import OutputChoice
+from attitude.outputs.aem_writer import QUATERNION_COMMENT, AemSegment, write_aem
+from attitude.outputs.formats import OutputChoice
+from attitude.solver.free_flow import advance
 
 TABLE = Path(__file__).resolve().parents[1] / "docs" / "conventions.md"
 HALF = math.sqrt(0.5)

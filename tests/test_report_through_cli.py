@@ -18,10 +18,10 @@ import pytest
 from aem_read_back import interpolate_as_declared, read_back, rotation_angle
 from csv_read_back import read_csv
 
-from attitude.cli import main
-from attitude.scenario_file import load_scenario
-from attitude.timescales import tt_seconds
-from attitude.trajectory import propagate
+from attitude.cli.main import main
+from attitude.environment.timescales import tt_seconds
+from attitude.files.scenario_reader import load_scenario
+from attitude.trajectory.trajectory import propagate
 
 SCENARIO = Path(__file__).parents[1] / "scenarios" / "spinner_thruster_pulse.toml"
 

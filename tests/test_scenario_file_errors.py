@@ -8,8 +8,8 @@ import re
 
 import pytest
 
-import attitude.report
-from attitude.cli import main
+import attitude.report.run
+from attitude.cli.main import main
 
 VALID = """
 [scenario]
@@ -176,7 +176,7 @@ def test_a_failed_run_leaves_no_output_and_keeps_the_old_one(tmp_path, monkeypat
     def fail(*args, **kwargs):
         raise OSError("disk full")
 
-    monkeypatch.setattr(attitude.report, "write_json", fail)
+    monkeypatch.setattr(attitude.report.run, "write_json", fail)
     assert main(["run", str(path), "--out", str(out), "--quiet"]) == 1
     assert "attitude: error: disk full" in capsys.readouterr().err
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before

@@ -24,8 +24,8 @@ from torqued_reference import (
     matrix_body_to_inertial,
 )
 
-from attitude.scenario_file import load_scenario
-from attitude.trajectory import propagate
+from attitude.files.scenario_reader import load_scenario
+from attitude.trajectory.trajectory import propagate
 
 EXAMPLE = Path(__file__).parents[1] / "scenarios" / "tumbler_gravity_gradient_burn.toml"
 ORBIT = circular_orbit(7.0e6, tilt=Rotation.from_euler("x", 51.6, degrees=True).as_matrix())

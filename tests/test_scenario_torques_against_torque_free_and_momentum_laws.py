@@ -26,18 +26,18 @@ import pytest
 import torqued_reference as ref
 from scipy.spatial.transform import Rotation
 
-from attitude.cli import main
-from attitude.euler_solver import EulerSolver
-from attitude.events import AngularImpulse, AttitudeReset, InertiaChange
-from attitude.horizon import validity_horizon
-from attitude.keplerian import KeplerianOrbit
-from attitude.scenario import InitialState, Scenario
-from attitude.scenario_torques import Burn, ScenarioTorques
-from attitude.spacecraft import Spacecraft
-from attitude.torqued_segment import TorquedMotion
-from attitude.torqued_solver import TorquedSolver, angles_between, departure_time
-from attitude.torques import GravityGradient
-from attitude.trajectory import propagate
+from attitude.cli.main import main
+from attitude.environment.keplerian import KeplerianOrbit
+from attitude.scenario.events import AngularImpulse, AttitudeReset, InertiaChange
+from attitude.scenario.scenario import InitialState, Scenario
+from attitude.scenario.spacecraft import Spacecraft
+from attitude.scenario.torques import Burn, ScenarioTorques
+from attitude.solver.euler_solver import EulerSolver
+from attitude.torques.models import GravityGradient
+from attitude.torques.solver import TorquedSolver, angles_between, departure_time
+from attitude.trajectory.horizon import validity_horizon
+from attitude.trajectory.torqued import TorquedMotion
+from attitude.trajectory.trajectory import propagate
 
 EPOCH = "2027-03-01T00:00:00"
 MU = 3.986004418e14
@@ -312,7 +312,7 @@ label = "burn"
         csv, delimiter=",", skip_header=preamble, names=True, dtype=None, encoding="utf-8"
     )
     q = np.column_stack([data[f"q_body_to_icrf_{c}"] for c in "wxyz"])
-    from attitude.torques import ConstantTorque
+    from attitude.torques.models import ConstantTorque
 
     direct = TorquedSolver(
         I_TUMBLER,

@@ -17,7 +17,7 @@ import pytest
 from reference_models import half_period_mpmath
 from scipy.spatial.transform import Rotation
 
-from attitude.cli import main
+from attitude.cli.main import main
 
 SCENARIOS = sorted((Path(__file__).parents[1] / "scenarios").glob("*.toml"))
 

@@ -1,7 +1,7 @@
-"""The size estimate of a run (attitude.output_budget) against what the writers write.
+"""The size estimate of a run (attitude.outputs.budget) against what the writers write.
 
 The disk check before a run counts the time series' columns from the pointing spec
-(attitude.csv_files.pointing_column_count); it is compared here with the columns the
+(attitude.outputs.csv.pointing_column_count); it is compared here with the columns the
 writer actually produces (pointing_columns of real samples) for every shape of spec,
 and the CSV estimate with the size of a CSV written by a run.
 """
@@ -11,13 +11,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from attitude.csv_files import pointing_column_count, pointing_columns
-from attitude.output_formats import OutputChoice
-from attitude.pointing import BodyVector, PointingSpec, pointing_samples
-from attitude.report import write_report
-from attitude.run_plan import plan_run
-from attitude.scenario_file import load_scenario
-from attitude.trajectory import propagate
+from attitude.files.scenario_reader import load_scenario
+from attitude.outputs.csv import pointing_column_count, pointing_columns
+from attitude.outputs.formats import OutputChoice
+from attitude.pointing.sampling import pointing_samples
+from attitude.pointing.spec import BodyVector, PointingSpec
+from attitude.report.plan import plan_run
+from attitude.report.run import write_report
+from attitude.trajectory.trajectory import propagate
 
 ROOT = Path(__file__).parents[1]
 SPINNER = ROOT / "scenarios" / "spinner_thruster_pulse.toml"

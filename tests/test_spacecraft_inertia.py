@@ -12,8 +12,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from attitude import InputError
-from attitude.errors import InertiaWarning
-from attitude.spacecraft import Spacecraft
+from attitude.base.errors import InertiaWarning
+from attitude.scenario.spacecraft import Spacecraft
 
 
 def test_a_rotated_tensor_gives_back_its_principal_moments_and_axes():

@@ -1,6 +1,6 @@
 """The spin-period analysis against the closed form of the free symmetric top.
 
-``attitude.motion_analysis`` measures the spin period numerically: the mean rate at
+``attitude.trajectory.motion`` measures the spin period numerically: the mean rate at
 which a body axis across the spin axis turns about the angular momentum H, over one
 period of m(t), on the closed-form attitude.  For a symmetric top that rate is known in
 closed form (Landau & Lifshitz, *Mechanics*, §33; Goldstein, *Classical Mechanics*,

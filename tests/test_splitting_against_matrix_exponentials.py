@@ -20,7 +20,7 @@ import mpmath as mp
 import numpy as np
 import pytest
 
-from attitude.splitting import COMPOSITIONS, DEFAULT_BY_ORDER, composition
+from attitude.torques.splitting import COMPOSITIONS, DEFAULT_BY_ORDER, composition
 
 DIGITS = 60
 

@@ -17,10 +17,10 @@ import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
-from attitude.output_formats import OutputChoice
-from attitude.report import output_grid, write_report
-from attitude.run_plan import plan_run
-from attitude.scenario_file import load_scenario
+from attitude.files.scenario_reader import load_scenario
+from attitude.outputs.formats import OutputChoice
+from attitude.report.plan import plan_run
+from attitude.report.run import output_grid, write_report
 
 ROOT = Path(__file__).parents[1]
 

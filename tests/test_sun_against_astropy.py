@@ -18,13 +18,13 @@ from astropy.coordinates import get_body_barycentric, solar_system_ephemeris
 from astropy.time import Time
 from reference_models import astropy_apparent_sun
 
-from attitude.ephemeris import (
+from attitude.base.errors import InputError
+from attitude.environment.ephemeris import (
     EphemerisRangeError,
     sun_direction_from_earth,
     sun_position_from_earth,
 )
-from attitude.errors import InputError
-from attitude.timescales import offline_time
+from attitude.environment.timescales import offline_time
 
 ARCSEC = np.pi / (180 * 3600)
 

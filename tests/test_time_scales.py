@@ -13,12 +13,12 @@ from astropy import units as u
 from astropy.time import Time
 from scipy.spatial.transform import Rotation
 
-from attitude.cli import main
-from attitude.events import AngularImpulse
-from attitude.scenario import InitialState, Scenario
-from attitude.spacecraft import Spacecraft
-from attitude.timescales import as_time, offline_time, tt_seconds
-from attitude.trajectory import propagate
+from attitude.cli.main import main
+from attitude.environment.timescales import as_time, offline_time, tt_seconds
+from attitude.scenario.events import AngularImpulse
+from attitude.scenario.scenario import InitialState, Scenario
+from attitude.scenario.spacecraft import Spacecraft
+from attitude.trajectory.trajectory import propagate
 
 SPACECRAFT = Spacecraft("test", [100.0, 200.0, 300.0])
 STATE = InitialState(Rotation.from_rotvec([0.2, 0.4, -0.1]), angular_velocity=[0.05, 0.3, 0.02])

@@ -9,10 +9,10 @@ import pytest
 from sgp4.api import Satrec
 from sgp4.io import compute_checksum
 
-from attitude.dispersions import draw_sample, read_dispersions, shifted_tle_epoch
-from attitude.montecarlo_metrics import metric_names
-from attitude.montecarlo_plan import Job, evaluate_batch
-from attitude.scenario_file import load_scenario
+from attitude.files.scenario_reader import load_scenario
+from attitude.montecarlo.dispersions import draw_sample, read_dispersions, shifted_tle_epoch
+from attitude.montecarlo.metrics import metric_names
+from attitude.montecarlo.plan import Job, evaluate_batch
 
 LINE1 = "1 59001U 27042A   27171.50000000  .00000120  00000-0  18000-4 0  9999"
 LINE2 = "2 59001  98.2100 175.3000 0012000  95.0000 265.2000 14.57123456    14"

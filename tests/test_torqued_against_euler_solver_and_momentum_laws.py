@@ -171,7 +171,7 @@ def test_keplerian_and_oem_orbits_as_the_position(tmp_path):
     from astropy.time import Time
 
     from attitude import InputError, KeplerianOrbit, OemOrbit
-    from attitude.timescales import offline_time
+    from attitude.environment.timescales import offline_time
 
     epoch = Time("2024-03-01T00:00:00", scale="utc")
     kepler = KeplerianOrbit(epoch, 7.0e6, 0.01, 0.9, 0.3, 0.2, mean_anomaly=0.1)

@@ -7,7 +7,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from attitude import ConstantTorque, GravityGradient, InputError, TorquedSolver, UserTorque
-from attitude.torqued_solver import propagate_batch
+from attitude.torques.solver import propagate_batch
 
 INERTIA = [100.0, 200.0, 300.0]
 M0 = [1.0, 2.0, 3.0]
@@ -151,7 +151,7 @@ def test_a_step_search_that_would_run_away_is_refused(monkeypatch):
     the span it refuses, naming the tolerance, the step and the last estimate, instead
     of running for hours (the cap lowered here so that the test is quick; the scenario
     layer refuses such a burn before any search, test_check_refuses_what_run_refuses)."""
-    import attitude.torqued_solver as torqued_solver
+    import attitude.torques.solver as torqued_solver
 
     monkeypatch.setattr(torqued_solver, "_SEARCH_MAX_STEPS", 2e3)
     spin_up = ConstantTorque([0.0, 0.0, 1e4], 0.0, math.inf)

@@ -19,7 +19,7 @@ import pytest
 from astropy import units as u
 
 from attitude import EulerSolver, InputError
-from attitude.cli import main
+from attitude.cli.main import main
 
 BASE = """
 [scenario]

@@ -1,0 +1,20 @@
+"""The shared base: errors, units, quaternions and vectors, float helpers, the compile
+policy and double-double arithmetic. It imports no other layer.
+
+Modules:
+
+- ``double_double``: Double-double arithmetic on floats, compiled (numba): a float plus
+  its rounding error.
+- ``errors``: Exception classes of the package.
+- ``float_math``: numpy's elementwise functions, on Python floats: the namespace of a
+  single state's path.
+- ``jit``: How the package compiles its kernels: ``jit``, numba's ``njit`` with one
+  policy.
+- ``quantities``: Numbers at the public edge: astropy Quantities to SI floats, and their
+  checks.
+- ``quaternions``: Hamilton quaternion algebra, scalar first, vectorized.
+- ``vectors``: Two small vector helpers: the angle between vectors, and a basis across a
+  unit vector.
+- ``version``: The package version (read by pyproject.toml and written into every
+  output).
+"""

@@ -1,0 +1,353 @@
+"""The command line: ``attitude run``, ``check`` and ``montecarlo`` (also ``python -m attitude``).
+
+    attitude run SCENARIO.toml --out DIR   propagate, write the outputs into DIR
+    attitude check SCENARIO.toml           validate the file and describe the run
+    attitude montecarlo SCENARIO.toml --out DIR   the [dispersions] samples, on Dask
+
+``run`` and ``check`` take ``--formats csv,parquet,aem,plots,report`` (the outputs to
+write; default ``csv,aem,plots,report``, or the file's ``[output] formats``) and
+``--aem-tolerance "1e-6 rad"`` (the accuracy the AEM is sampled for; an angle with its
+unit).  ``montecarlo`` writes its own outputs (``docs/montecarlo.md``).
+``check`` goes through the same checks as ``run`` up to the sampling
+(``attitude.report.plan``): what ``check`` accepts, ``run`` computes, and it states the
+size of each chosen output.  ``--out`` given to ``check`` also checks the folder and
+its free space, which is the one thing ``check`` cannot know without it.
+
+The output folder (``attitude.outputs.folder``): ``run`` writes into a new or empty
+folder, or one it wrote before, where it replaces only its own previous outputs; it
+never removes or overwrites a file it did not write.
+
+Exit status, with one line on stderr and never a traceback:
+0 success; 2 a bad scenario file, a run that cannot fit, or an output folder that is
+not ours (the line names the file, the key and the value); 1 the outputs cannot be
+written (a full disk, a folder we may not write); 130 interrupted (Ctrl-C), 143
+terminated (SIGTERM), 129 hung up (SIGHUP), and nothing of the run is left behind;
+3 a bug (an exception this tool did not expect; ``ATTITUDE_TRACEBACK=1`` shows its
+traceback).  Warnings are one line each, ``attitude: warning: FILE: KEY: ...``, and so
+are notes (``attitude: note: ...``: a clamped precision, a far TLE epoch).
+
+This module imports the package only inside :func:`main`, after the signal handlers
+are installed, so that even a Ctrl-C while numpy loads ends with one line.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import os
+import signal
+import sys
+import threading
+from pathlib import Path
+
+__all__ = ["main"]
+
+_SIGNAL_EXIT = {signal.SIGINT: 130, signal.SIGTERM: 143}
+if hasattr(signal, "SIGHUP"):
+    _SIGNAL_EXIT[signal.SIGHUP] = 129
+_SIGNAL_TEXT = {130: "interrupted", 143: "terminated", 129: "hung up"}
+
+
+class _Stopped(BaseException):
+    """A signal asked the run to stop (raised by the handler, like KeyboardInterrupt)."""
+
+    def __init__(self, number: int) -> None:
+        super().__init__(number)
+        self.number = number
+
+
+def _raise_stopped(number: int, frame) -> None:
+    raise _Stopped(number)
+
+
+def _one_line(text: str) -> str:
+    return " / ".join(line.strip() for line in str(text).splitlines() if line.strip())
+
+
+def _error(message: str) -> None:
+    print(f"attitude: error: {_one_line(message)}", file=sys.stderr, flush=True)
+
+
+def _parser() -> argparse.ArgumentParser:
+    from attitude.base.version import __version__
+
+    parser = argparse.ArgumentParser(prog="attitude", description="Exact spacecraft attitude.")
+    parser.add_argument("-V", "--version", action="version", version=f"attitude {__version__}")
+    commands = parser.add_subparsers(dest="command", required=True)
+    run = commands.add_parser("run", help="propagate a scenario and write its outputs")
+    run.add_argument("scenario", type=Path, help="scenario file (TOML)")
+    run.add_argument(
+        "--out",
+        type=Path,
+        required=True,
+        help="output folder: new, empty, or written by attitude before (only its own "
+        "files are replaced; a folder holding other files is refused)",
+    )
+    run.add_argument("--quiet", action="store_true", help="no progress messages")
+    check = commands.add_parser("check", help="validate a scenario file and describe the run")
+    check.add_argument("scenario", type=Path, help="scenario file (TOML)")
+    check.add_argument("--out", type=Path, help="also check this output folder and its free space")
+    for command in (run, check):
+        command.add_argument(
+            "--formats",
+            help="the outputs to write, comma-separated, from csv, parquet, aem, plots, report "
+            "(default: the file's [output] formats, else csv,aem,plots,report); "
+            "summary.json, and intervals.csv with [pointing], are always written",
+        )
+        command.add_argument(
+            "--aem-tolerance",
+            metavar="ANGLE",
+            help="the AEM is sampled so that its declared interpolation stays within this "
+            'of the exact attitude, with its unit: "1e-6 rad" (the default), "0.2 arcsec"',
+        )
+    _montecarlo_parser(commands)
+    return parser
+
+
+def _montecarlo_parser(commands) -> None:
+    """``attitude montecarlo``: the dispersed samples of a scenario on Dask."""
+    mc = commands.add_parser(
+        "montecarlo",
+        help="run the [dispersions] samples of a scenario on Dask (docs/montecarlo.md)",
+    )
+    mc.add_argument("scenario", type=Path, help="scenario file (TOML) with [dispersions]")
+    mc.add_argument("--out", type=Path, help="output folder (the rules of run --out)")
+    mc.add_argument("--samples", type=int, help="sample count (replaces the file's)")
+    mc.add_argument("--seed", type=int, help="seed (replaces the file's)")
+    where = mc.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", help="address of a Dask scheduler (default: local)")
+    where.add_argument("--workers", type=int, help="local worker processes (default: all cores)")
+    mc.add_argument("--batch-size", type=int, help="samples per task (default: from costs)")
+    mc.add_argument(
+        "--sample", type=int, action="append", help="with --emit-scenario: sample K (repeatable)"
+    )
+    mc.add_argument(
+        "--emit-scenario",
+        type=Path,
+        metavar="DIR",
+        help="write sample K as DIR/sample_K.toml, an ordinary scenario, instead of running",
+    )
+    mc.add_argument("--quiet", action="store_true", help="no progress bar or messages")
+
+
+def _outputs(args, outputs):
+    """``outputs`` (the file's) with the command line's --formats and --aem-tolerance."""
+    import dataclasses
+    import re
+
+    from attitude.base.errors import InputError
+    from attitude.base.quantities import convert_unit
+    from attitude.outputs.aem_sampling import check_tolerance
+    from attitude.outputs.formats import parse_formats
+
+    if args.formats is not None:
+        outputs = dataclasses.replace(outputs, formats=parse_formats(args.formats))
+    if args.aem_tolerance is not None:
+        text = args.aem_tolerance
+        found = re.fullmatch(r"\s*([-+]?[0-9.]+(?:[eE][-+]?\d+)?)\s*(\S.*)?", text)
+        if not found or not found.group(2):
+            raise InputError(
+                f'--aem-tolerance: {text!r} needs an angle with its unit, e.g. "1e-6 rad" '
+                'or "0.2 arcsec"'
+            )
+        value = convert_unit(
+            float(found.group(1)), found.group(2).strip(), "angle", "--aem-tolerance"
+        )
+        outputs = dataclasses.replace(
+            outputs,
+            aem_tolerance_rad=check_tolerance(float(value), "--aem-tolerance"),
+            tolerance_key="--aem-tolerance",
+        )
+    return outputs
+
+
+def _describe(loaded, plan, out: Path | None = None) -> str:
+    """What ``attitude check`` prints: the run as it will be done."""
+    import math
+
+    import numpy as np
+
+    scenario = loaded.scenario
+    craft = scenario.spacecraft
+    lines = [
+        f"{loaded.path}: OK",
+        f"  scenario    {scenario.name}",
+        f"  epoch       {scenario.format_epoch(0.0)}",
+        f"  span        {scenario.stop_s:.12g} s, to {scenario.format_epoch(scenario.stop_s)}",
+        f"  output      every {scenario.step_s:.12g} s from "
+        f"{scenario.format_epoch(scenario.start_s)}",
+        f"  formats     {','.join(plan.outputs.formats)}",
+        f"  outputs     {plan.budget.describe()}",
+        f"  spacecraft  {craft.name}, principal moments {craft.principal_moments.tolist()} kg m²",
+    ]
+    initial = scenario.initial_state
+    if initial.angular_velocity is not None:
+        lines.append(
+            "  rate        "
+            f"{np.degrees(initial.angular_velocity).tolist()} deg/s (body, at the epoch)"
+        )
+    for index, item in enumerate(plan.motion):
+        period = "" if math.isinf(item.period_s) else f", body period {item.period_s:.6g} s"
+        flips = f", {item.flip_count} flips" if item.flip_count else ""
+        how = "splitting" if item.formula == "torqued" else f"formula {item.formula}"
+        lines.append(
+            f"  segment {index}   from {scenario.format_epoch(item.start_s)}: {item.motion} "
+            f"({how}{period}{flips})"
+        )
+    from attitude.report.torques import torques_lines
+
+    lines += [f"  {line}" for line in torques_lines(plan)]
+    lines.append(f"  events      {len(scenario.events)}")
+    lines += [
+        f"    {scenario.format_epoch(t)} (+{t:.12g} s)  {event.kind}"
+        f"{f' ({event.label})' if event.label else ''}"
+        for t, event in scenario.events
+    ]
+    from attitude.pointing.spec import describe_lines
+
+    lines += [f"  {line}" for line in describe_lines(loaded.pointing)]
+    if plan.aem is not None:
+        steps = [item.step_s for item in plan.aem.segments]
+        lines.append(
+            f"  aem         {plan.aem.records} records (a record every "
+            f"{min(steps):.4g} to {max(steps):.4g} s), LAGRANGE interpolation within "
+            f"{plan.aem.tolerance_rad:g} rad of the "
+            f"{'propagated' if scenario.torques.any else 'exact'} attitude"
+        )
+    if out is None:
+        lines.append("  disk        not checked: `check --out DIR` checks the free space of DIR")
+    else:
+        from attitude.outputs.budget import free_disk_bytes, size_text
+
+        lines.append(f"  disk        {size_text(free_disk_bytes(out))} free for {out}: enough")
+    lines += [f"  note        {note}" for note in plan.notes]
+    return "\n".join(lines)
+
+
+def _run(args, state: dict) -> int:
+    """``run`` or ``check``, with every warning shown as one line naming the file."""
+    import warnings
+
+    def show_warning(message, category, filename, lineno, file=None, line=None):
+        text = _one_line(str(message))
+        name = state.get("file")
+        if name and not text.startswith(f"{name}:"):
+            text = f"{name}: {text}"
+        print(f"attitude: warning: {text}", file=sys.stderr, flush=True)
+
+    with warnings.catch_warnings():
+        warnings.showwarning = show_warning
+        return _checked_run(args, state)
+
+
+def _checked_run(args, state: dict) -> int:
+    from attitude.base.errors import InputError
+    from attitude.files.scenario_reader import ScenarioFileError, load_scenario
+    from attitude.outputs.budget import check_fits
+    from attitude.outputs.folder import OutputFolderError, claim
+    from attitude.outputs.formats import OUTPUT_NAMES, OutputChoice
+    from attitude.report.plan import horizon_beside, plan_run
+
+    try:
+        # The command line's own options first: their errors name the option, not a file.
+        try:
+            if args.command != "montecarlo":  # montecarlo writes no time series
+                _outputs(args, OutputChoice())
+        except InputError as exc:
+            _error(str(exc))
+            return 2
+        loaded = load_scenario(args.scenario)
+        state["file"] = loaded.path.name
+        if args.command == "montecarlo":
+            from attitude.cli.montecarlo import command
+
+            return command(args, loaded)
+        outputs = _outputs(args, loaded.outputs)
+        # A run computes the validity horizon beside its outputs (attitude.report.run).
+        plan = plan_run(loaded.scenario, loaded.pointing, outputs, horizon=args.command == "check")
+        montecarlo = None
+        if "dispersions" in loaded.document:  # checked by run too: one reading of the file
+            from attitude.montecarlo.plan import plan_montecarlo
+
+            montecarlo = plan_montecarlo(loaded, plan)
+        if args.command == "check":
+            if args.out is not None:
+                check_fits(plan.budget, args.out)
+                claim(args.out, OUTPUT_NAMES, dry_run=True)
+            print(_describe(loaded, plan, args.out), flush=True)
+            if montecarlo is not None:
+                print("\n".join(montecarlo.describe()), flush=True)
+            return 0
+        claim(args.out, OUTPUT_NAMES, dry_run=True)  # a folder that is not ours: say so first
+        for note in plan.notes:
+            print(f"attitude: note: {loaded.path.name}: {note}", file=sys.stderr, flush=True)
+        # The horizon starts beside the run before the writers and plots are imported.
+        with horizon_beside(plan) or contextlib.nullcontext() as horizon:
+            from attitude.report.run import Progress, write_report
+
+            progress = Progress(None if args.quiet else lambda line: print(line, file=sys.stderr))
+            write_report(
+                loaded.scenario,
+                args.out,
+                loaded.pointing,
+                loaded.path.name,
+                progress,
+                plan,
+                horizon=horizon,
+            )
+        return 0
+    except (ScenarioFileError, OutputFolderError) as exc:
+        _error(str(exc))
+        return 2
+    except InputError as exc:
+        name = state.get("file") or args.scenario.name
+        _error(f"{name}: {exc}")
+        return 2
+    except MemoryError:
+        _error(f"{args.scenario.name}: out of memory: use a longer output.step or a shorter span")
+        return 1
+    except BrokenPipeError:
+        raise  # stdout closed by the reader: see main
+    except OSError as exc:  # the file system: a full disk, a folder we cannot write
+        where = f" ({exc.filename})" if getattr(exc, "filename", None) else ""
+        _error(f"{exc.strerror or exc}{where}")
+        return 1
+
+
+def main(argv: list[str] | None = None) -> int:
+    state: dict = {}
+    previous = {}
+    in_main_thread = threading.current_thread() is threading.main_thread()
+    try:
+        if in_main_thread:
+            for number in _SIGNAL_EXIT:
+                if number != signal.SIGINT:
+                    previous[number] = signal.signal(number, _raise_stopped)
+        args = _parser().parse_args(argv)
+        return _run(args, state)
+    except KeyboardInterrupt:
+        _error("interrupted; nothing of this run was left behind")
+        return 130
+    except _Stopped as stop:
+        code = _SIGNAL_EXIT[stop.number]
+        _error(f"{_SIGNAL_TEXT[code]}; nothing of this run was left behind")
+        return code
+    except BrokenPipeError:  # `attitude check x | head -1`
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 0
+    except Exception as exc:  # a bug: one line, and the traceback on request
+        if os.environ.get("ATTITUDE_TRACEBACK"):
+            raise
+        _error(
+            f"internal error: {type(exc).__name__}: {exc} (a bug: please report it; "
+            "ATTITUDE_TRACEBACK=1 shows the traceback)"
+        )
+        return 3
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,85 @@
+"""``attitude montecarlo``: the command (its options are parsed in ``attitude.cli.main``)."""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from pathlib import Path
+
+from attitude.base.errors import InputError
+from attitude.files.scenario_reader import ScenarioFile
+from attitude.montecarlo.plan import emit_samples, plan_montecarlo
+from attitude.montecarlo.report import check_folder, write_report
+from attitude.montecarlo.simulation import simulate
+from attitude.report.run import Progress
+
+__all__ = ["ProgressBar", "command"]
+
+
+def command(args, loaded: ScenarioFile) -> int:
+    """``attitude montecarlo`` (the command line's options in ``args``): run the job into
+    ``--out``, or write samples ``--sample`` into ``--emit-scenario``."""
+    mc = plan_montecarlo(loaded, None, args.samples, args.seed)
+    if args.emit_scenario is not None or args.sample is not None:
+        if args.emit_scenario is None or args.sample is None:
+            raise InputError("--sample K and --emit-scenario DIR go together")
+        if args.out is not None:
+            raise InputError("--out: runs the job; --emit-scenario writes samples instead")
+        for path in emit_samples(mc, args.sample, args.emit_scenario):
+            print(path, flush=True)
+        return 0
+    if args.out is None:
+        raise InputError("--out: the output folder is required (or --emit-scenario)")
+    check_folder(mc, args.out)
+    stage = Progress(None if args.quiet else lambda line: print(line, file=sys.stderr))
+    bar = None if args.quiet else ProgressBar(sys.stderr)
+    result = simulate(mc, args.scheduler, args.workers, args.batch_size, bar, stage)
+    failed = result.failed
+    if len(failed) == mc.samples:
+        first = failed.iloc[0]
+        raise InputError(f"every sample failed; sample {first['sample']}: {first['error']}")
+    write_report(result, args.out)
+    if len(failed):
+        print(
+            f"attitude: note: {loaded.path.name}: {len(failed)} of {mc.samples} samples "
+            f"failed (the first: sample {failed.iloc[0]['sample']}: {failed.iloc[0]['error']}); "
+            "statistics.json lists them with their parameters",
+            file=sys.stderr,
+            flush=True,
+        )
+    stage(f"done: {Path(args.out) / 'report.html'}")
+    return 0
+
+
+class ProgressBar:
+    """A one-line progress bar on a text stream (redrawn in place on a terminal, a line
+    every 10 % otherwise)."""
+
+    def __init__(self, stream=None, width: int = 30) -> None:
+        self.stream = stream or sys.stderr
+        self.width = width
+        self.start: float | None = None  # the first call: the samples start
+        self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
+        self.shown = -1
+
+    def __call__(self, done: int, total: int, failed: int) -> None:
+        if self.start is None:
+            self.start = time.perf_counter()
+        fraction = done / total if total else 1.0
+        if not self.tty:
+            decile = int(10 * fraction)
+            if decile == self.shown:
+                return
+            self.shown = decile
+        elapsed = time.perf_counter() - self.start
+        eta = elapsed / fraction - elapsed if fraction > 0 else math.nan
+        filled = int(self.width * fraction)
+        text = (
+            f"[{'#' * filled}{'.' * (self.width - filled)}] {done}/{total} samples"
+            + (f", {failed} failed" if failed else "")
+            + f", {elapsed:.0f} s"
+            + (f", {eta:.0f} s to go" if done < total and math.isfinite(eta) else "")
+        )
+        end = "\n" if not self.tty or done >= total else ""
+        print(("\r" if self.tty else "") + text, end=end, file=self.stream, flush=True)

@@ -1,0 +1,715 @@
+"""Scenario files: the TOML format (``docs/scenarios.md``) read into a Scenario.
+
+Every error names the file, the key path and the value, e.g.
+``dzhanibekov.toml: events[1].impulse: expected 3 numbers, got [0.0, 1.0]``; unknown
+keys are refused (a misspelt key would otherwise be silently ignored).
+
+Numbers are in SI units (s, kg m², N m s, rad/s) unless given as a table with a
+unit, ``{ value = [0, 30, 0], unit = "deg/s" }``, read by ``astropy.units`` and
+converted strictly (``Hz`` is refused as ambiguous, see ``attitude.base.quantities``).
+An angle (``sun_exclusion_half_angle``, an inclination) must carry its unit: a bare 3
+would be 171.9° in radians, or 3° to a reader of a data sheet.  Numbers are TOML numbers:
+booleans and strings are refused, not read as 1 or parsed.  Warnings (a body that
+breaks the triangle inequality) are :class:`ScenarioFileWarning`, one line naming the
+file and the key.
+
+An attitude may be given in an orbit frame (``frame = "lvlh"`` or ``"rtn"``, in
+``[initial_state]`` and in attitude resets) or read from an AEM file (``aem = "..."``):
+it is resolved to ICRF here, at load time, with the orbit of ``[pointing]`` at the
+state's epoch, so that the scenario layer below only ever sees body → ICRF.  Files
+(``oem``, ``aem``) are read relative to the scenario file's folder.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+import warnings
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from attitude.base.errors import InertiaWarning, InputError
+from attitude.base.quantities import convert_unit
+from attitude.environment.frames import ORBIT_FRAMES, orbit_frame_to_icrf
+from attitude.environment.keplerian import KeplerianOrbit
+from attitude.environment.oem import OemOrbit
+from attitude.environment.orbit import Orbit, TleOrbit
+from attitude.environment.timescales import SCALES, as_time, time_from_tt_seconds
+from attitude.files.aem_reader import attitude_from_aem
+from attitude.outputs.aem_sampling import check_tolerance
+from attitude.outputs.formats import DEFAULT_FORMATS, OutputChoice, parse_formats
+from attitude.pointing.spec import KINDS, BodyVector, PointingSpec
+from attitude.scenario.events import AngularImpulse, AttitudeReset, InertiaChange
+from attitude.scenario.scenario import InitialState, Scenario
+from attitude.scenario.spacecraft import Spacecraft
+from attitude.scenario.torques import Burn, ScenarioTorques
+
+__all__ = [
+    "ScenarioFile",
+    "ScenarioFileError",
+    "ScenarioFileWarning",
+    "load_scenario",
+    "read_document",
+    "scenario_from_document",
+]
+
+# A scenario is a few kilobytes; anything this large is not one (and reading a huge
+# or endless file, e.g. /dev/zero, must not exhaust the memory).
+MAX_FILE_BYTES = 1 << 20
+
+
+class ScenarioFileError(InputError):
+    """A scenario file has a bad or missing key; the message says where and what."""
+
+
+class ScenarioFileWarning(UserWarning):
+    """Something in a scenario file is computed but suspicious; the message says where."""
+
+
+@dataclass
+class ScenarioFile:
+    """A loaded scenario file: the scenario and what to compute and write from it."""
+
+    path: Path
+    scenario: Scenario
+    pointing: PointingSpec = field(default_factory=PointingSpec)
+    outputs: OutputChoice = field(default_factory=OutputChoice)
+    # The TOML document as read: attitude.montecarlo.dispersions reads its [dispersions] table
+    # and writes each Monte Carlo sample as a copy of it.
+    document: dict[str, Any] = field(default_factory=dict)
+
+
+class _Table:
+    """A TOML table with its key path, for reading typed values with clear errors."""
+
+    def __init__(self, file: Path, path: str, data: Any) -> None:
+        self.file, self.path = file, path
+        if not isinstance(data, dict):
+            self.fail(f"expected a table, got {data!r}")
+        self.data = data
+
+    def where(self, key: str | None = None) -> str:
+        return self.path if key is None else (f"{self.path}.{key}" if self.path else key)
+
+    def fail(self, message: str, key: str | None = None):
+        where = self.where(key)
+        raise ScenarioFileError(
+            f"{self.file.name}: {where}: {message}" if where else f"{self.file.name}: {message}"
+        )
+
+    def allow(self, *keys: str) -> None:
+        unknown = sorted(set(self.data) - set(keys))
+        if unknown:
+            self.fail(f"unknown key {unknown[0]!r}; expected one of: {', '.join(keys)}")
+
+    def has(self, key: str) -> bool:
+        return key in self.data
+
+    def table(self, key: str, required: bool = True) -> _Table | None:
+        if key not in self.data:
+            if required:
+                self.fail(f"missing table [{self.where(key)}]")
+            return None
+        return _Table(self.file, self.where(key), self.data[key])
+
+    def tables(self, key: str) -> list[_Table]:
+        value = self.data.get(key, [])
+        if not isinstance(value, list):
+            self.fail(f"expected an array of tables [[{key}]], got {value!r}", key)
+        return [_Table(self.file, f"{self.where(key)}[{i}]", item) for i, item in enumerate(value)]
+
+    def raw(self, key: str, required: bool = True, default: Any = None) -> Any:
+        if key not in self.data:
+            if required:
+                self.fail("missing key", key)
+            return default
+        return self.data[key]
+
+    def string(self, key: str, required: bool = True, default: str | None = None) -> str | None:
+        value = self.raw(key, required, default)
+        if value is not None and not isinstance(value, str):
+            self.fail(f"expected a string, got {_short(value)}", key)
+        if value is not None and not value.isprintable():
+            self.fail(f"expected one line of printable text, got {_short(value)}", key)
+        return value
+
+    def choice(self, key: str, choices: tuple[str, ...], default: str | None = None) -> str:
+        value = self.string(key, default is None, default)
+        if value not in choices:
+            self.fail(f"expected one of {', '.join(choices)}, got {value!r}", key)
+        return value
+
+    def quantity(
+        self,
+        key: str,
+        kind: str,
+        shape: tuple[int, ...],
+        required: bool = True,
+        to: str | None = None,
+    ):
+        """A number or array in SI units, or ``{ value = ..., unit = "..." }``; finite.
+
+        ``kind``: a key of ``SI_UNITS``; ``to``: another unit of that kind to convert
+        to (e.g. "deg").  An angle must be given with its unit; a dimensionless value
+        (quaternion, matrix, direction) takes none.
+        """
+        value = self.raw(key, required)
+        if value is None:
+            return None
+        unit = None
+        if isinstance(value, dict):
+            sub = _Table(self.file, self.where(key), value)
+            sub.allow("value", "unit")
+            unit = sub.string("unit")
+            value = sub.raw("value")
+            if kind == "dimensionless":
+                self.fail(f"takes no unit (it is a pure number), got unit {unit!r}", key)
+        elif kind == "angle":
+            self.fail(
+                f'an angle needs its unit, e.g. {{ value = {value!r}, unit = "deg" }} '
+                "(a bare number would be read as radians)",
+                key,
+            )
+        if not _is_numbers(value):
+            self.fail(f"expected {_describe(shape)}, got {_short(value)}", key)
+        try:
+            array = np.array(value, dtype=float)
+        except OverflowError:
+            self.fail(f"a number is beyond the float range (1.8e308): {_short(value)}", key)
+        except (TypeError, ValueError):
+            self.fail(f"expected {_describe(shape)}, got {_short(value)}", key)
+        if array.shape != shape:
+            self.fail(f"expected {_describe(shape)}, got {_short(value)}", key)
+        if not np.all(np.isfinite(array)):
+            self.fail(f"expected finite numbers, got {_short(value)}", key)
+        if unit is not None:
+            try:
+                array = np.asarray(convert_unit(array, unit, kind, "", to), dtype=float)
+            except InputError as exc:
+                self.fail(str(exc).removeprefix(": "), key)
+            if not np.all(np.isfinite(array)):
+                self.fail(f"{value!r} {unit} is beyond the float range in SI units", key)
+        return array if shape else float(array)
+
+    def boolean(self, key: str, default: bool) -> bool:
+        value = self.raw(key, required=False, default=default)
+        if not isinstance(value, bool):
+            self.fail(f"expected true or false, got {_short(value)}", key)
+        return value
+
+    def file_path(self, key: str) -> Path:
+        """A file named by a string key, relative to the scenario file's folder."""
+        text = self.string(key)
+        if not text:
+            self.fail("expected a file name, got an empty string", key)
+        return self.file.parent / Path(text).expanduser()
+
+    def epoch(self, key: str, scale: str, required: bool = True):
+        value = self.string(key, required)
+        if value is None:
+            return None
+        try:
+            return as_time(value, scale, name=self.where(key))
+        except InputError as exc:
+            self.fail(str(exc).removeprefix(f"{self.where(key)}: "), key)
+
+    def positive(self, key: str, kind: str, required: bool = True):
+        value = self.quantity(key, kind, (), required)
+        if value is not None and not value > 0.0:
+            self.fail(f"must be positive, got {value!r}", key)
+        return value
+
+
+def _is_numbers(value: Any) -> bool:
+    """True for a TOML number or nested arrays of them (not booleans, not strings)."""
+    if isinstance(value, list):
+        return all(_is_numbers(item) for item in value)
+    return isinstance(value, int | float) and not isinstance(value, bool)
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 60 else f"{text[:40]}...{text[-10:]} ({len(text)} characters)"
+
+
+def _describe(shape: tuple[int, ...]) -> str:
+    if shape == ():
+        return "a number"
+    if len(shape) == 1:
+        return f"{shape[0]} numbers"
+    return f"a {shape[0]}x{shape[1]} array of numbers"
+
+
+def _inertia(table: _Table) -> tuple[np.ndarray, str]:
+    """The inertia (moments or tensor) and the key it was given under."""
+    if table.has("principal_moments") == table.has("inertia_tensor"):
+        table.fail("give exactly one of principal_moments and inertia_tensor")
+    if table.has("principal_moments"):
+        return table.quantity("principal_moments", "moment_of_inertia", (3,)), "principal_moments"
+    return table.quantity("inertia_tensor", "moment_of_inertia", (3, 3)), "inertia_tensor"
+
+
+def _checked(table: _Table, key: str | None, build, *args, **kwargs):
+    """``build(*args, **kwargs)``, its InputError and InertiaWarning named after the key."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", InertiaWarning)
+        try:
+            result = build(*args, **kwargs)
+        except ScenarioFileError:
+            raise
+        except InputError as exc:
+            table.fail(_without_inertia_name(str(exc)), key)
+    for warning in caught:
+        if issubclass(warning.category, InertiaWarning):
+            text = _without_inertia_name(str(warning.message))
+            where = table.where(key)
+            warnings.warn(f"{table.file.name}: {where}: {text}", ScenarioFileWarning, stacklevel=2)
+        else:
+            warnings.warn_explicit(
+                warning.message, warning.category, warning.filename, warning.lineno
+            )
+    return result
+
+
+def _without_inertia_name(message: str) -> str:
+    """A message of ``attitude.solver.inertia`` without its own name for the field: the file's
+    key path replaces it."""
+    return message.removeprefix("inertia_change.").removeprefix("inertia: ")
+
+
+def _attitude(table: _Table) -> Rotation | None:
+    """The attitude given as a quaternion or a matrix (in the table's frame), or None."""
+    given = [key for key in ("quaternion", "matrix") if table.has(key)]
+    if len(given) > 1:
+        table.fail("give one of quaternion and matrix, not both")
+    if not given:
+        return None
+    if given[0] == "quaternion":
+        q = table.quantity("quaternion", "dimensionless", (4,))
+        norm = float(np.linalg.norm(q))
+        if abs(norm - 1.0) > 1e-6:
+            table.fail(f"quaternion must have unit norm, got |q| = {norm:.9g}", "quaternion")
+        return Rotation.from_quat(q, scalar_first=True)
+    a = table.quantity("matrix", "dimensionless", (3, 3))
+    if np.max(np.abs(a @ a.T - np.eye(3))) > 1e-6 or np.linalg.det(a) < 0:
+        table.fail(f"matrix must be a rotation (orthonormal, det +1), got {a.tolist()}", "matrix")
+    return Rotation.from_matrix(a)
+
+
+def _attitude_in_icrf(table: _Table, orbit: Orbit | None, at) -> Rotation | None:
+    """The table's attitude (quaternion or matrix, or ``aem``) as body → ICRF at the
+    epoch ``at`` (a ``Time``): a ``frame = "lvlh"``/``"rtn"`` attitude is composed with
+    the orbit frame there, an AEM file is read at that epoch."""
+    frame = table.choice("frame", ("icrf", *ORBIT_FRAMES), default="icrf")
+    attitude = _attitude(table)
+    if table.has("aem"):
+        if attitude is not None:
+            table.fail("give one of quaternion, matrix and aem, not two")
+        if frame != "icrf":
+            table.fail("an AEM file states its own frame: frame applies to quaternion or matrix")
+        path = table.file_path("aem")
+        try:
+            attitude, notes = attitude_from_aem(path, at)
+        except InputError as exc:
+            table.fail(str(exc), "aem")
+        for note in notes:
+            warnings.warn(
+                f"{table.file.name}: {table.where('aem')}: {note}",
+                ScenarioFileWarning,
+                stacklevel=2,
+            )
+        return attitude
+    if frame == "icrf" or attitude is None:
+        if frame != "icrf":
+            table.fail(f"frame = {frame!r} without a quaternion or matrix to place in it", "frame")
+        return attitude
+    if orbit is None:
+        table.fail(
+            f"frame = {frame!r} needs an orbit: give [pointing] a tle, an oem or "
+            "[pointing.keplerian]",
+            "frame",
+        )
+    try:
+        r, v = orbit.position_velocity(at)
+        return orbit_frame_to_icrf(frame, r, v) * attitude
+    except InputError as exc:
+        table.fail(f"the orbit at {at.isot} {at.scale.upper()}: {exc}", "frame")
+
+
+def _rate(table: _Table, required: bool) -> dict[str, np.ndarray]:
+    given = [k for k in ("angular_velocity", "angular_momentum") if table.has(k)]
+    if len(given) > 1:
+        table.fail("give one of angular_velocity and angular_momentum, not both")
+    if not given:
+        if required:
+            table.fail("missing angular_velocity (rad/s) or angular_momentum (N m s)")
+        return {}
+    return {given[0]: table.quantity(given[0], given[0], (3,))}
+
+
+def _event_epoch(table: _Table, scale: str):
+    """The event's epoch: a ``Time``, or its offset in TT seconds exactly as written."""
+    if table.has("epoch") == table.has("offset"):
+        table.fail("give exactly one of epoch (ISO 8601) and offset (seconds after the epoch)")
+    if table.has("epoch"):
+        return table.epoch("epoch", scale)
+    return table.quantity("offset", "time", ())
+
+
+def _event_time(at, epoch):
+    """An event's epoch as a ``Time``: given, or the offset in TT seconds after ``epoch``."""
+    return at if not isinstance(at, float) else time_from_tt_seconds(epoch, at)
+
+
+def _events(root: _Table, scale: str, epoch, orbit: Orbit | None) -> list:
+    events = []
+    for table in root.tables("events"):
+        kind = table.choice("type", ("angular_impulse", "inertia_change", "attitude_reset"))
+        common = ("type", "epoch", "offset", "label")
+        label = table.string("label", required=False, default="")
+        at = _event_epoch(table, scale)
+        if kind == "angular_impulse":
+            table.allow(*common, "impulse", "frame")
+            impulse = table.quantity("impulse", "angular_momentum", (3,))
+            frame = table.choice("frame", ("body", "inertial"), default="body")
+            events.append(_checked(table, None, AngularImpulse, at, impulse, frame, label))
+        elif kind == "inertia_change":
+            table.allow(*common, "principal_moments", "inertia_tensor")
+            inertia, key = _inertia(table)
+            events.append(_checked(table, key, InertiaChange, at, inertia, label))
+        else:
+            table.allow(
+                *common,
+                "quaternion",
+                "matrix",
+                "frame",
+                "aem",
+                "angular_velocity",
+                "angular_momentum",
+            )
+            attitude = _attitude_in_icrf(table, orbit, _event_time(at, epoch))
+            rate = _rate(table, required=attitude is None)
+            events.append(_checked(table, None, AttitudeReset, at, attitude, label=label, **rate))
+    return events
+
+
+def _angle_deg(item: _Table, key: str, low: float, high: float) -> float | None:
+    """An optional angle in degrees, with its unit, in [low, high) (low excluded if 0)."""
+    value = item.quantity(key, "angle", (), required=False, to="deg")
+    if value is not None and not (low <= value < high and (low < 0.0 or value > 0.0)):
+        item.fail(f"must be between {low:g} and {high:g} deg, got {value!r} deg", key)
+    return value
+
+
+def _body_vector(item: _Table) -> BodyVector:
+    item.allow(
+        "name",
+        "vector",
+        "kind",
+        "sun_exclusion_half_angle",
+        "moon_exclusion_half_angle",
+        "earth_limb_exclusion_angle",
+    )
+    name = item.string("name")
+    vector = item.quantity("vector", "dimensionless", (3,))
+    if not np.linalg.norm(vector) > 0:
+        item.fail(f"must be a non-zero vector, got {vector.tolist()}", "vector")
+    sun = _angle_deg(item, "sun_exclusion_half_angle", 0.0, 180.0)
+    moon = _angle_deg(item, "moon_exclusion_half_angle", 0.0, 180.0)
+    limb = _angle_deg(item, "earth_limb_exclusion_angle", -90.0, 180.0)
+    kind = item.choice("kind", KINDS, default="other")
+
+    def radians(degrees: float | None) -> float | None:
+        return None if degrees is None else math.radians(degrees)
+
+    return _checked(
+        item,
+        None,
+        BodyVector,
+        name,
+        vector,
+        radians(sun),
+        kind,
+        sun,
+        moon_exclusion_half_angle_rad=radians(moon),
+        moon_exclusion_half_angle_deg=moon,
+        earth_limb_exclusion_angle_rad=radians(limb),
+        earth_limb_exclusion_angle_deg=limb,
+    )
+
+
+def _keplerian(table: _Table, scale: str, epoch, name: str) -> KeplerianOrbit:
+    table.allow(
+        "epoch",
+        "semi_major_axis",
+        "eccentricity",
+        "inclination",
+        "raan",
+        "argument_of_perigee",
+        "mean_anomaly",
+        "true_anomaly",
+        "frame",
+        "j2",
+    )
+    at = table.epoch("epoch", scale, required=False)
+    at = epoch if at is None else at
+    if table.has("mean_anomaly") == table.has("true_anomaly"):
+        table.fail("give exactly one of mean_anomaly and true_anomaly")
+    anomaly = "mean_anomaly" if table.has("mean_anomaly") else "true_anomaly"
+    elements = {
+        "semi_major_axis_m": table.positive("semi_major_axis", "length"),
+        "eccentricity": table.quantity("eccentricity", "dimensionless", ()),
+        "inclination": table.quantity("inclination", "angle", ()),
+        "raan": table.quantity("raan", "angle", ()),
+        "argument_of_perigee": table.quantity("argument_of_perigee", "angle", ()),
+        anomaly: table.quantity(anomaly, "angle", ()),
+    }
+    frame = table.choice("frame", ("ICRF", "EME2000"), default="ICRF")
+    j2 = table.boolean("j2", default=False)
+    return _checked(table, None, KeplerianOrbit, at, frame=frame, j2=j2, name=name, **elements)
+
+
+def _orbit(table: _Table, scale: str, epoch, name: str) -> Orbit | None:
+    """The orbit of ``[pointing]``: one of tle, oem and [pointing.keplerian], or None."""
+    given = [key for key in ("tle", "oem", "keplerian") if table.has(key)]
+    if len(given) > 1:
+        table.fail(f"give one orbit: {' or '.join(given)}, not both")
+    if not given:
+        return None
+    if given[0] == "tle":
+        lines = table.raw("tle")
+        if not (
+            isinstance(lines, list) and len(lines) == 2 and all(isinstance(s, str) for s in lines)
+        ):
+            table.fail(f"expected the two lines of a TLE, got {_short(lines)}", "tle")
+        return _checked(table, "tle", TleOrbit, *lines, name)
+    if given[0] == "oem":
+        return _checked(table, "oem", OemOrbit, table.file_path("oem"), name)
+    return _keplerian(table.table("keplerian"), scale, epoch, name)
+
+
+def _pointing(root: _Table, scale: str, epoch, name: str) -> PointingSpec:
+    table = root.table("pointing", required=False)
+    if table is None:
+        return PointingSpec()
+    table.allow(
+        "body_vectors",
+        "tle",
+        "oem",
+        "keplerian",
+        "interval_precision",
+        "earth_limb_atmosphere_height",
+        "lvlh_euler_sequence",
+    )
+    vectors = [_body_vector(item) for item in table.tables("body_vectors")]
+    names = [v.name for v in vectors]
+    if len(set(names)) != len(names):
+        table.fail(f"body vector names must be unique, got {names}", "body_vectors")
+    orbit = _orbit(table, scale, epoch, name)
+    options: dict[str, Any] = {}
+    precision = table.positive("interval_precision", "time", required=False)
+    if precision is not None:
+        options["interval_precision_s"] = precision
+    height = table.quantity("earth_limb_atmosphere_height", "length", (), required=False)
+    if height is not None:
+        options["earth_limb_atmosphere_height_m"] = height
+    sequence = table.string("lvlh_euler_sequence", required=False)
+    if sequence is not None:
+        options["lvlh_euler_sequence"] = sequence
+    return _checked(table, None, PointingSpec, vectors, orbit, **options)
+
+
+def _burn(table: _Table, scale: str) -> Burn:
+    table.allow("epoch", "offset", "duration", "torque", "frame", "label")
+    at = _event_epoch(table, scale)
+    duration = table.positive("duration", "time")
+    torque = table.quantity("torque", "torque", (3,))
+    frame = table.choice("frame", ("body", "inertial"), default="body")
+    label = table.string("label", required=False, default="")
+    return _checked(table, None, Burn, at, duration, torque, frame, label)
+
+
+def _torques(root: _Table, scale: str, orbit: Orbit | None) -> ScenarioTorques | None:
+    """``[torques]``: gravity gradient (on the orbit of ``[pointing]``), burns, the
+    splitting's step or accuracy and order, the validity horizon's threshold."""
+    table = root.table("torques", required=False)
+    if table is None:
+        return None
+    table.allow("gravity_gradient", "burns", "step", "accuracy", "order", "horizon_threshold")
+    gravity_gradient = table.boolean("gravity_gradient", default=False)
+    if gravity_gradient and orbit is None:
+        table.fail(
+            "gravity gradient needs an orbit: give [pointing] a tle, an oem or "
+            "[pointing.keplerian]",
+            "gravity_gradient",
+        )
+    burns = [_burn(item, scale) for item in table.tables("burns")]
+    if table.has("step") and table.has("accuracy"):
+        table.fail("give step or accuracy, not both")
+    options: dict[str, Any] = {
+        "step": table.positive("step", "time", required=False),
+        "accuracy": table.quantity("accuracy", "angle", (), required=False),
+    }
+    order = table.raw("order", required=False, default=4)
+    if isinstance(order, bool) or order not in (2, 4, 6) or not isinstance(order, int):
+        table.fail(f"expected 2, 4 or 6 (the splitting's order), got {_short(order)}", "order")
+    threshold = table.quantity("horizon_threshold", "angle", (), required=False)
+    if threshold is not None:
+        options["horizon_threshold"] = threshold
+    try:
+        return ScenarioTorques(
+            orbit if gravity_gradient else None, tuple(burns), order=order, **options
+        )
+    except InputError as exc:
+        raise ScenarioFileError(f"{table.file.name}: {exc}") from None
+
+
+def read_document(path: Path) -> dict[str, Any]:
+    """The TOML document at ``path``; ScenarioFileError for anything that is not one."""
+    try:
+        with open(path, "rb") as stream:
+            data = stream.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        raise ScenarioFileError(f"{path}: cannot read: {exc.strerror or exc}") from None
+    if len(data) > MAX_FILE_BYTES:
+        raise ScenarioFileError(
+            f"{path.name}: larger than {MAX_FILE_BYTES // 1024} KiB: not a scenario file"
+        )
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        kind = "UTF-16" if data[:2] in (b"\xff\xfe", b"\xfe\xff") else "binary or not UTF-8"
+        raise ScenarioFileError(
+            f"{path.name}: not a TOML file: TOML is UTF-8 text, this is {kind} (byte {exc.start})"
+        ) from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ScenarioFileError(f"{path.name}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise ScenarioFileError(f"{path.name}: not valid TOML: nested too deeply") from None
+
+
+def load_scenario(path: str | Path) -> ScenarioFile:
+    """Read and check a scenario file; raises :class:`ScenarioFileError`."""
+    path = Path(path)
+    return scenario_from_document(path, read_document(path))
+
+
+def scenario_from_document(path: Path, document: dict[str, Any]) -> ScenarioFile:
+    """Check a TOML document as :func:`load_scenario` checks a file (``path`` names it in
+    the errors): a Monte Carlo sample is built from its document through this one path.
+
+    A ``[dispersions]`` table is let through unread: ``attitude.montecarlo.dispersions`` reads it.
+    The tables are read in the order their errors are reported: [scenario],
+    [spacecraft], [pointing] (the orbit: an attitude may be given in its frame),
+    [initial_state], [[events]], [torques], [output].
+    """
+    root = _Table(path, "", document)
+    root.allow(
+        "scenario",
+        "spacecraft",
+        "initial_state",
+        "events",
+        "output",
+        "pointing",
+        "torques",
+        "dispersions",
+    )
+    name, scale, epoch = _scenario_table(root)
+    spacecraft = _spacecraft(root)
+    pointing = _pointing(root, scale, epoch, spacecraft.name)
+    state = _initial_state(root, pointing.orbit, epoch)
+    events = _events(root, scale, epoch, pointing.orbit)
+    torques = _torques(root, scale, pointing.orbit)
+    output = root.table("output")
+    output.allow("start", "stop", "duration", "step", "formats", "aem_tolerance")
+    span = _span(output, scale)
+    try:
+        scenario = Scenario(name, spacecraft, epoch, state, events, **span, torques=torques)
+    except InputError as exc:
+        end = "stop" if span["stop"] is not None else "duration"
+        raise ScenarioFileError(f"{path.name}: {_scenario_key(str(exc), end)}") from None
+    return ScenarioFile(path, scenario, pointing, _outputs(output), document)
+
+
+def _scenario_table(root: _Table) -> tuple[str, str, Any]:
+    """[scenario]: its name, the time scale of the file's epochs, and its epoch."""
+    meta = root.table("scenario")
+    meta.allow("name", "epoch", "time_scale")
+    scale = meta.choice("time_scale", SCALES, default="utc")
+    epoch = meta.epoch("epoch", scale)
+    return meta.string("name"), scale, epoch
+
+
+def _spacecraft(root: _Table) -> Spacecraft:
+    """[spacecraft]: its name and its inertia (principal moments or a tensor)."""
+    craft = root.table("spacecraft")
+    craft.allow("name", "principal_moments", "inertia_tensor")
+    craft_name = craft.string("name")
+    inertia, key = _inertia(craft)
+    return _checked(craft, key, Spacecraft, craft_name, inertia)
+
+
+def _initial_state(root: _Table, orbit: Orbit | None, epoch) -> InitialState:
+    """[initial_state]: the attitude (in ICRF, from the frame or AEM file it is given
+    in) and the rate (angular velocity or momentum)."""
+    initial = root.table("initial_state")
+    initial.allow("quaternion", "matrix", "frame", "aem", "angular_velocity", "angular_momentum")
+    attitude = _attitude_in_icrf(initial, orbit, epoch)
+    if attitude is None:
+        initial.fail("missing quaternion (w, x, y, z, body -> ICRF) or matrix")
+    rate = _rate(initial, required=True)
+    return _checked(initial, None, InitialState, attitude, **rate)
+
+
+def _span(output: _Table, scale: str) -> dict[str, Any]:
+    """[output]'s span and step, as :class:`Scenario` takes them: exactly one of stop and
+    duration, and the start and step if given."""
+    if output.has("stop") == output.has("duration"):
+        output.fail("give exactly one of stop (ISO 8601) and duration (seconds)")
+    return {
+        "stop": output.epoch("stop", scale, required=False),
+        "duration": output.positive("duration", "time", required=False),
+        "start": output.epoch("start", scale, required=False),
+        "step": output.positive("step", "time", required=False),
+    }
+
+
+def _outputs(output: _Table) -> OutputChoice:
+    """``formats`` (a list of names) and ``aem_tolerance`` (an angle, with its unit)."""
+    formats = output.raw("formats", required=False, default=list(DEFAULT_FORMATS))
+    if not isinstance(formats, list):
+        output.fail(f"expected a list of format names, got {_short(formats)}", "formats")
+    try:
+        formats = parse_formats(formats, "formats")
+    except InputError as exc:
+        output.fail(str(exc).removeprefix("formats: "), "formats")
+    tolerance = output.quantity("aem_tolerance", "angle", (), required=False)
+    if tolerance is None:
+        return OutputChoice(formats)
+    try:
+        check_tolerance(tolerance, "aem_tolerance")
+    except InputError as exc:
+        output.fail(str(exc).removeprefix("aem_tolerance: "), "aem_tolerance")
+    return OutputChoice(formats, tolerance)
+
+
+def _scenario_key(message: str, end: str) -> str:
+    """A Scenario's message with its key as the file spells it (``output.step: ...``).
+
+    ``end``: the key that gave the end of the span, ``stop`` or ``duration``.
+    """
+    head, _, rest = message.partition(" ")
+    key = head.removesuffix(":")
+    if key == "epoch":
+        return f"scenario.epoch: {rest}"
+    if key in ("start", "step", "duration", "stop"):
+        return f"output.{end if key == 'stop' else key}: {rest}"
+    if message.startswith("the span"):
+        return f"output.{end}: {message}"
+    return message

@@ -1,0 +1,44 @@
+"""Scenario files written back: a scenario document (the TOML that
+:mod:`attitude.files.scenario_reader` reads) as text that reads back to the same document.
+
+``tomli_w`` writes every float with ``repr``, the shortest text that reads back as the
+same double, so a number drawn by a Monte Carlo job and written here is the number
+the job used, to the last bit.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+__all__ = ["scenario_text", "with_absolute_files"]
+
+
+def scenario_text(document: dict[str, Any], comments: list[str] = ()) -> str:
+    """The TOML text of ``document``, after ``comments`` (each a ``#`` line)."""
+    import tomli_w
+
+    head = "".join(f"# {' '.join(line.split())}\n" for line in comments)
+    return head + ("\n" if head else "") + tomli_w.dumps(document)
+
+
+def with_absolute_files(document: dict[str, Any], folder: Path) -> dict[str, Any]:
+    """``document`` with the files it names (``pointing.oem``, ``initial_state.aem``, an
+    attitude reset's ``aem``), which the reader takes relative to the scenario file's
+    folder, made absolute from ``folder``: the same files, wherever the document is
+    written or read.  The tables it changes are copies."""
+    folder = Path(folder).absolute()
+
+    def resolved(table: Any, key: str) -> Any:
+        if not isinstance(table, dict) or not isinstance(table.get(key), str):
+            return table
+        return {**table, key: str(folder / Path(table[key]).expanduser())}
+
+    document = dict(document)
+    if "pointing" in document:
+        document["pointing"] = resolved(document["pointing"], "oem")
+    if "initial_state" in document:
+        document["initial_state"] = resolved(document["initial_state"], "aem")
+    if isinstance(document.get("events"), list):
+        document["events"] = [resolved(event, "aem") for event in document["events"]]
+    return document

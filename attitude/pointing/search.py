@@ -1,0 +1,620 @@
+"""The pointing's search: every interval and extremum over a span, on the exact motion.
+
+:func:`pointing_analysis` finds, over [start_s, stop_s], the eclipses (any part of the
+Sun hidden, all of it), the Moon behind the Earth, and for each body vector of the
+:class:`attitude.pointing.spec.PointingSpec` its Sun visibility and constraint
+violations (intervals), the least and greatest of its Sun, Moon, nadir and limb angles
+and of its Sun incidence (extrema), and the time averages of the incidence and of the
+lit fraction.  It finds them on the exact motion, whatever the output step, and in
+bounded memory: the span is searched in chunks of :data:`CHUNK_POINTS` points, and
+only what was found is kept between chunks.  The values it searches are those of
+:mod:`attitude.pointing.surroundings`, the same as :func:`attitude.pointing.sampling
+.pointing_samples` gives at the same times.
+
+**The search grid** (:func:`search_grid`): each quantity is sampled with a step that
+comes from the motion and the geometry, not from the output step: 64 samples per 2π
+radians of the fastest rate any direction here can turn at, the body's fastest
+rotation (bounded by √(2T/I_min) over the segments) plus the orbit's (the nadir's
+angular rate, the rate of the Earth's angular radius, the Moon's parallax), and at
+most 30 s on an orbit (600 s at the Earth's centre).
+
+**Intervals**: a condition's sign changes on the grid are refined on the exact
+motion (:func:`attitude.pointing.intervals.find_all_intervals`: regula falsi, then bisection
+where needed) to ``interval_precision``.  **Extrema**: each grid minimum or maximum
+brackets an extremum, narrowed by golden-section search on the exact motion
+(:func:`attitude.pointing.extrema.least_of_each`) to 1 µs, with brackets that cannot hold the
+answer dropped on a rate bound: each body vector's own (:func:`_vector_rates`) plus
+the sky's.
+``tests/test_extrema_against_dense_sampling.py`` compares them with a sampling 100×
+denser than a 10 s output grid.
+
+:func:`check_pointing` checks, before anything is sampled, what the search and the
+samples need: the ephemeris and the orbit over the span, and the size of the grid.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from attitude.base.errors import InputError
+from attitude.environment.earth import EARTH_EQUATORIAL_RADIUS_M, angular_radius
+from attitude.environment.ephemeris import skyfield_times
+from attitude.environment.orbit import Orbit
+from attitude.environment.timescales import SECONDS_PER_DAY
+from attitude.pointing.eclipse import SUN_RADIUS_M
+from attitude.pointing.extrema import Extremum, Problem, least_of_each
+from attitude.pointing.intervals import Interval, difference, find_all_intervals, join
+from attitude.pointing.spec import BodyVector, PointingSpec, interval_precision
+from attitude.pointing.surroundings import SunMoonEarth, moon_hidden, scenario_jd, vector_angles
+from attitude.solver.euler_solver import EulerSolver
+from attitude.trajectory.trajectory import Trajectory
+
+__all__ = [
+    "CHUNK_POINTS",
+    "EXTREMA",
+    "MAX_SEARCH_POINTS",
+    "PointingAnalysis",
+    "SearchGrid",
+    "VectorAnalysis",
+    "check_pointing",
+    "pointing_analysis",
+    "search_grid",
+]
+
+# The search grid: this many samples per turn (2π rad) of the fastest rate at which
+# any direction here turns, and at most this step (on an orbit, at the Earth's centre).
+_SAMPLES_PER_TURN = 64
+_LONGEST_STEP_ON_ORBIT_S = 30.0
+_LONGEST_STEP_S = 600.0
+# The orbit is sampled this often to bound its angular rates (and checked above ground).
+_ORBIT_CHECK_STEP_S = 60.0
+# Bounds on how fast the Sun and the Moon move across the sky of a spacecraft near
+# the Earth: their own motion plus the parallax of the spacecraft's velocity at their
+# least distance (1.47e11 m, 3.56e8 m).
+_SUN_SKY_RATE = 3.1e4 / 1.47e11
+_MOON_SKY_RATE = 1.1e3 / 3.56e8
+# The Sun's least angular radius from near the Earth (at aphelion): the fastest the
+# lit fraction can change is (2/π a) per radian of the discs' relative motion.
+_SUN_LEAST_RADIUS_RAD = SUN_RADIUS_M / 1.53e11
+# The search grid is evaluated this many points at a time (bounded memory: about 26 MB
+# more at the search's peak than 32 768, which cost 13 % more time in the one-day spinner,
+# each chunk paying its own ~30 refinement calls of ~0.8 ms fixed cost), and a run
+# searches at most this many points: about 20 µs a point with the refinements (the
+# spinner scenario, 2-core machine), so half an hour.
+CHUNK_POINTS = 65_536
+MAX_SEARCH_POINTS = 100_000_000
+# Extrema: refined to 1 µs, and a bracket that could improve the best by less than
+# this (radians for angles, or a cosine) is not refined.
+_EXTREMUM_PRECISION_S = 1e-6
+_EXTREMUM_TOLERANCE = 5e-9
+# A body vector's rate bound samples ω this many times over a body period of each
+# segment, and at most this many times in all (at least the last figure a segment).
+_RATE_SAMPLES = 16384
+_RATE_SAMPLES_IN_ALL = 2_000_000
+_RATE_SAMPLES_LEAST = 64
+
+
+@dataclass(frozen=True)
+class SearchGrid:
+    """The search grid of :func:`pointing_analysis` and the rate bounds behind it.
+
+    ``step_s``: the grid step; ``count``: its points over the span;
+    ``body_rate_rad_s``: a bound on the body's rotation rate (√(2T/I_min));
+    ``orbit_rate_rad_s``: the
+    fastest turn of the nadir (|r × v|/r²) plus the rate of the Earth's angular radius;
+    ``orbit_speed_m_s``: the greatest orbital speed; ``vector_rates_rad_s``: for each
+    body vector by name, a bound on how fast it turns (:func:`_vector_rates`; never
+    above ``body_rate_rad_s``, which stands for a vector not listed).
+    """
+
+    start_s: float
+    stop_s: float
+    step_s: float
+    count: int
+    body_rate_rad_s: float
+    orbit_rate_rad_s: float
+    orbit_speed_m_s: float
+    vector_rates_rad_s: dict[str, float] = field(default_factory=dict, compare=False)
+
+    @property
+    def angle_rate_bound(self) -> float:
+        """A bound on how fast any angle between two of our directions changes, rad/s."""
+        return self.body_rate_rad_s + self._geometry_rate
+
+    @property
+    def _geometry_rate(self) -> float:
+        """How fast the Sun, the Moon and the Earth can move across the sky, rad/s."""
+        return (
+            self.orbit_rate_rad_s
+            + _SUN_SKY_RATE
+            + _MOON_SKY_RATE
+            + 2.0 * self.orbit_speed_m_s / 3.56e8
+        )
+
+    def vector_angle_rate_bound(self, name: str) -> float:
+        """A bound on how fast an angle between body vector ``name`` and the Sun, the
+        Moon, the nadir or the limb changes, rad/s: the vector's own rate plus theirs."""
+        return self.vector_rates_rad_s.get(name, self.body_rate_rad_s) + self._geometry_rate
+
+    @property
+    def fraction_rate_bound(self) -> float:
+        """A bound on how fast the lit fraction of the Sun's disc changes, 1/s."""
+        return 2.0 * self.orbit_rate_rad_s / (math.pi * _SUN_LEAST_RADIUS_RAD)
+
+
+def _body_rate(trajectory: Trajectory, start_s: float, stop_s: float) -> float:
+    """A bound on the body's rotation rate over [start_s, stop_s], rad/s: the largest
+    over the segments of √(2T/I_min), since |ω|² = Σ m_i²/I_i² ≤ (Σ m_i²/I_i)/I_min =
+    2T/I_min (tighter than G/I_min, which it never exceeds)."""
+    rates = [
+        math.sqrt(
+            max(2.0 * segment.solver.kinetic_energy, 0.0)
+            / float(np.min(segment.solver.moments_of_inertia))
+        )
+        for segment in trajectory.segments
+        if segment.end_s >= start_s and segment.start_s <= stop_s
+    ]
+    return max(rates, default=0.0)
+
+
+def _vector_rates(
+    trajectory: Trajectory, spec: PointingSpec, start_s: float, stop_s: float
+) -> dict[str, float]:
+    """For each body vector b, a bound on its inertial rate |ω × b| over [start_s,
+    stop_s], rad/s: the pointing's extrema are pruned with it (a vector near the spin
+    axis turns far slower than the body, and :func:`_body_rate` would keep every
+    bracket of its Sun angle).
+
+    Per segment, ω(t) (body axes) is sampled :data:`_RATE_SAMPLES` times (fewer when
+    many segments share :data:`_RATE_SAMPLES_IN_ALL`) over one body period of its
+    solver, in which it takes all its values (the torque-free ω repeats in the body),
+    or over the part of the segment in the span if that is shorter.
+    Within s ≤ Δ/2 of a sample t_k, |ω(t) − ω(t_k)| ≤ |ω̇(t_k)| s + ½ max|ω̈| s², with
+    ω̇ = I⁻¹(m × ω) (Euler's equations, m = Iω, ṁ = m × ω) at the sample, and
+    |ω̈| = |I⁻¹((m × ω) × ω + m × ω̇)| ≤ (G ω_max² + G² ω_max / I_min) / I_min
+    ≤ 2 G² ω_max / I_min² (as G ≥ I_min ω_max); ω_max = √(2T/I_min), the body's
+    bound, also caps the result.
+    """
+    vectors = [(v.name, v.vector) for v in spec.body_vectors]
+    rates = dict.fromkeys((name for name, _ in vectors), 0.0)
+    segments = [
+        segment
+        for segment in trajectory.segments
+        if segment.end_s >= start_s and segment.start_s <= stop_s
+    ]
+    if not vectors or not segments:
+        return rates
+    # Thousands of events share the samples (the bound stays rigorous, only looser).
+    samples = min(_RATE_SAMPLES, max(_RATE_SAMPLES_LEAST, _RATE_SAMPLES_IN_ALL // len(segments)))
+    for segment in segments:
+        a, b = max(segment.start_s, start_s), min(segment.end_s, stop_s)
+        solver = segment.solver
+        least = float(np.min(solver.moments_of_inertia))
+        highest = math.sqrt(max(2.0 * solver.kinetic_energy, 0.0) / least)
+        window = min(b - a, solver.period) if isinstance(solver, EulerSolver) else math.nan
+        if not math.isfinite(window):  # under torques ω need not repeat; no period
+            for name, _ in vectors:
+                rates[name] = max(rates[name], highest)
+            continue
+        s = window / samples / 2.0
+        ω = solver.angular_velocity(a + 2.0 * s * np.arange(samples + 1.0))
+        tensor = solver.inertia_tensor
+        ω_dot = np.linalg.solve(tensor, np.cross(ω @ tensor.T, ω)[..., None])[..., 0]
+        G = solver.angular_momentum_norm
+        curvature = 0.5 * (2.0 * G * G * highest / (least * least)) * s * s
+        step = np.linalg.norm(ω_dot, axis=-1) * s + curvature
+        for name, vector in vectors:
+            found = float(np.max(np.linalg.norm(np.cross(ω, vector), axis=-1) + step))
+            rates[name] = max(rates[name], min(found, highest))
+    return rates
+
+
+def _orbit_samples(
+    trajectory: Trajectory, orbit: Orbit, start_s: float, stop_s: float
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
+    """The orbit every 60 s over [start_s, stop_s] (both ends included): τ, r, v."""
+    count = max(math.ceil((stop_s - start_s) / _ORBIT_CHECK_STEP_S), 1) + 1
+    τ = np.linspace(start_s, stop_s, count)
+    jd1, jd2 = scenario_jd(trajectory)
+    r, v = orbit.state_tt(np.full(τ.size, jd1), jd2 + τ / SECONDS_PER_DAY)
+    return τ, r, v
+
+
+def search_grid(
+    trajectory: Trajectory,
+    spec: PointingSpec,
+    start_s: float | None = None,
+    stop_s: float | None = None,
+) -> SearchGrid:
+    """The search grid of :func:`pointing_analysis` over [start_s, stop_s] (the output
+    span by default), from the rates of the motion and the orbit (see the module notes).
+    """
+    scenario = trajectory.scenario
+    start_s = scenario.start_s if start_s is None else float(start_s)
+    stop_s = scenario.stop_s if stop_s is None else float(stop_s)
+    body = _body_rate(trajectory, start_s, stop_s)
+    orbit_rate = speed = 0.0
+    if spec.orbit is not None:
+        _, r, v = _orbit_samples(trajectory, spec.orbit, start_s, stop_s)
+        distance = np.linalg.norm(r, axis=-1)
+        nadir_rate = np.linalg.norm(np.cross(r, v), axis=-1) / distance**2
+        rho = angular_radius(r, spec.earth_limb_atmosphere_height_m)
+        radial = np.abs(np.sum(r * v, axis=-1)) / distance
+        rho_rate = np.tan(np.minimum(rho, 1.5)) * radial / distance
+        # Between samples 60 s apart the rates change little: 25 % covers the peaks
+        # of a perigee pass that the samples straddle.
+        orbit_rate = 1.25 * float(np.max(nadir_rate + rho_rate))
+        speed = float(np.max(np.linalg.norm(v, axis=-1)))
+    longest = _LONGEST_STEP_ON_ORBIT_S if spec.orbit is not None else _LONGEST_STEP_S
+    rate = body + orbit_rate + _SUN_SKY_RATE + _MOON_SKY_RATE
+    step = min(longest, 2.0 * math.pi / (_SAMPLES_PER_TURN * rate))
+    count = max(math.ceil((stop_s - start_s) / step) + 1, 2)
+    return SearchGrid(
+        start_s,
+        stop_s,
+        (stop_s - start_s) / (count - 1),
+        count,
+        body,
+        orbit_rate,
+        speed,
+        _vector_rates(trajectory, spec, start_s, stop_s),
+    )
+
+
+def check_pointing(
+    trajectory: Trajectory, spec: PointingSpec
+) -> tuple[list[str], SearchGrid | None]:
+    """Everything the pointing of ``spec`` needs, checked before anything is sampled.
+
+    The orbit over the span (the source covers it, and stays above the ground: see
+    each source's ``check_span``; a TLE far from its epoch is noted with its age),
+    and the Sun and Moon ephemeris over the span with the margins the interpolation
+    adds.  Raises :class:`InputError` whose message starts with the key
+    (``pointing.tle: ...``, ``output: ...``); returns notes for the user and the
+    search grid of :func:`pointing_analysis` (None without pointing).
+    """
+    scenario = trajectory.scenario
+    if spec.is_empty:
+        return [], None
+    notes = []
+    _, note = interval_precision(spec, scenario.stop_s)
+    if note:
+        notes.append(f"pointing.interval_precision: {note}")
+    margin = 600.0  # one node of the Sun and Moon ephemeris
+    ends = np.array([scenario.start_s - margin, scenario.stop_s + margin])
+    try:
+        skyfield_times(scenario.times(ends), name="span")
+    except InputError as exc:
+        raise InputError(
+            f"output: the span with its {margin:g} s margins needs the Sun and the Moon over "
+            f"{scenario.format_epoch(ends[0])} to {scenario.format_epoch(ends[1])}: "
+            f"{str(exc).removeprefix('span: ')}"
+        ) from None
+    orbit = spec.orbit
+    if orbit is not None:
+        notes += orbit.check_span(scenario.times(scenario.start_s), scenario.times(scenario.stop_s))
+        try:
+            τ, r, _ = _orbit_samples(trajectory, orbit, scenario.start_s, scenario.stop_s)
+        except InputError as exc:
+            raise InputError(f"{orbit.key}: {exc}") from None
+        distance = np.linalg.norm(r, axis=-1)
+        low = distance <= EARTH_EQUATORIAL_RADIUS_M
+        if np.any(low):
+            when = scenario.format_epoch(float(τ[np.argmax(low)]))
+            raise InputError(
+                f"{orbit.key}: the orbit is inside the Earth at {when} "
+                f"({float(distance[np.argmax(low)]) / 1e3:.1f} km from its centre, less than "
+                f"its {EARTH_EQUATORIAL_RADIUS_M / 1e3:g} km radius)"
+            )
+    grid = search_grid(trajectory, spec)
+    if grid.count > MAX_SEARCH_POINTS:
+        raise InputError(
+            f"output: the pointing's search needs {grid.count:.3g} points over the span "
+            f"(every {grid.step_s:.3g} s: 64 a turn of the fastest rotation), more than the "
+            f"{MAX_SEARCH_POINTS:.0e} one run searches (about 20 µs a point): use a shorter span"
+        )
+    return notes, grid
+
+
+# The extrema reported per body vector, and whether each needs an orbit.
+EXTREMA = {
+    "sun_angle": False,
+    "moon_angle": False,
+    "nadir_angle": True,
+    "earth_limb_angle": True,
+    "cos_incidence": False,
+}
+
+
+@dataclass
+class VectorAnalysis:
+    """One body vector's intervals and extrema over the analysed span.
+
+    Intervals (TT s since the epoch): ``sun_visible`` (the Sun in front of the
+    vector and the spacecraft not in umbra), ``sun_exclusion``, ``moon_exclusion`` and
+    ``earth_limb_exclusion`` (each constraint violated, as in :class:`VectorSamples`).
+    ``extrema``: for each quantity of :data:`EXTREMA` it has, (least, greatest)
+    :class:`attitude.pointing.extrema.Extremum`, radians for angles.  ``mean_cos_incidence``:
+    the time average of the incidence over the span.
+    """
+
+    vector: BodyVector
+    extrema: dict[str, tuple[Extremum, Extremum]]
+    sun_visible: list[Interval] = field(default_factory=list)
+    sun_exclusion: list[Interval] = field(default_factory=list)
+    moon_exclusion: list[Interval] = field(default_factory=list)
+    earth_limb_exclusion: list[Interval] = field(default_factory=list)
+    mean_cos_incidence: float = 0.0
+
+
+@dataclass
+class PointingAnalysis:
+    """Intervals and extrema over [start_s, stop_s]: see :func:`pointing_analysis`.
+
+    ``shadow``/``umbra``: the eclipses (any part, all of the Sun hidden);
+    ``moon_hidden``: the Moon's centre behind the Earth; ``sunlit_fraction_mean``: the
+    time average of the lit fraction; ``grid``: the search grid used.
+    """
+
+    start_s: float
+    stop_s: float
+    precision_s: float
+    on_orbit: bool
+    orbit: str
+    grid: SearchGrid
+    vectors: list[VectorAnalysis]
+    shadow: list[Interval] = field(default_factory=list)
+    umbra: list[Interval] = field(default_factory=list)
+    moon_hidden: list[Interval] = field(default_factory=list)
+    sunlit_fraction_mean: float = 1.0
+
+
+class _Quantities:
+    """Every quantity the analysis searches, at any times of one chunk."""
+
+    def __init__(self, trajectory: Trajectory, spec: PointingSpec, start_s: float, stop_s: float):
+        self.trajectory = trajectory
+        self.spec = spec
+        self.env = SunMoonEarth(trajectory, spec, start_s, stop_s)
+
+    def __call__(self, seconds: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
+        env = self.env.at(seconds)
+        attitude = self.trajectory.attitude(seconds)
+        values = {"sunlit_fraction": env.sunlit_fraction}
+        if env.shadow_angles is not None:
+            a, b, c = env.shadow_angles
+            values["shadow"] = (a + b) - c
+            values["umbra"] = (b - a) - c
+            values["moon_hidden"] = moon_hidden(env)
+        for v in self.spec.body_vectors:
+            for quantity, value in vector_angles(attitude.apply(v.vector), env).items():
+                values[f"{v.name}.{quantity}"] = value
+        return values
+
+
+def _conditions(spec: PointingSpec) -> dict[str, tuple[str, float, float]]:
+    """Each interval condition: (quantity, scale, offset), true where scale·q − offset > 0."""
+    conditions: dict[str, tuple[str, float, float]] = {}
+    if spec.orbit is not None:
+        conditions["shadow"] = ("shadow", 1.0, 0.0)
+        conditions["umbra"] = ("umbra", 1.0, 0.0)
+        conditions["moon_hidden"] = ("moon_hidden", 1.0, 0.0)
+    for v in spec.body_vectors:
+        name = v.name
+        conditions[f"{name}.sun_visible"] = (f"{name}.sun_cosine", 1.0, 0.0)
+        if v.sun_exclusion_half_angle_rad is not None:
+            conditions[f"{name}.sun_exclusion"] = (
+                f"{name}.sun_angle",
+                -1.0,
+                -v.sun_exclusion_half_angle_rad,
+            )
+        if v.moon_exclusion_half_angle_rad is not None:
+            conditions[f"{name}.moon_exclusion"] = (
+                f"{name}.moon_angle",
+                -1.0,
+                -v.moon_exclusion_half_angle_rad,
+            )
+        if v.earth_limb_exclusion_angle_rad is not None:
+            conditions[f"{name}.earth_limb_exclusion"] = (
+                f"{name}.earth_limb_angle",
+                -1.0,
+                -v.earth_limb_exclusion_angle_rad,
+            )
+    return conditions
+
+
+def _grid_points(
+    grid: SearchGrid, first: int, last: int, events_s: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Points first..last of the search grid, with the event epochs between them."""
+    span = grid.stop_s - grid.start_s
+    index = np.arange(first, last + 1, dtype=np.float64)
+    τ = grid.start_s + span * index / (grid.count - 1)
+    τ[-1] = grid.stop_s if last == grid.count - 1 else τ[-1]
+    inside = events_s[(events_s > τ[0]) & (events_s < τ[-1])]
+    return np.unique(np.concatenate([τ, inside])) if inside.size else τ
+
+
+class _Search:
+    """The intervals, extrema and averages of the analysis, accumulated chunk by chunk."""
+
+    def __init__(self, trajectory: Trajectory, spec: PointingSpec, grid: SearchGrid) -> None:
+        self.trajectory, self.spec, self.grid = trajectory, spec, grid
+        self.precision = interval_precision(spec, trajectory.scenario.stop_s)[0]
+        self.extremum_precision = max(_EXTREMUM_PRECISION_S, 4.0 * float(np.spacing(grid.stop_s)))
+        self.conditions = _conditions(spec)
+        self.found: dict[str, list[Interval]] = {name: [] for name in self.conditions}
+        # (vector, quantity) pairs, and the least and greatest of each found so far.
+        self.wanted = [
+            (v.name, quantity)
+            for v in spec.body_vectors
+            for quantity, needs_orbit in EXTREMA.items()
+            if spec.on_orbit or not needs_orbit
+        ]
+        self.lows: dict[tuple[str, str], Extremum | None] = dict.fromkeys(self.wanted)
+        self.highs: dict[tuple[str, str], Extremum | None] = dict.fromkeys(self.wanted)
+        self.sums = {"sunlit_fraction": 0.0} | {
+            f"{v.name}.cos_incidence": 0.0 for v in spec.body_vectors
+        }
+
+    def _rate(self, name: str, quantity: str) -> float:
+        """A bound on the rate of change of a vector's quantity (the incidence adds the
+        lit fraction's)."""
+        rate = self.grid.vector_angle_rate_bound(name)
+        if quantity == "cos_incidence":
+            return rate + self.grid.fraction_rate_bound
+        return rate
+
+    def _condition_values(self, values: dict[str, NDArray]) -> dict[str, NDArray]:
+        return {
+            name: scale * values[key] - offset
+            for name, (key, scale, offset) in self.conditions.items()
+        }
+
+    def _extremum_values(self, values: dict[str, NDArray]) -> dict[str, NDArray]:
+        """Each quantity to minimize ('.low') and its negative to minimize ('.high')."""
+        out = {}
+        for name, quantity in self.wanted:
+            key = f"{name}.{quantity}"
+            out[f"{key}.low"] = values[key]
+            out[f"{key}.high"] = -values[key]
+        return out
+
+    def chunk(self, τ: NDArray[np.float64]) -> None:
+        """Search the grid points τ (one chunk) and fold what they hold into the totals."""
+        quantities = _Quantities(self.trajectory, self.spec, float(τ[0]), float(τ[-1]))
+        values = quantities(τ)
+        self._intervals(quantities, τ, values)
+        self._extrema(quantities, τ, values)
+        widths = np.diff(τ)
+        for key in self.sums:  # the trapezoid rule on the search grid
+            self.sums[key] += float(np.sum(0.5 * (values[key][1:] + values[key][:-1]) * widths))
+
+    def _intervals(self, quantities: _Quantities, τ, values) -> None:
+        pieces = find_all_intervals(
+            lambda t: self._condition_values(quantities(t)),
+            τ,
+            self.precision,
+            self._condition_values(values),
+        )
+        for name in self.conditions:
+            join(self.found[name], pieces[name], float(τ[0]))
+
+    def _extrema(self, quantities: _Quantities, τ, values) -> None:
+        on_grid = self._extremum_values(values)
+        problems = {}
+        for name, quantity in self.wanted:
+            key = f"{name}.{quantity}"
+            low, high = self.lows[(name, quantity)], self.highs[(name, quantity)]
+            if quantity == "cos_incidence" and np.min(on_grid[f"{key}.low"]) <= 0.0:
+                # No light: 0 is the least incidence, placed from the intervals (result).
+                self.lows[(name, quantity)] = Extremum(float(τ[0]), 0.0)
+            else:
+                problems[f"{key}.low"] = Problem(
+                    on_grid[f"{key}.low"], self._rate(name, quantity), low
+                )
+            problems[f"{key}.high"] = Problem(
+                on_grid[f"{key}.high"],
+                self._rate(name, quantity),
+                None if high is None else Extremum(high.time_s, -high.value),
+            )
+        if not problems:
+            return
+        best = least_of_each(
+            lambda t: self._extremum_values(quantities(t)),
+            τ,
+            problems,
+            _EXTREMUM_TOLERANCE,
+            self.extremum_precision,
+        )
+        for name, quantity in self.wanted:
+            key = f"{name}.{quantity}"
+            if f"{key}.low" in best:
+                self.lows[(name, quantity)] = best[f"{key}.low"]
+            high = best[f"{key}.high"]
+            self.highs[(name, quantity)] = Extremum(high.time_s, -high.value)
+
+    def result(self) -> PointingAnalysis:
+        """The analysis: the accumulated intervals (each condition less what hides it),
+        extrema and averages."""
+        grid, spec, found = self.grid, self.spec, self.found
+        span = max(grid.stop_s - grid.start_s, 1e-300)
+        umbra = found.get("umbra", [])
+        analysis = PointingAnalysis(
+            start_s=grid.start_s,
+            stop_s=grid.stop_s,
+            precision_s=self.precision,
+            on_orbit=spec.on_orbit,
+            orbit="Earth centre" if spec.orbit is None else spec.orbit.describe(),
+            grid=grid,
+            vectors=[],
+            shadow=found.get("shadow", []),
+            umbra=umbra,
+            moon_hidden=found.get("moon_hidden", []),
+            sunlit_fraction_mean=self.sums["sunlit_fraction"] / span,
+        )
+        for v in spec.body_vectors:
+            name = v.name
+            extrema = {
+                q: (self.lows[(name, q)], self.highs[(name, q)])
+                for n, q in self.wanted
+                if n == name
+            }
+            item = VectorAnalysis(
+                vector=v,
+                extrema=extrema,
+                sun_visible=difference(found[f"{name}.sun_visible"], umbra),
+                sun_exclusion=difference(found.get(f"{name}.sun_exclusion", []), umbra),
+                moon_exclusion=difference(
+                    found.get(f"{name}.moon_exclusion", []), analysis.moon_hidden
+                ),
+                earth_limb_exclusion=found.get(f"{name}.earth_limb_exclusion", []),
+                mean_cos_incidence=self.sums[f"{name}.cos_incidence"] / span,
+            )
+            low, high = extrema["cos_incidence"]
+            item.extrema["cos_incidence"] = (_first_dark(item, grid) or low, high)
+            analysis.vectors.append(item)
+        return analysis
+
+
+def pointing_analysis(
+    trajectory: Trajectory,
+    spec: PointingSpec,
+    start_s: float | None = None,
+    stop_s: float | None = None,
+    grid: SearchGrid | None = None,
+) -> PointingAnalysis:
+    """Every interval and extremum of ``spec``'s pointing over [start_s, stop_s] (TT s
+    since the epoch; the output span by default), on the exact motion.
+
+    The span is searched in chunks of :data:`CHUNK_POINTS` grid points (see the
+    module notes for the grid): memory does not grow with the span, only the list of
+    intervals found.  Interval ends are refined to ``spec.interval_precision_s``,
+    extrema to 1 µs.
+    """
+    if grid is None:
+        grid = search_grid(trajectory, spec, start_s, stop_s)
+    search = _Search(trajectory, spec, grid)
+    events_s = np.array([t for t, _ in trajectory.scenario.events], dtype=np.float64)
+    first = 0
+    while first < grid.count - 1:
+        last = min(first + CHUNK_POINTS, grid.count - 1)
+        search.chunk(_grid_points(grid, first, last, events_s))
+        first = last
+    return search.result()
+
+
+def _first_dark(item: VectorAnalysis, grid: SearchGrid) -> Extremum | None:
+    """The least incidence, 0, at the first time the vector gets no sunlight (the end of
+    its first Sun-visible interval, or the start of the span): exact from the
+    intervals, where the search would stop at whichever grid point first reads 0."""
+    visible = item.sun_visible
+    if visible and visible[0].starts_before:
+        if visible[0].ends_after:
+            return None  # lit throughout
+        return Extremum(visible[0].end_s, 0.0)
+    return Extremum(grid.start_s, 0.0)

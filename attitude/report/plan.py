@@ -1,0 +1,145 @@
+"""Everything a run checks before it samples: one path for ``attitude check`` and ``run``.
+
+``plan_run(scenario, pointing, outputs)`` propagates the scenario (the exact solver
+segments, refused where the motion is faster than TT seconds can follow), analyses
+each segment (flips counted, not listed), checks the pointing (the orbit source over
+the span, the Sun and Moon ephemeris with the interpolation's margins, the size of
+the exact search), chooses the AEM's records for its tolerance, counts the output
+samples and estimates the outputs' sizes and the (constant) memory of the streamed
+run.  It notes an output step that undersamples the motion (more than a tenth of its
+shortest period).  Segments under torques are propagated (their whole grid, and the
+error estimate of their step); a scenario with an orbit that leaves the gravity
+gradient out (torque-free, or burns alone) gets its validity horizon
+(``attitude.trajectory.horizon.validity_horizon``).  What it refuses, a run would have refused
+later, after computing; what it returns is what the run uses.  Errors are
+``attitude.base.errors.InputError`` whose message starts with the scenario key.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from attitude.base.errors import InputError
+from attitude.outputs.aem_sampling import AemPlan, plan_aem
+from attitude.outputs.budget import OutputBudget, check_fits, estimate
+from attitude.outputs.csv import pointing_column_count
+from attitude.outputs.formats import OutputChoice
+from attitude.outputs.parquet import check_span
+from attitude.pointing.search import SearchGrid, check_pointing
+from attitude.pointing.spec import PointingSpec
+from attitude.report.beside import Beside
+from attitude.scenario.scenario import Scenario
+from attitude.trajectory.horizon import ValidityHorizon, validity_horizon
+from attitude.trajectory.motion import SegmentMotion, analyze, undersampling_note
+from attitude.trajectory.trajectory import Trajectory, propagate
+
+__all__ = ["RunPlan", "horizon_beside", "plan_run"]
+
+
+@dataclass
+class RunPlan:
+    """A scenario checked for a run: its trajectory, motion, outputs, sizes and notes."""
+
+    scenario: Scenario
+    pointing: PointingSpec
+    trajectory: Trajectory
+    motion: list[SegmentMotion]
+    budget: OutputBudget
+    notes: list[str] = field(default_factory=list)
+    outputs: OutputChoice = field(default_factory=OutputChoice)
+    aem: AemPlan | None = None
+    search: SearchGrid | None = None  # the pointing's exact search (None without pointing)
+    horizon: ValidityHorizon | None = None  # on an orbit, no gravity gradient: how long it holds
+    # The horizon is wanted but left for the run to compute (plan_run(horizon=False)).
+    horizon_deferred: bool = False
+
+
+def plan_run(
+    scenario: Scenario,
+    pointing: PointingSpec | None = None,
+    outputs: OutputChoice | None = None,
+    horizon: bool = True,
+) -> RunPlan:
+    """Check ``scenario`` (``pointing``, ``outputs``) as a run would, up to the sampling.
+
+    ``horizon=False``: the validity horizon, when there is one, is not computed here
+    (``horizon_deferred`` says it is wanted): a run computes it beside its outputs
+    (``attitude.report.run``), since it checks nothing and takes as long as a day's outputs.
+    """
+    pointing = pointing or PointingSpec()
+    outputs = outputs or OutputChoice()
+    samples = scenario.output_count()
+    if "parquet" in outputs:
+        check_span(scenario.start_s, scenario.stop_s, "--formats parquet")
+    trajectory = propagate(scenario)
+    # The size and memory checks come before the analysis and the pointing checks,
+    # which do not depend on the output grid but can take a while on a long span.
+    vectors, on_orbit = len(pointing.body_vectors), pointing.on_orbit
+    columns = pointing_column_count(pointing) if not pointing.is_empty else 0
+    budget = estimate(
+        samples, 0, vectors, on_orbit, outputs.formats, aem_records=0, pointing_columns=columns
+    )
+    check_fits(budget)
+    motion = analyze(trajectory)
+    notes, search = check_pointing(trajectory, pointing)
+    undersampled = undersampling_note(trajectory, motion)
+    if undersampled:
+        notes.append(undersampled)
+    # The error estimates the summary states (each segment's, and the run's), checked here.
+    errors = [getattr(s.solver, "error_estimate", 0.0) for s in trajectory.segments]
+    errors.append(trajectory.error_estimate)
+    if not all(math.isfinite(error) for error in errors):
+        raise InputError(
+            f"torques: the propagation has no finite error estimate ({errors}): "
+            "give a smaller step or an accuracy"
+        )
+    found = None
+    # On an orbit, unless the gravity gradient is modelled: a torque-free run, or burns
+    # alone, neglects it.
+    wanted = pointing.orbit is not None and scenario.torques.gravity_gradient is None
+    if wanted and horizon:
+        found = validity_horizon(trajectory, pointing.orbit)
+    aem = None
+    if "aem" in outputs:
+        aem = plan_aem(
+            trajectory,
+            motion,
+            scenario.start_s,
+            scenario.stop_s,
+            outputs.aem_tolerance_rad,
+            outputs.tolerance_key,
+        )
+    budget = estimate(
+        samples,
+        0 if search is None else search.count,
+        vectors,
+        on_orbit,
+        outputs.formats,
+        0 if aem is None else aem.records,
+        pointing_columns=columns,
+    )
+    return RunPlan(
+        scenario,
+        pointing,
+        trajectory,
+        motion,
+        budget,
+        notes,
+        outputs,
+        aem,
+        search,
+        found,
+        horizon_deferred=wanted and not horizon,
+    )
+
+
+def horizon_beside(plan: RunPlan) -> Beside[ValidityHorizon] | None:
+    """The validity horizon ``plan`` left to the run, started now in a process beside
+    this one (:class:`attitude.report.beside.Beside`; use it as a context manager), or None
+    when the plan has none to compute.  The command line starts it before it imports
+    the writers and the plots, so that the horizon, the longest single job of a
+    one-day report, starts as early as it can."""
+    if not plan.horizon_deferred:
+        return None
+    return Beside(validity_horizon, plan.trajectory, plan.pointing.orbit)

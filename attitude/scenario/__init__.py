@@ -1,0 +1,12 @@
+"""The scenario layer: the spacecraft, its initial state at an epoch, events, and the
+torques a scenario models.
+
+Modules:
+
+- ``events``: Events that change the spacecraft's motion at an epoch.
+- ``scenario``: A scenario: spacecraft, initial state at an epoch, events, and the
+  output span.
+- ``spacecraft``: The spacecraft: a name and an inertia in its own body axes.
+- ``torques``: The torques of a scenario: gravity gradient, finite burns, and how they
+  are propagated.
+"""

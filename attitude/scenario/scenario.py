@@ -1,0 +1,336 @@
+"""A scenario: spacecraft, initial state at an epoch, events, and the output span.
+
+Time rules (what a user can rely on):
+
+- ``epoch`` is an ``astropy.time.Time`` in any scale; it is the time of the initial
+  state, and the scale the outputs are written in.  Internally every epoch is
+  reduced to TT seconds since ``epoch`` from two-part Julian dates (never one float).
+- The propagation covers [epoch, stop].  Outputs are sampled on [start, stop] every
+  ``step`` seconds (``start`` defaults to ``epoch``, and ``stop`` is always included).
+- Events are applied in time order; the list may be given in any order (it is
+  sorted, stably).  Events at the same epoch are applied in the order given.
+- An event before ``epoch`` or after ``stop`` is an error (it would not change
+  anything the scenario outputs, and is almost certainly a mistake).  An event at
+  ``stop`` exactly is applied: the output at ``stop`` is the post-event state.
+- At an event's epoch every output is the **post-event** state.
+- An event's ``epoch`` is a ``Time`` (or ISO string in the epoch's scale), or a
+  number of TT seconds after the scenario epoch (a float or a time ``Quantity``),
+  taken exactly as given.
+- Every epoch of the span lies in the years 0001–9999 of the epoch's scale (the
+  years that ISO 8601 and the CCSDS files write with four digits).
+- The output grid must be representable: a step that TT seconds resolve at the end
+  of the span (see :meth:`Scenario.output_count`).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
+
+from attitude.base.errors import InputError
+from attitude.base.quantities import as_si_scalar, as_vector3
+from attitude.environment.timescales import (
+    SAME_INSTANT_S,
+    as_time,
+    check_year_range,
+    iso_texts,
+    offline_time,
+    time_from_tt_seconds,
+    tt_seconds,
+)
+from attitude.scenario.events import Event
+from attitude.scenario.spacecraft import Spacecraft
+from attitude.scenario.torques import MAX_STEPS, PlacedBurn, ScenarioTorques
+
+if TYPE_CHECKING:  # astropy loads only when a Time is made
+    from astropy.time import Time
+
+__all__ = ["InitialState", "Scenario"]
+
+# Ten thousand Julian years: no span of years 0001–9999 is longer.
+_LONGEST_SPAN_S = 1e4 * 365.25 * 86400.0
+
+
+@dataclass(frozen=True)
+class InitialState:
+    """Attitude (body → inertial) and rate at the scenario epoch.
+
+    Give exactly one of ``angular_velocity`` (rad/s) and ``angular_momentum``
+    (N m s), body axes.  See :meth:`from_quaternion` and :meth:`from_matrix` for
+    the other ways of giving the attitude.
+    """
+
+    attitude: Rotation
+    angular_velocity: NDArray[np.float64] | None = None
+    angular_momentum: NDArray[np.float64] | None = None
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.attitude, Rotation) and self.attitude.single):
+            raise InputError(
+                f"initial_state.attitude must be a single scipy Rotation, got {self.attitude!r}"
+            )
+        if (self.angular_velocity is None) == (self.angular_momentum is None):
+            raise InputError(
+                "initial_state: give exactly one of angular_velocity and angular_momentum"
+            )
+        for name in ("angular_velocity", "angular_momentum"):  # each is also its unit kind
+            value = getattr(self, name)
+            if value is not None:
+                object.__setattr__(self, name, as_vector3(value, name, f"initial_state.{name}"))
+
+    @classmethod
+    def from_quaternion(cls, quaternion_scalar_first: Any, **rate: Any) -> InitialState:
+        """Attitude from a unit quaternion (w, x, y, z), body → inertial."""
+        q = np.asarray(quaternion_scalar_first, dtype=float)
+        if q.shape != (4,) or not np.all(np.isfinite(q)):
+            raise InputError(f"initial_state.quaternion must be 4 finite numbers, got {q.tolist()}")
+        norm = np.linalg.norm(q)
+        if abs(norm - 1.0) > 1e-6:
+            raise InputError(f"initial_state.quaternion must have unit norm, got |q| = {norm:.9g}")
+        return cls(Rotation.from_quat(q, scalar_first=True), **rate)
+
+    @classmethod
+    def from_matrix(cls, matrix: Any, **rate: Any) -> InitialState:
+        """Attitude from a direction cosine matrix taking body to inertial coordinates."""
+        a = np.asarray(matrix, dtype=float)
+        if a.shape != (3, 3) or not np.all(np.isfinite(a)):
+            raise InputError(f"initial_state.matrix must be a finite 3x3 matrix, got {a.tolist()}")
+        orthogonality = np.max(np.abs(a @ a.T - np.eye(3)))
+        if orthogonality > 1e-6 or np.linalg.det(a) < 0:
+            raise InputError(
+                f"initial_state.matrix must be a rotation (orthonormal, det +1), got {a.tolist()}"
+            )
+        return cls(Rotation.from_matrix(a), **rate)
+
+
+class Scenario:
+    """Everything needed to propagate: spacecraft, epoch, initial state, events, span.
+
+    Parameters
+    ----------
+    name
+        Title of the scenario.
+    spacecraft
+        The :class:`Spacecraft` (its inertia at the epoch).
+    epoch
+        ``astropy.time.Time`` (or ISO 8601 string in UTC) of the initial state.
+    initial_state
+        :class:`InitialState`.
+    events
+        Events (``attitude.scenario.events``), in any order.
+    stop, duration
+        End of the propagation: a ``Time`` (or ISO string in the epoch's scale), or
+        a duration in seconds from the epoch.  Exactly one.
+    start
+        First output epoch (default: the epoch).
+    step
+        Output step, seconds (default: the output span / 1000).
+    torques
+        :class:`~attitude.scenario.torques.ScenarioTorques`: gravity gradient, burns,
+        and the splitting's step and order (default: none, the exact torque-free
+        motion).
+    """
+
+    def __init__(
+        self,
+        name: str,
+        spacecraft: Spacecraft,
+        epoch: Any,
+        initial_state: InitialState,
+        events: list[Event] | tuple[Event, ...] = (),
+        *,
+        stop: Any = None,
+        duration: Any = None,
+        start: Any = None,
+        step: Any = None,
+        torques: ScenarioTorques | None = None,
+    ) -> None:
+        self.name = str(name)
+        if not isinstance(spacecraft, Spacecraft):
+            raise InputError(f"spacecraft must be a Spacecraft, got {spacecraft!r}")
+        if not isinstance(initial_state, InitialState):
+            raise InputError(f"initial_state must be an InitialState, got {initial_state!r}")
+        self.spacecraft = spacecraft
+        self.initial_state = initial_state
+        self._set_epoch(epoch)
+        self._set_span(stop, duration)
+        self._set_output_grid(start, step)
+        self._place_events(events)
+        self._place_torques(torques)
+
+    def _set_epoch(self, epoch: Any) -> None:
+        self.epoch = as_time(epoch, name="epoch")
+        if not self.epoch.isscalar:
+            raise InputError(f"epoch must be a single epoch, got {len(self.epoch)} of them")
+        check_year_range(self.epoch, "epoch")
+
+    def _set_span(self, stop: Any, duration: Any) -> None:
+        """The end of the propagation, ``stop_s``: within 10,000 years and years 1–9999."""
+        if (stop is None) == (duration is None):
+            raise InputError("give exactly one of stop and duration")
+        if duration is not None:
+            self.stop_s = as_si_scalar(duration, "time", "duration")
+        else:
+            self.stop_s = float(tt_seconds(as_time(stop, self.time_scale, name="stop"), self.epoch))
+        if not self.stop_s > 0.0:
+            raise InputError(f"the span must end after the epoch, got {self.stop_s:g} s")
+        if self.stop_s > _LONGEST_SPAN_S:
+            raise InputError(f"the span must be shorter than 10,000 years, got {self.stop_s:g} s")
+        with offline_time():
+            end = time_from_tt_seconds(self.epoch, self.stop_s)
+            check_year_range(getattr(end, self.time_scale), "stop")
+
+    def _set_output_grid(self, start: Any, step: Any) -> None:
+        """The output grid's ``start_s`` and ``step_s``: a grid that TT seconds resolve."""
+        if start is None:
+            self.start_s = 0.0
+        else:
+            self.start_s = float(tt_seconds(as_time(start, self.time_scale, "start"), self.epoch))
+        if not 0.0 <= self.start_s < self.stop_s:
+            raise InputError(
+                f"start must lie in [epoch, stop), got {self.start_s:g} s after the epoch "
+                f"(stop at {self.stop_s:g} s)"
+            )
+        span = self.stop_s - self.start_s
+        self.step_s = span / 1000.0 if step is None else as_si_scalar(step, "time", "step")
+        if not self.step_s > 0.0:
+            raise InputError(f"step must be positive, got {self.step_s:g} s")
+        resolution = float(np.spacing(self.stop_s))
+        if self.step_s < 4.0 * resolution:
+            raise InputError(
+                f"step {self.step_s:g} s is below what TT seconds resolve at the end of the "
+                f"span ({self.stop_s:g} s, resolution {resolution:.3g} s): the output grid "
+                "would repeat epochs"
+            )
+
+    def _place_events(self, events: list[Event] | tuple[Event, ...]) -> None:
+        """``events`` as (offset, event) in time order, stably; each within [0, stop]."""
+        timed = []
+        for index, event in enumerate(events):
+            offset = self._offset_in_span(event.epoch, f"events[{index}].epoch")
+            where = f"events[{index}] ({event.kind} at {self.format_epoch(offset)})"
+            if offset < 0.0:
+                raise InputError(f"{where} is before the scenario epoch {self.format_epoch(0.0)}")
+            if offset > self.stop_s:
+                end = self.format_epoch(self.stop_s)
+                raise InputError(f"{where} is after the end of the propagation span {end}")
+            timed.append((offset, index, event))
+        timed.sort(key=lambda item: (item[0], item[1]))
+        self.events: list[tuple[float, Event]] = [(offset, event) for offset, _, event in timed]
+        # The place of each event (in time order) in the list given: events[i].
+        self.event_indices: list[int] = [index for _, index, _ in timed]
+
+    def _place_torques(self, torques: ScenarioTorques | None) -> None:
+        """``torques`` (none: torque-free) and its burns on the time line, ``burns``.
+
+        A burn starts within [epoch, stop) and may run past the end of the span; a
+        step that would take more than ``MAX_STEPS`` over the span is refused.
+        """
+        if torques is None:
+            torques = ScenarioTorques()
+        if not isinstance(torques, ScenarioTorques):
+            raise InputError(f"torques must be a ScenarioTorques, got {torques!r}")
+        self.torques = torques
+        self.burns: list[PlacedBurn] = []
+        for index, burn in enumerate(torques.burns):
+            where = f"torques.burns[{index}]"
+            start_s = self._offset_in_span(burn.epoch, f"{where}.epoch")
+            if not 0.0 <= start_s < self.stop_s:
+                raise InputError(
+                    f"{where}.epoch: the burn starts at {self.format_epoch(start_s)}, outside "
+                    f"the span [{self.format_epoch(0.0)}, {self.format_epoch(self.stop_s)})"
+                )
+            # The momentum it adds, and the kinetic energy (~ H²/2I), must be floats.
+            impulse = math.hypot(*burn.torque) * min(burn.duration, self.stop_s - start_s)
+            if not math.isfinite(impulse * impulse):
+                raise InputError(
+                    f"{where}.torque: {burn.torque.tolist()} N m over the span is an angular "
+                    f"impulse of {impulse:.3g} N m s, beyond what floats hold (its square)"
+                )
+            self.burns.append(PlacedBurn(start_s, start_s + burn.duration, burn, index))
+        if torques.step is not None and torques.step > self.stop_s:
+            raise InputError(
+                f"torques.step: {torques.step:g} s is longer than the span ({self.stop_s:g} s)"
+            )
+        if torques.step is not None and self.stop_s / torques.step > MAX_STEPS:
+            raise InputError(
+                f"torques.step: {torques.step:g} s is {self.stop_s / torques.step:.3g} steps "
+                f"over the span of {self.stop_s:g} s, more than {MAX_STEPS:g}: give a larger "
+                "step, an accuracy, or a shorter span"
+            )
+
+    def with_torques(self, torques: ScenarioTorques | None) -> Scenario:
+        """The same scenario propagated under ``torques`` (e.g. to measure what a
+        torque-free run neglects)."""
+        other = copy.copy(self)
+        other._place_torques(torques)
+        return other
+
+    def _offset_in_span(self, epoch: Any, name: str) -> float:
+        """An epoch's TT seconds after the scenario epoch, snapped to 0 or to stop when
+        within a nanosecond of either (the rounding of a UTC → TT conversion)."""
+        offset = self._event_offset(epoch, name)
+        if abs(offset) <= SAME_INSTANT_S:
+            return 0.0
+        if abs(offset - self.stop_s) <= SAME_INSTANT_S:
+            return self.stop_s
+        return offset
+
+    def _event_offset(self, epoch: Any, name: str) -> float:
+        """TT seconds after the epoch of an event's epoch (Time, ISO text or seconds)."""
+        from astropy.time import Time
+
+        if isinstance(epoch, Time | str):
+            return float(tt_seconds(as_time(epoch, self.epoch.scale, name), self.epoch))
+        if isinstance(epoch, bool):
+            raise InputError(f"{name} must be a Time or seconds after the epoch, got {epoch!r}")
+        return as_si_scalar(epoch, "time", name)
+
+    @property
+    def time_scale(self) -> str:
+        """The astropy scale of the epoch, used for every epoch written out."""
+        return self.epoch.scale
+
+    def times(self, seconds: Any) -> Time:
+        """``Time`` (in the scenario's scale) of TT ``seconds`` after the epoch."""
+        t = time_from_tt_seconds(self.epoch, seconds)
+        with offline_time():
+            t = getattr(t, self.time_scale)
+        t.precision = 9  # ISO texts to the nanosecond, like the epochs read in
+        return t
+
+    def format_epoch(self, seconds: float) -> str:
+        """ISO 8601 text of the epoch ``seconds`` after the scenario epoch, with its scale."""
+        return f"{self.iso(seconds)} {self.time_scale.upper()}"
+
+    def iso(self, seconds: Any) -> Any:
+        """ISO 8601 texts (in the scenario's scale) of TT ``seconds`` after the epoch."""
+        return iso_texts(self.times(seconds))
+
+    def output_count(self) -> int:
+        """The number of output epochs (start, start + step, ..., and stop), without
+        building the grid: a span of 1e9 s every 1e-3 s is 1e12 epochs."""
+        steps = (self.stop_s - self.start_s) / self.step_s * (1 + 1e-12)
+        count = int(steps) + 1  # steps is finite and ≥ 0: step is checked above
+        last = self.start_s + self.step_s * (count - 1)
+        return count + (1 if self.stop_s - last > 1e-9 * self.step_s else 0)
+
+    def output_seconds(self) -> NDArray[np.float64]:
+        """The output grid: start, start + step, ..., and stop (TT s since the epoch)."""
+        count = int(np.floor((self.stop_s - self.start_s) / self.step_s * (1 + 1e-12))) + 1
+        grid = self.start_s + self.step_s * np.arange(count, dtype=np.float64)
+        if self.stop_s - grid[-1] > 1e-9 * self.step_s:
+            grid = np.append(grid, self.stop_s)
+        return grid
+
+    def __repr__(self) -> str:
+        return (
+            f"Scenario({self.name!r}, {self.spacecraft.name!r}, epoch {self.format_epoch(0.0)}, "
+            f"{len(self.events)} events, {self.stop_s:g} s)"
+        )

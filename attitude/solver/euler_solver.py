@@ -1,0 +1,651 @@
+"""The exact motion of a torque-free rigid body from one state: ``EulerSolver``.
+
+One state, evaluated at any number of times: the closed form of attitude.solver.closed_form
+(Celledoni, Fassò, Säfström and Zanna [CFSZ08] with Leroy's corrections [Leroy]; the
+project's derivation is docs/derivation.md) with float constants, built once, and
+numpy arrays of times.  No numerical integration: evaluation at any time costs the
+same and does not drift.  (Many states at one time each: attitude.solver.free_flow.)
+
+The attitude is Q(t) = R ∘ Y(ψ(t) − ψ(t0)) ∘ P(t) ∘ S ([Leroy] "An alternative
+quaternionic solution"): S maps the user's body axes onto the frame of the state's
+formula (the principal axes of a tensor, sorted, flipped and relabelled: see
+attitude.solver.closed_form), P(t) maps m(t) onto G e3, Y(ψ) turns about e3 and R, constant,
+makes Q(t0) the given attitude.  The glossary of [Leroy]'s symbols is in
+attitude.solver.closed_form.
+
+Cases (the exact sign of Δ2 of the float inputs, attitude.solver.invariants):
+  (i)   Δ2 < 0: m circulates about the axis of least inertia, m1 = B13 dn > 0
+  (ii)  Δ2 > 0: m circulates about the axis of greatest inertia, m3 = B31 dn > 0
+  (iii) Δ2 = 0: the separatrix, m1 = B13 sech, m3 = B31 sech, m2 = G th
+  steady and rest are the special cases whose formulas would be 0/0 or ∞·0: the
+  sphere (I1 = I3), a rate λ that underflows (m within ~1e-160 G of an axis of a
+  symmetric body), and G = 0.  Every other degenerate body (I1 = I2, I2 = I3, spin
+  about any axis, the intermediate one included) goes through the general formulas,
+  and so does every state next to the separatrix, however small its mc.
+
+References
+----------
+[CFSZ08] E. Celledoni, F. Fassò, N. Säfström, A. Zanna, "The exact computation of the
+    free rigid body motion and its use in splitting methods", SIAM J. Sci. Comput. 30(4)
+    (2008) 2084–2112, doi:10.1137/070704393.
+[Leroy] P. Leroy, "On an Article by Celledoni et al." (2020), in Principia's
+    documentation:
+    https://github.com/mockingbirdnest/Principia/blob/master/documentation/Celledoni.pdf
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.spatial.transform import Rotation
+
+from attitude.base.errors import InputError
+from attitude.base.float_math import FLOAT
+from attitude.base.quantities import as_si_array, as_si_scalar, as_vector3
+from attitude.base.quaternions import left_matrix, right_matrix
+from attitude.elliptic.phase_table import PiecewiseChebyshev
+from attitude.solver.closed_form import (
+    CaseFormula,
+    Elliptic,
+    OneState,
+    Separatrix,
+    p_quaternion,
+    y_times_p,
+)
+from attitude.solver.inertia import PrincipalAxes, principal_axes
+
+__all__ = ["EulerSolver"]
+
+# Evaluations over many times run in slices of this many samples (see _evaluate): a
+# slice's temporaries (at most ~130 B a sample) stay in the processor's cache, and
+# bound what a call holds besides its output to ~1 MB.
+_CHUNK = 8192
+# From this many times in one call, the attitude takes the periodic part of ψ from a
+# table built once (``_angle_table``: 1000 to 6000 formula evaluations, which cost
+# about as much as this many samples of the formula) instead of one R_J a sample.
+_TABLE_MIN_SAMPLES = 16384
+_UNBUILT = object()
+try:  # numpy's array-API namespace as scipy's Rotation keeps it (see _one_rotation)
+    from scipy._lib._array_api import array_namespace as _array_namespace
+
+    _NUMPY_NAMESPACE: Any = _array_namespace(np.empty(0))
+except ImportError:  # pragma: no cover
+    _NUMPY_NAMESPACE = None
+
+
+def _as_rotation(attitude: Any) -> Rotation:
+    if attitude is None:
+        return Rotation.identity()
+    if not isinstance(attitude, Rotation):
+        raise InputError(
+            "attitude must be a scipy.spatial.transform.Rotation (body -> inertial), "
+            f"got {type(attitude).__name__}: {attitude!r}"
+        )
+    if not attitude.single:
+        raise InputError(f"attitude must be a single rotation, got a stack of {len(attitude)}")
+    q = attitude.as_quat(scalar_first=True)
+    if not np.all(np.isfinite(q)):
+        raise InputError(f"attitude must be finite, got quaternion {q.tolist()}")
+    return attitude
+
+
+def _one_rotation(q_scalar_last: NDArray[np.float64]) -> Rotation:
+    """One ``Rotation`` from a unit quaternion, scalar last.
+
+    scipy's public constructors cost ~8 µs for a single quaternion (array-API
+    dispatch and checks), five times the rest of a scalar ``attitude(t)``; its internal
+    constructor, which skips them, ~2 µs.  That one is private, so it is used only
+    where it exists with the signature we know, and
+    tests/test_fast_paths_against_the_general_ones.py checks that it gives the public
+    constructor's rotation.
+    """
+    try:
+        # Private, so scipy-stubs does not declare it.
+        return Rotation._from_raw_quat(q_scalar_last, xp=_NUMPY_NAMESPACE)  # type: ignore[attr-defined]
+    except (AttributeError, TypeError):  # pragma: no cover  (another scipy)
+        return Rotation(q_scalar_last, normalize=False, copy=False)
+
+
+class EulerSolver:
+    """Exact torque-free motion of a rigid body from its state at ``t0``.
+
+    Parameters
+    ----------
+    inertia
+        The three principal moments of inertia along the body x, y, z axes, in any
+        order, or the symmetric 3×3 inertia tensor in body axes, kg m² (or a
+        ``Quantity``).  A tensor is diagonalized and every result is still given in
+        the body axes.
+    angular_momentum
+        Body-frame angular momentum at ``t0``, N m s (kg m²/s).
+    attitude
+        ``scipy.spatial.transform.Rotation`` taking body coordinates to inertial
+        coordinates at ``t0``; identity when None.
+    t0
+        Epoch of the initial state, seconds (the solver's own time origin).
+
+    Notes
+    -----
+    The attitude at t is ``Q(t) = R ∘ Y(ψ(t) − ψ(t0)) ∘ P(t) ∘ S`` (module docstring),
+    built so that ``Q(t0)`` is the given attitude and nothing is singular anywhere
+    on the sphere of momenta.  All evaluations accept a scalar or an array of times
+    (seconds, before or after ``t0``) and are vectorized.
+    """
+
+    def __init__(
+        self,
+        inertia: ArrayLike,
+        angular_momentum: ArrayLike,
+        attitude: Rotation | None = None,
+        t0: float = 0.0,
+    ) -> None:
+        axes = principal_axes(inertia)
+        m_body = as_vector3(angular_momentum, "angular_momentum", "angular_momentum")
+        self._initial_attitude = _as_rotation(attitude)
+        self._t0 = as_si_scalar(t0, "time", "t0")
+        self._axes = axes
+        self._initial_angular_momentum = m_body
+        self._state = self._select_formula(axes, m_body)
+        self._formula: CaseFormula = self._state.formula
+        self._G = self._state.G
+        self._S_matrix = self._body_to_formula_frame(axes)
+        # The moments along the axes of the formula's frame (for ω = m/I there).
+        self._I_frame = np.array([float(axes.moments[k]) for k in self._state.index])
+        self._I_frame_floats = tuple(self._I_frame.tolist())
+        # Column k of S: its non-zero entries (i, S_ik), all three for a tensor.
+        S = self._S_matrix.tolist()
+        self._S_columns = tuple(
+            tuple((i, S[i][k]) for i in range(3) if S[i][k] != 0.0)
+            if axes.is_diagonal
+            else tuple((i, S[i][k]) for i in range(3))
+            for k in range(3)
+        )
+        self._M, self._ψ_t0 = self._constant_rotation()
+        self._M_rows = tuple(tuple(row) for row in self._M.tolist())  # for one time
+        self._table = _UNBUILT  # the periodic part of ψ tabulated: see _angle_table
+        I1, I2, I3 = self._state.I
+        m1, m2, m3 = self._state.preferred
+        G = self._G
+        x1, x2, x3 = (m1 / G, m2 / G, m3 / G) if G > 0.0 else (0.0, 0.0, 0.0)
+        # 2T = G² Σ xj²/Ij; Python floats: an energy beyond the float range is inf.
+        self._kinetic_energy = 0.5 * G * (G * (x1 * x1 / I1 + x2 * x2 / I2 + x3 * x3 / I3))
+        self._inertial_angular_momentum = self._initial_attitude.apply(m_body)
+
+    @staticmethod
+    def _select_formula(axes: PrincipalAxes, m_body: NDArray[np.float64]) -> OneState:
+        """The case, its formula and the preferred flips (attitude.solver.closed_form.OneState).
+
+        Refuses a state whose angular velocity |m|/I1 is beyond the float range.
+        """
+        m_principal = m_body if axes.is_diagonal else axes.body_to_principal.apply(m_body)
+        I1, I2, I3 = axes.moments
+        moments = (float(I1), float(I2), float(I3))
+        momentum = tuple(float(v) for v in m_principal)
+        G = math.hypot(*momentum)  # math.hypot scales: no overflow of the squares
+        if not math.isfinite(G / min(moments)):
+            raise InputError(
+                f"angular_momentum {m_body.tolist()} with moments {axes.moments.tolist()}: the "
+                f"angular velocity |m|/I1 = {G / min(moments):g} rad/s is beyond the float range"
+            )
+        return OneState(moments, momentum)
+
+    def _body_to_formula_frame(self, axes: PrincipalAxes) -> NDArray[np.float64]:
+        """S as a matrix: the signed permutation of the principal axes onto the
+        formula's frame, after the body → principal rotation of a tensor.  Row vectors
+        go back to the body as v_frame @ S (exact for a signed permutation)."""
+        S_matrix = np.zeros((3, 3))
+        S_matrix[np.arange(3), self._state.index] = self._state.sign
+        if not axes.is_diagonal:
+            S_matrix = S_matrix @ axes.body_to_principal.as_matrix()
+        return np.ascontiguousarray(S_matrix)
+
+    def _constant_rotation(self) -> tuple[NDArray[np.float64], float]:
+        """R = Q0 ∘ S⁻¹ ∘ P(t0)⁻¹, folded with S into one 4×4 matrix M, and ψ(t0).
+
+        q(t) = R ⊗ (Y ⊗ P)(t) ⊗ S = L(R) Rr(S) (Y ⊗ P)(t) = M (Y ⊗ P)(t), scalar first.
+        """
+        S = Rotation.from_matrix(self._S_matrix).as_quat(scalar_first=True)
+        Q0 = self._initial_attitude.as_quat(scalar_first=True)
+        a, b, c, ψ_t0 = self._formula.momentum_and_angle(0.0, FLOAT)  # float constants
+        if self._formula.name == "rest":
+            P0 = np.array([1.0, 0.0, 0.0, 0.0])
+        else:
+            P0 = np.array([*p_quaternion(a, b, c, self._G, FLOAT), 0.0])
+        conjugate = np.array([1.0, -1.0, -1.0, -1.0])
+        R = left_matrix(Q0) @ left_matrix(S * conjugate) @ (P0 * conjugate)
+        return left_matrix(R) @ right_matrix(S), float(ψ_t0)
+
+    @classmethod
+    def from_angular_velocity(
+        cls,
+        inertia: ArrayLike,
+        angular_velocity: ArrayLike,
+        attitude: Rotation | None = None,
+        t0: float = 0.0,
+    ) -> EulerSolver:
+        """Build the solver from the body angular velocity at ``t0`` (rad/s)."""
+        tensor = principal_axes(inertia).tensor
+        ω = as_vector3(angular_velocity, "angular_velocity", "angular_velocity")
+        return cls(inertia, tensor @ ω, attitude, t0)
+
+    # ----------------------------------------------------------------- evaluation
+
+    def _times(self, t: Any) -> NDArray[np.float64]:
+        """``t`` as float seconds (no copy of a float64 array); τ = t − t0 is formed a
+        slice at a time by ``_evaluate``."""
+        return as_si_array(t, "time", "t")
+
+    def _evaluate(self, chunk, t: Any, width: int, times: NDArray[np.float64] | None = None):
+        """``chunk(τ, out)`` over τ = t − t0 in slices of ``_CHUNK``, into one array.
+
+        A slice's temporaries stay in the processor's cache (over a million samples
+        this is several times faster than whole-array passes), and each writes its own
+        rows of the output: besides the result, memory holds only a slice's
+        temporaries.  Far enough from t0 (|t − t0| beyond ~1.8e308 divided by the
+        motion's fastest angular rate) an angle λ(t − t0) or ψ(t) leaves the float
+        range and the result would be NaN: that time gets an InputError that names it
+        instead.
+        """
+        if times is None:
+            times = self._times(t)
+        flat = times.ravel()
+        out = np.empty((flat.size, width))
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            for start in range(0, flat.size, _CHUNK):
+                block = out[start : start + _CHUNK]
+                chunk(flat[start : start + _CHUNK] - self._t0, block)
+                if not np.isfinite(block).all():
+                    bad = start + int(np.flatnonzero(~np.isfinite(block).all(axis=1))[0])
+                    raise self._too_far(t, bad)
+        return out.reshape((*times.shape, width))
+
+    def _too_far(self, t: Any, index: int) -> InputError:
+        t_bad = np.ravel(as_si_array(t, "time", "t"))[index] if np.ndim(t) else t
+        rate = max(abs(getattr(self._formula, "λ", 0.0)), self._G / self._state.I[0])
+        return InputError(
+            f"t = {float(t_bad)!r} s is too far from t0 = {self._t0!r} s for this motion: "
+            f"its angles, at rates up to {rate:.3g} rad/s, times t - t0 exceed the float "
+            "range (1.8e308)"
+        )
+
+    def _to_body(self, v_frame: NDArray[np.float64]) -> NDArray[np.float64]:
+        """Row vectors of the formula's frame in body axes, v_frame @ S."""
+        return np.dot(v_frame, self._S_matrix)
+
+    def _write_body(self, components: tuple, out: NDArray[np.float64], divisors=None) -> None:
+        """``out[:, k]``: the body components of a vector given by its ``components`` in
+        the formula's frame (each divided by ``divisors``, if given), that is v_frame @ S
+        written column by column: a signed permutation for principal body axes (exact),
+        three fused sums for a tensor.  No BLAS call: numpy's (n, 3) @ (3, 3) starts
+        OpenBLAS threads above some n, and its cost per row jumps by a large factor."""
+        if divisors is not None:
+            components = tuple(c / d for c, d in zip(components, divisors, strict=True))
+        for k, column in enumerate(self._S_columns):
+            if len(column) == 1:  # v_body[k] = ±v_frame[i]
+                i, S_ik = column[0]
+                np.multiply(components[i], S_ik, out=out[:, k])
+            else:
+                out[:, k] = components[0] * column[0][1] + components[1] * column[1][1]
+                out[:, k] += components[2] * column[2][1]
+
+    def _momentum_chunk(self, τ: NDArray[np.float64], out: NDArray[np.float64]) -> None:
+        self._write_body(self._formula.momentum(τ, np), out)
+
+    def _velocity_chunk(self, τ: NDArray[np.float64], out: NDArray[np.float64]) -> None:
+        self._write_body(self._formula.momentum(τ, np), out, self._I_frame)
+
+    def _quaternion_chunk(
+        self, τ: NDArray[np.float64], out: NDArray[np.float64], table, columns: tuple
+    ) -> None:
+        """Unit attitude quaternions at τ = t − t0, body → inertial, component i of
+        (w, x, y, z) into ``out[:, columns[i]]``.
+
+        q = M (Y(ψ − ψ(t0)) ⊗ P)  (``_constant_rotation``), the 4×4 product written as
+        four fused sums (no BLAS: see ``_write_body``).  With a ``table`` of the periodic
+        part of ψ (``_angle_table``), ψ(τ) − ψ(t0) = Ω τ + per(r(τ)) − per(r(0)):
+        no R_J per sample.
+        """
+        f = self._formula
+        # Each intermediate is dropped as soon as it is used, and the product is
+        # summed into ``out`` itself: a slice holds as few arrays as the formulas allow
+        # (the same operations in the same order as without the in-place forms: the
+        # same bits).
+        if table is None:
+            a, b, c, ψ = f.momentum_and_angle(τ, np)
+            ψ -= self._ψ_t0
+            ψ *= 0.5
+            half_ψ = ψ
+        else:
+            assert isinstance(f, Elliptic)  # only Elliptic formulas get a table
+            j, r, sn_r, cn_r, dn_r = f.phase(τ, np)
+            a, b, c = f.momentum_of_phase(j, sn_r, cn_r, dn_r, np)
+            del j, sn_r, cn_r, dn_r
+            periodic = table(r)
+            del r
+            periodic -= self._per_t0
+            half_ψ = self._Ω * τ
+            half_ψ += periodic
+            half_ψ *= 0.5
+            del periodic
+        p = p_quaternion(a, b, c, self._G, np)
+        del a, b, c
+        yp = y_times_p(half_ψ, *p, np)
+        del p, half_ψ
+        M = self._M
+        term = np.empty_like(yp[0])
+        for i in range(4):
+            q_i = out[:, columns[i]]
+            np.multiply(yp[0], M[i, 0], out=q_i)
+            for k in (1, 2, 3):
+                q_i += np.multiply(yp[k], M[i, k], out=term)
+        del yp
+        q = [out[:, columns[i]] for i in range(4)]
+        norm = np.multiply(q[0], q[0])
+        for i in (1, 2, 3):
+            norm += np.multiply(q[i], q[i], out=term)
+        np.sqrt(norm, out=norm)
+        for q_i in q:
+            q_i /= norm
+
+    def _quaternion_at(self, τ: float, t: Any) -> tuple[float, float, float, float]:
+        """The unit attitude quaternion (w, x, y, z) at one time, on Python floats: the
+        formulas of ``_quaternion_chunk`` (without a table) at ~1/100 of numpy's cost."""
+        f = self._formula
+        if f.name == "rest":
+            return tuple(self._initial_attitude.as_quat(scalar_first=True).tolist())
+        try:
+            a, b, c, ψ = f.momentum_and_angle(τ, FLOAT)
+            yp = y_times_p(0.5 * (ψ - self._ψ_t0), *p_quaternion(a, b, c, self._G, FLOAT), FLOAT)
+        except (ValueError, OverflowError):  # math on an angle beyond the float range
+            raise self._too_far(t, 0) from None
+        q = [yp[0] * M0 + yp[1] * M1 + yp[2] * M2 + yp[3] * M3 for M0, M1, M2, M3 in self._M_rows]
+        norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+        if not math.isfinite(norm):
+            raise self._too_far(t, 0)
+        return q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm
+
+    def _angle_table(self):
+        """The periodic part of ψ tabulated (attitude.elliptic.phase_table), built at the first
+        call with at least ``_TABLE_MIN_SAMPLES`` times; None where the formula has no
+        R_J to save (separatrix, symmetric bodies, the near-one kernels: their ψ costs
+        a few elementary functions) or the table would not reach its rounding."""
+        if self._table is _UNBUILT:
+            self._table = None
+            f = self._formula
+            if isinstance(f, Elliptic) and not f.parameter.near_one and f.n != 0.0:
+                table = PiecewiseChebyshev.fit(f.periodic_angle, -float(f.K), float(f.K))
+                if table is not None:
+                    _, r0, *_ = f.phase(np.zeros(1), np)
+                    self._per_t0 = float(table(r0)[0])
+                    self._Ω = f.angle_rates()[1]
+                    self._table = table
+        return self._table
+
+    def _body_vector_at(self, τ: float, t: Any, divisors=None) -> NDArray[np.float64]:
+        """``_write_body`` of the momentum (or, with ``divisors``, the angular velocity)
+        at one time, on Python floats: the same operations, at ~1/30 of numpy's cost."""
+        try:
+            v = self._formula.momentum(τ, FLOAT)
+        except (ValueError, OverflowError):  # math on an angle beyond the float range
+            raise self._too_far(t, 0) from None
+        if divisors is not None:
+            v = tuple(c / d for c, d in zip(v, divisors, strict=True))
+        out = np.empty(3)
+        for k, column in enumerate(self._S_columns):
+            if len(column) == 1:
+                i, S_ik = column[0]
+                out[k] = v[i] * S_ik
+            else:
+                out[k] = (v[0] * column[0][1] + v[1] * column[1][1]) + v[2] * column[2][1]
+        if not np.isfinite(out).all():
+            raise self._too_far(t, 0)
+        return out
+
+    def angular_momentum(self, t: ArrayLike) -> NDArray[np.float64]:
+        """Body-frame angular momentum at ``t`` (N m s), shape ``np.shape(t) + (3,)``."""
+        if isinstance(t, float) and math.isfinite(t):
+            return self._body_vector_at(t - self._t0, t)
+        return self._evaluate(self._momentum_chunk, t, 3)
+
+    def angular_velocity(self, t: ArrayLike) -> NDArray[np.float64]:
+        """Body-frame angular velocity at ``t`` (rad/s), shape ``np.shape(t) + (3,)``."""
+        if isinstance(t, float) and math.isfinite(t):
+            return self._body_vector_at(t - self._t0, t, self._I_frame_floats)
+        return self._evaluate(self._velocity_chunk, t, 3)
+
+    def attitude(self, t: ArrayLike) -> Rotation:
+        """Rotation taking body coordinates to inertial coordinates at ``t``.
+
+        One ``Rotation`` for a scalar ``t``, a stack for a 1-D array.
+        """
+        if isinstance(t, float) and math.isfinite(t):  # one time: no numpy on the way
+            w, x, y, z = self._quaternion_at(t - self._t0, t)
+            return _one_rotation(np.array([x, y, z, w]))
+        times = self._times(t)
+        if times.ndim > 1:
+            raise InputError(
+                f"t must be a scalar or a 1-D array for attitude(), got shape {times.shape}"
+            )
+        if times.ndim == 0:
+            w, x, y, z = self._quaternion_at(float(times) - self._t0, t)
+            return _one_rotation(np.array([x, y, z, w]))
+        # Unit quaternions, scalar last: scipy takes them as they are, without a copy.
+        return Rotation(self._quaternions(t, times, (3, 0, 1, 2)), normalize=False, copy=False)
+
+    def attitude_quaternion(self, t: ArrayLike, scalar_first: bool = True) -> NDArray[np.float64]:
+        """The attitude at ``t`` as unit quaternions, body → inertial, shape ``np.shape(t) + (4,)``.
+
+        Scalar first (w, x, y, z) by default.  The same rotation as ``attitude(t)``,
+        without building a ``Rotation``: for writing files and for callers that
+        assemble many segments.
+        """
+        columns = (0, 1, 2, 3) if scalar_first else (3, 0, 1, 2)
+        times = np.float64(t) if isinstance(t, float) and math.isfinite(t) else self._times(t)
+        if times.ndim == 0:
+            q = self._quaternion_at(float(times) - self._t0, t)
+            return np.array(q if scalar_first else (q[1], q[2], q[3], q[0]))
+        return self._quaternions(t, times, columns)
+
+    def _quaternions(self, t: Any, times: NDArray[np.float64], columns: tuple) -> NDArray:
+        if self._formula.name == "rest":
+            q = np.empty((*times.shape, 4))
+            q[..., list(columns)] = self._initial_attitude.as_quat(scalar_first=True)
+            return q
+        table = self._angle_table() if times.size >= _TABLE_MIN_SAMPLES else None
+
+        def chunk(τ, out):
+            self._quaternion_chunk(τ, out, table, columns)
+
+        return self._evaluate(chunk, t, 4, times)
+
+    def spin_axis_cone(self) -> tuple[NDArray[np.float64], float, float] | None:
+        """The body axis about which m circulates, and the cone it describes about m.
+
+        In case (i) m circulates about the axis of least inertia (m1 = B13 dn u), in
+        case (ii) about the axis of greatest inertia (m3 = B31 dn u).  Returns that
+        axis as a unit vector in body coordinates, and the least and greatest angle
+        (rad) between it and the angular momentum: arccos(B/G) at dn = 1 and
+        arccos(B √mc/G) at dn = √mc, reached alternately every period/2 (the
+        nutation).  None on the separatrix, for a sphere and at rest.
+        """
+        f = self._formula
+        if not isinstance(f, Elliptic):
+            return None
+        B = f.A_d  # B13 (case i) or B31 (case ii), along e3 of the formula's frame
+        axis = self._to_body(np.array([0.0, 0.0, 1.0]))
+        G = self._G
+        return axis, math.acos(min(1.0, B / G)), math.acos(min(1.0, B * f.parameter.kc / G))
+
+    def _flip_phases(self, t_start: Any, t_end: Any) -> tuple[float, float] | None:
+        """The phases u at t_start and t_end (ascending), or None if the body never flips.
+
+        A flip is a sign change of the momentum component along the intermediate
+        principal axis while the body turns over: m2 ∝ sn(u) vanishes at u = 2jK in
+        cases (i) and (ii), every period/2; on the separatrix there is one, at u = 0.
+        The body turns over only if the intermediate axis swings from near +m to
+        near −m: we count flips when the amplitude of m2 exceeds G/√2 (that axis
+        comes within 45° of the angular momentum).  Below, m2 changes sign too, but
+        as part of a nutation about the spin axis, not as a flip.  None also for a
+        body without a distinct intermediate axis (I1 = I2 or I2 = I3).
+        """
+        t_start = as_si_scalar(t_start, "time", "t_start")
+        t_end = as_si_scalar(t_end, "time", "t_end")
+        f = self._formula
+        I1, I2, I3 = self._state.I
+        if not (I1 < I2 < I3) or not isinstance(f, Elliptic | Separatrix) or f.λ == 0.0:
+            return None
+        if not math.isfinite(f.ν):  # a steady spin about the intermediate axis
+            return None
+        # The amplitude of m2 is |A_s| = B21 (case i) or B23 (case ii).
+        if isinstance(f, Elliptic) and abs(f.A_s) <= self._G * math.sqrt(0.5):
+            return None
+        phases = []
+        for name, t in (("t_start", t_start), ("t_end", t_end)):
+            u = f.λ * (t - self._t0) - f.ν
+            if not math.isfinite(u):
+                raise InputError(
+                    f"{name} = {t!r} s is too far from t0 = {self._t0!r} s: the phase of the "
+                    f"motion, {f.λ:.3g} rad/s times {name} - t0, exceeds the float range"
+                )
+            phases.append(u)
+        u_a, u_b = sorted(phases)
+        return u_a, u_b
+
+    def flip_count(self, t_start: float, t_end: float) -> int:
+        """The number of flips in [t_start, t_end], in closed form (no array is built).
+
+        The count of j with 2jK in [u(t_start), u(t_end)] (``flip_times`` says what a
+        flip is): floor(u_b/2K) − ceil(u_a/2K) + 1, exact for the float phases u;
+        0 or 1 on the separatrix.  A flip within rounding of t_start or t_end (a few
+        ulps of λ(t − t0)) may be counted on either side.
+        """
+        phases = self._flip_phases(t_start, t_end)
+        if phases is None:
+            return 0
+        u_a, u_b = phases
+        f = self._formula
+        if not isinstance(f, Elliptic):  # the separatrix (phases are None otherwise)
+            return int(u_a <= 0.0 <= u_b)
+        return max(0, math.floor(u_b / (2.0 * f.K)) - math.ceil(u_a / (2.0 * f.K)) + 1)
+
+    def flip_times(
+        self, t_start: float, t_end: float, limit: int = 10_000_000
+    ) -> NDArray[np.float64]:
+        """Times in [t_start, t_end] at which the body flips (the Джанибеков effect).
+
+        The exact times t = t0 + (2jK + ν)/λ, every period/2, at which the momentum
+        component along the intermediate axis changes sign while the body turns over
+        (see ``_flip_phases``); on the separatrix there is one, at u = 0.  Empty if
+        the body never turns over.
+
+        A span with more than ``limit`` flips (80 MB of float64 at the default) is
+        refused with an InputError naming the count: ``flip_count`` gives the count
+        alone, at no cost, for any span.
+        """
+        count = self.flip_count(t_start, t_end)
+        if count > limit:
+            count_text = str(count) if count < 10**12 else f"{float(count):.4g}"
+            raise InputError(
+                f"flip_times({t_start!r}, {t_end!r}): the body flips {count_text} times in "
+                f"this span ({count * 8 / 2**30:.3g} GiB of float64), beyond limit={limit}; "
+                "ask for a shorter span, or flip_count() for the number alone"
+            )
+        phases = self._flip_phases(t_start, t_end)
+        if count == 0 or phases is None:
+            return np.empty(0)
+        u_a, _ = phases
+        f = self._formula
+        if isinstance(f, Separatrix):
+            zeros_u = np.array([0.0])
+        elif isinstance(f, Elliptic):
+            zeros_u = 2.0 * f.K * (float(math.ceil(u_a / (2.0 * f.K))) + np.arange(count))
+        else:  # pragma: no cover (phases are None for the other cases)
+            return np.empty(0)
+        return np.sort(self._t0 + (zeros_u + f.ν) / f.λ)
+
+    # ----------------------------------------------------------------- properties
+
+    @property
+    def period(self) -> float:
+        """Period of the body-frame motion m(t), seconds: 4K/|λ|.
+
+        ``math.inf`` on the separatrix, for a sphere and at rest.  For a steady spin
+        about axis 1 or 3 (m constant) it is the period of the nearby motions.
+        """
+        return float(self._formula.period)
+
+    @property
+    def formula(self) -> str:
+        """Which closed form applies: 'i', 'ii', 'iii' (separatrix), 'steady' (the sphere,
+        or m fixed to within float range) or 'rest'."""
+        return self._formula.name
+
+    @property
+    def mc(self) -> float:
+        """Complementary parameter 1 − m of the Jacobi functions (0 on the separatrix)."""
+        return float(self._formula.mc)
+
+    @property
+    def t0(self) -> float:
+        """Epoch of the initial state, seconds."""
+        return self._t0
+
+    @property
+    def moments_of_inertia(self) -> NDArray[np.float64]:
+        """Principal moments, kg m²: as given, or ascending for a tensor."""
+        return self._axes.moments.copy()
+
+    @property
+    def inertia_tensor(self) -> NDArray[np.float64]:
+        """The inertia tensor in body axes, kg m²."""
+        return self._axes.tensor.copy()
+
+    @property
+    def initial_angular_momentum(self) -> NDArray[np.float64]:
+        """Body-frame angular momentum at ``t0``, N m s."""
+        return self._initial_angular_momentum.copy()
+
+    @property
+    def initial_attitude(self) -> Rotation:
+        """Attitude (body → inertial) at ``t0``."""
+        return self._initial_attitude
+
+    @property
+    def angular_momentum_norm(self) -> float:
+        """G = |m|, N m s (conserved)."""
+        return self._G
+
+    @property
+    def kinetic_energy(self) -> float:
+        """T = ½ Σ mj²/Ij, J (conserved).
+
+        Raises an InputError, naming its size, for a state whose energy is beyond the
+        float range (|m| above ~1e154 N m s on unit moments), whose motion is computed.
+        """
+        if not math.isfinite(self._kinetic_energy):
+            I1, I2, I3 = self._state.I
+            m1, m2, m3 = self._state.preferred
+            G = self._G
+            x2_over_I = (m1 / G) ** 2 / I1 + (m2 / G) ** 2 / I2 + (m3 / G) ** 2 / I3
+            log10_T = 2.0 * math.log10(G) + math.log10(0.5 * x2_over_I)
+            raise InputError(
+                f"the kinetic energy of angular_momentum {self._initial_angular_momentum.tolist()}"
+                f" with moments {self._axes.moments.tolist()}, about 1e{log10_T:.0f} J, is "
+                "beyond the float range"
+            )
+        return self._kinetic_energy
+
+    @property
+    def inertial_angular_momentum(self) -> NDArray[np.float64]:
+        """The angular momentum in inertial axes, N m s (conserved)."""
+        return self._inertial_angular_momentum.copy()
+
+    def __repr__(self) -> str:
+        return (
+            f"EulerSolver(inertia={self._axes.moments.tolist()}, "
+            f"angular_momentum={self._initial_angular_momentum.tolist()}, t0={self._t0}, "
+            f"formula={self.formula!r}, period={self.period:.6g} s)"
+        )

@@ -1,0 +1,12 @@
+"""Torques and splitting: torque models, the splitting compositions and ``TorquedSolver``,
+the torques applied between exact free flows.
+
+Modules:
+
+- ``models``: External torques on a rigid spacecraft: gravity gradient, constant
+  torques, user torques.
+- ``solver``: Attitude under external torques: splitting with the exact free flow
+  (``TorquedSolver``).
+- ``splitting``: Splitting compositions: the coefficients that join the free flow and
+  the torque kick.
+"""
