@@ -7,11 +7,14 @@ the span, the Sun and Moon ephemeris with the interpolation's margins, the size 
 the exact search), chooses the AEM's records for its tolerance, counts the output
 samples and estimates the outputs' sizes and the (constant) memory of the streamed
 run.  It notes an output step that undersamples the motion (more than a tenth of its
-shortest period).  Segments under torques are propagated (their whole grid, and the
-error estimate of their step); a scenario with an orbit that leaves the gravity
-gradient out (torque-free, or burns alone) gets its validity horizon
-(``attitude.trajectory.horizon.validity_horizon``).  What it refuses, a run would have refused
-later, after computing; what it returns is what the run uses.  Errors are
+shortest period).  Segments under torques are propagated at the step given or chosen
+for the accuracy, and the run's error is estimated (``attitude.trajectory.steps``);
+a scenario with an orbit that leaves the gravity gradient out (torque-free, or burns
+alone) gets its validity horizon (``attitude.trajectory.horizon.validity_horizon``).
+What it refuses, a run would have refused later, after computing; what it returns is
+what the run uses.  ``attitude check`` plans with ``check=True``: the same path
+within a budget of steps, with what lies beyond it predicted (a run that measures
+more can still refuse an accuracy that its measurement says is missed).  Errors are
 ``attitude.base.errors.InputError`` whose message starts with the scenario key.
 """
 
@@ -53,6 +56,8 @@ class RunPlan:
     horizon: ValidityHorizon | None = None  # on an orbit, no gravity gradient: how long it holds
     # The horizon is wanted but left for the run to compute (plan_run(horizon=False)).
     horizon_deferred: bool = False
+    # Planned for `attitude check` (plan_run(check=True)): predictions where the run computes.
+    check: bool = False
 
 
 def plan_run(
@@ -60,19 +65,27 @@ def plan_run(
     pointing: PointingSpec | None = None,
     outputs: OutputChoice | None = None,
     horizon: bool = True,
+    check: bool = False,
 ) -> RunPlan:
     """Check ``scenario`` (``pointing``, ``outputs``) as a run would, up to the sampling.
 
     ``horizon=False``: the validity horizon, when there is one, is not computed here
     (``horizon_deferred`` says it is wanted): a run computes it beside its outputs
     (``attitude.report.run``), since it checks nothing and takes as long as a day's outputs.
+
+    ``check``: for ``attitude check``, which answers in seconds: under torques, the
+    step search within its budget (``attitude.trajectory.steps``: what it refuses, the
+    run refuses too), the run's error measured as far as the budget goes and predicted
+    beyond, a run longer than the budget propagated at a longer step for the checks
+    that read the motion (``Trajectory.approximate``), and the flips under torques
+    left to the run.
     """
     pointing = pointing or PointingSpec()
     outputs = outputs or OutputChoice()
     samples = scenario.output_count()
     if "parquet" in outputs:
         check_span(scenario.start_s, scenario.stop_s, "--formats parquet")
-    trajectory = propagate(scenario)
+    trajectory = propagate(scenario, check=check)
     # The size and memory checks come before the analysis and the pointing checks,
     # which do not depend on the output grid but can take a while on a long span.
     vectors, on_orbit = len(pointing.body_vectors), pointing.on_orbit
@@ -81,19 +94,20 @@ def plan_run(
         samples, 0, vectors, on_orbit, outputs.formats, aem_records=0, pointing_columns=columns
     )
     check_fits(budget)
-    motion = analyze(trajectory)
+    # The run's estimated error (a given step: measured now; check: within its budget).
+    steps = trajectory.steps if check else trajectory.measured()
+    if steps is not None and steps.measurement is not None:
+        if not math.isfinite(steps.measurement.estimate_rad):
+            raise InputError(
+                f"torques.step: at {steps.step_s:g} s the propagation has no finite error "
+                "estimate (the run at twice the step runs away): give a smaller step or an "
+                "accuracy"
+            )
+    motion = analyze(trajectory, locate=not check)
     notes, search = check_pointing(trajectory, pointing)
     undersampled = undersampling_note(trajectory, motion)
     if undersampled:
         notes.append(undersampled)
-    # The error estimates the summary states (each segment's, and the run's), checked here.
-    errors = [getattr(s.solver, "error_estimate", 0.0) for s in trajectory.segments]
-    errors.append(trajectory.error_estimate)
-    if not all(math.isfinite(error) for error in errors):
-        raise InputError(
-            f"torques: the propagation has no finite error estimate ({errors}): "
-            "give a smaller step or an accuracy"
-        )
     found = None
     # On an orbit, unless the gravity gradient is modelled: a torque-free run, or burns
     # alone, neglects it.
@@ -131,6 +145,7 @@ def plan_run(
         search,
         found,
         horizon_deferred=wanted and not horizon,
+        check=check,
     )
 
 

@@ -41,6 +41,7 @@ from numpy.typing import NDArray
 
 from attitude.base.errors import InputError
 from attitude.base.quantities import as_si_scalar, as_vector3
+from attitude.torques.solver import TOLERANCE_RANGE_RAD
 
 __all__ = [
     "DEFAULT_ACCURACY_RAD",
@@ -54,7 +55,7 @@ __all__ = [
 DEFAULT_ACCURACY_RAD = 1e-6
 DEFAULT_HORIZON_THRESHOLD_RAD = math.radians(1.0)
 # Accuracies the step search can meet: below 1e-12 rad the estimate is rounding.
-_ACCURACY_RANGE_RAD = (1e-12, 0.1)
+_ACCURACY_RANGE_RAD = TOLERANCE_RANGE_RAD
 # More steps than this over the span is refused as a mistake: at 8 free flows a step
 # and tens of µs a flow, 1e7 steps are about an hour of computing.
 MAX_STEPS = 1e7
