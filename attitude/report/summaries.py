@@ -257,8 +257,8 @@ def outputs_summary(plan: RunPlan) -> dict[str, Any]:
             "largest_error_rad": plan.aem.measured_error_rad,
             "largest_error_note": "measured on the records written: every interval read as "
             "declared where the interpolation error peaks (the extremum of the node "
-            "polynomial), against the propagated attitude, plus |omega| x 0.5 ns for the "
-            "1 ns time tags",
+            "polynomial) against the propagated attitude, the largest times 1 + |omega| h/18 "
+            "for the rest of the interval, plus |omega| x 0.5 ns for the 1 ns time tags",
             "segments": [
                 {
                     "segment": item.segment,
