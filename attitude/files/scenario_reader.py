@@ -413,6 +413,7 @@ def _body_vector(item: _Table) -> BodyVector:
         "sun_exclusion_half_angle",
         "moon_exclusion_half_angle",
         "earth_limb_exclusion_angle",
+        "sun_inclusion_half_angle",
     )
     name = item.string("name")
     vector = item.quantity("vector", "dimensionless", (3,))
@@ -421,6 +422,13 @@ def _body_vector(item: _Table) -> BodyVector:
     sun = _angle_deg(item, "sun_exclusion_half_angle", 0.0, 180.0)
     moon = _angle_deg(item, "moon_exclusion_half_angle", 0.0, 180.0)
     limb = _angle_deg(item, "earth_limb_exclusion_angle", -90.0, 180.0)
+    inclusion = _angle_deg(item, "sun_inclusion_half_angle", 0.0, 180.0)
+    if inclusion is not None and sun is not None and inclusion <= sun:
+        item.fail(
+            f"{inclusion!r} deg is within sun_exclusion_half_angle ({sun!r} deg): the Sun "
+            "could never be inside the field of view and outside the exclusion cone",
+            "sun_inclusion_half_angle",
+        )
     kind = item.choice("kind", KINDS, default="other")
 
     def radians(degrees: float | None) -> float | None:
@@ -439,6 +447,8 @@ def _body_vector(item: _Table) -> BodyVector:
         moon_exclusion_half_angle_deg=moon,
         earth_limb_exclusion_angle_rad=radians(limb),
         earth_limb_exclusion_angle_deg=limb,
+        sun_inclusion_half_angle_rad=radians(inclusion),
+        sun_inclusion_half_angle_deg=inclusion,
     )
 
 

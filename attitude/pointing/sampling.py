@@ -33,7 +33,8 @@ class VectorSamples:
 
     ``sun_violated``: the Sun inside the exclusion cone and the spacecraft not in
     umbra; ``moon_violated``: the Moon inside its cone and not hidden by the Earth;
-    ``earth_limb_violated``: the vector less than the exclusion angle above the limb.
+    ``earth_limb_violated``: the vector less than the exclusion angle above the limb;
+    ``sun_in_view``: the Sun inside the inclusion cone and the spacecraft not in umbra.
     None where the constraint (or the orbit) is absent.
     """
 
@@ -48,6 +49,7 @@ class VectorSamples:
     sun_violated: NDArray[np.bool_] | None = None
     moon_violated: NDArray[np.bool_] | None = None
     earth_limb_violated: NDArray[np.bool_] | None = None
+    sun_in_view: NDArray[np.bool_] | None = None
 
 
 @dataclass
@@ -102,6 +104,11 @@ def _vector_samples(vector: BodyVector, icrf: NDArray[np.float64], env: Surround
             item.moon_violated &= hidden <= 0.0
     if vector.earth_limb_exclusion_angle_rad is not None:
         item.earth_limb_violated = item.earth_limb_angle_rad < vector.earth_limb_exclusion_angle_rad
+    if vector.sun_inclusion_half_angle_rad is not None:
+        # In umbra the Sun is hidden: the sensor sees nothing.
+        item.sun_in_view = (item.sun_angle_rad < vector.sun_inclusion_half_angle_rad) & (
+            env.sunlit_fraction > 0.0
+        )
     return item
 
 

@@ -1,9 +1,11 @@
 """What a scenario asks of the pointing: body vectors, their constraints, the orbit.
 
 A :class:`BodyVector` is a direction fixed in body axes (a panel normal, a boresight, a
-star tracker's axis) with its constraints: a Sun and a Moon exclusion cone, and a least
-angle above the Earth's limb.  A :class:`PointingSpec` gathers the vectors, where the
-spacecraft is (an :class:`attitude.environment.orbit.Orbit`, or the Earth's centre when None), the
+star tracker's axis, a Sun sensor's axis) with its constraints: a Sun and a Moon
+exclusion cone, a least angle above the Earth's limb, and a Sun inclusion cone (the
+field of view of a Sun sensor, which must contain the Sun).  A :class:`PointingSpec`
+gathers the vectors, where the spacecraft is (an
+:class:`attitude.environment.orbit.Orbit`, or the Earth's centre when None), the
 precision of interval ends, the height of the limb's atmosphere and an optional Euler
 sequence for the attitude in LVLH.  Nothing here computes a direction: that is
 :mod:`attitude.pointing.sampling` (at given times) and :mod:`attitude.pointing.search`
@@ -35,7 +37,7 @@ __all__ = [
     "interval_precision",
 ]
 
-KINDS = ("panel", "instrument", "star_tracker", "other")
+KINDS = ("panel", "instrument", "star_tracker", "sun_sensor", "other")
 
 
 def _angle(value: Any, name: str, what: str, low: float, high: float) -> float | None:
@@ -56,15 +58,22 @@ class BodyVector:
     """A named direction fixed in body axes (normalized on construction), and its
     constraints.
 
-    ``kind``: 'panel' (its Sun incidence is reported), 'instrument', 'star_tracker'
-    or 'other'.  Constraints (radians, or angle Quantities; None for none):
+    ``kind``: 'panel' (its Sun incidence is reported), 'instrument', 'star_tracker',
+    'sun_sensor' or 'other'.  Constraints (radians, or angle Quantities; None for none):
 
     - ``sun_exclusion_half_angle_rad``: the Sun must stay outside this cone about the
       vector (unless the spacecraft is in umbra: a hidden Sun blinds nothing);
     - ``moon_exclusion_half_angle_rad``: the same for the Moon (unless the Earth hides
       the Moon's centre);
     - ``earth_limb_exclusion_angle_rad``: the vector must stay at least this far above
-      the Earth's limb (or the limb of its atmosphere, see :class:`PointingSpec`).
+      the Earth's limb (or the limb of its atmosphere, see :class:`PointingSpec`);
+    - ``sun_inclusion_half_angle_rad``: the Sun must be *inside* this cone about the
+      vector (a Sun sensor's field of view); it is seen there unless the spacecraft is
+      in umbra.  With a Sun exclusion cone too, it must be the wider of the two, or
+      the Sun could never be seen.
+
+    The exclusions together say when the vector is blinded (by any of them); the
+    inclusion when it sees the Sun (:class:`attitude.pointing.search.VectorAnalysis`).
 
     The ``*_deg`` fields carry the same angles in degrees as the user wrote them (30,
     not degrees(radians(30)) = 29.999999999999996), for the reports; computed from the
@@ -80,6 +89,8 @@ class BodyVector:
     moon_exclusion_half_angle_deg: float | None = None
     earth_limb_exclusion_angle_rad: float | None = None
     earth_limb_exclusion_angle_deg: float | None = None
+    sun_inclusion_half_angle_rad: float | None = None
+    sun_inclusion_half_angle_deg: float | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", self.name):
@@ -100,6 +111,7 @@ class BodyVector:
             ("sun_exclusion_half_angle", "sun exclusion half angle", 0.0),
             ("moon_exclusion_half_angle", "moon exclusion half angle", 0.0),
             ("earth_limb_exclusion_angle", "earth limb exclusion angle", -90.0),
+            ("sun_inclusion_half_angle", "sun inclusion half angle", 0.0),
         ):
             radians = _angle(getattr(self, f"{prefix}_rad"), self.name, what, low, 180.0)
             degrees = getattr(self, f"{prefix}_deg")
@@ -110,6 +122,27 @@ class BodyVector:
             object.__setattr__(self, f"{prefix}_rad", radians)
             if radians is not None and degrees is None:
                 object.__setattr__(self, f"{prefix}_deg", math.degrees(radians))
+        inclusion, exclusion = self.sun_inclusion_half_angle_rad, self.sun_exclusion_half_angle_rad
+        if inclusion is not None and exclusion is not None and inclusion <= exclusion:
+            raise InputError(
+                f"body vector {self.name!r}: sun inclusion half angle "
+                f"{self.sun_inclusion_half_angle_deg:g} deg is within its sun exclusion half "
+                f"angle {self.sun_exclusion_half_angle_deg:g} deg: the Sun could never be seen"
+            )
+
+    @property
+    def exclusions(self) -> list[str]:
+        """The exclusions this vector has, by name (``sun_exclusion``, ``moon_exclusion``,
+        ``earth_limb_exclusion``): what can blind it."""
+        return [
+            name
+            for name, angle in (
+                ("sun_exclusion", self.sun_exclusion_half_angle_rad),
+                ("moon_exclusion", self.moon_exclusion_half_angle_rad),
+                ("earth_limb_exclusion", self.earth_limb_exclusion_angle_rad),
+            )
+            if angle is not None
+        ]
 
 
 _EULER_SEQUENCE = re.compile(r"[XYZ]{3}|[xyz]{3}")
@@ -209,6 +242,7 @@ def describe_lines(spec: PointingSpec) -> list[str]:
                 ("Sun exclusion half angle", vector.sun_exclusion_half_angle_deg),
                 ("Moon exclusion half angle", vector.moon_exclusion_half_angle_deg),
                 ("Earth limb exclusion angle", vector.earth_limb_exclusion_angle_deg),
+                ("Sun inclusion half angle", vector.sun_inclusion_half_angle_deg),
             )
             if angle is not None
         ]
