@@ -24,6 +24,7 @@ import csv
 import itertools
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -296,3 +297,12 @@ def test_a_bad_inclusion_cone_is_refused_in_python():
         )
     with pytest.raises(InputError, match="sun inclusion half angle must be between"):
         BodyVector("sensor", [0.0, 0.0, 1.0], sun_inclusion_half_angle_rad=math.radians(200.0))
+
+
+def test_eclipse_png_on_any_orbit_as_the_docs_say(run):
+    """A Keplerian orbit (no TLE) gets its eclipse figure, and the docs say so."""
+    out = run[1]
+    assert (out / "eclipse.png").stat().st_size > 0
+    docs = (Path(__file__).parents[1] / "docs" / "scenarios.md").read_text()
+    row = next(line for line in docs.splitlines() if line.startswith("| `plots` |"))
+    assert "TLE" not in row and "`eclipse.png` with an orbit" in row
