@@ -530,7 +530,9 @@ def _pointing(root: _Table, scale: str, epoch, name: str) -> PointingSpec:
     sequence = table.string("lvlh_euler_sequence", required=False)
     if sequence is not None:
         options["lvlh_euler_sequence"] = sequence
-    return _checked(table, None, PointingSpec, vectors, orbit, **options)
+    spec = _checked(table, None, PointingSpec, vectors, orbit, **options)
+    _checked(table, None, spec.check_orbit)
+    return spec
 
 
 def _burn(table: _Table, scale: str) -> Burn:
@@ -571,9 +573,8 @@ def _torques(root: _Table, scale: str, orbit: Orbit | None) -> ScenarioTorques |
     if threshold is not None:
         options["horizon_threshold"] = threshold
     try:
-        return ScenarioTorques(
-            orbit if gravity_gradient else None, tuple(burns), order=order, **options
-        )
+        # True: the scenario's orbit, the one of [pointing] (given once, to the Scenario).
+        return ScenarioTorques(gravity_gradient or None, tuple(burns), order=order, **options)
     except InputError as exc:
         raise ScenarioFileError(f"{table.file.name}: {exc}") from None
 
@@ -640,7 +641,9 @@ def scenario_from_document(path: Path, document: dict[str, Any]) -> ScenarioFile
     output.allow("start", "stop", "duration", "step", "formats", "aem_tolerance")
     span = _span(output, scale)
     try:
-        scenario = Scenario(name, spacecraft, epoch, state, events, **span, torques=torques)
+        scenario = Scenario(
+            name, spacecraft, epoch, state, events, **span, torques=torques, orbit=pointing.orbit
+        )
     except InputError as exc:
         end = "stop" if span["stop"] is not None else "duration"
         raise ScenarioFileError(f"{path.name}: {_scenario_key(str(exc), end)}") from None

@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 from attitude.base.errors import InputError
 from attitude.environment.frames import euler_angles_deg, lvlh_to_icrf
-from attitude.pointing.spec import BodyVector, PointingSpec
+from attitude.pointing.spec import BodyVector, PointingSpec, for_scenario
 from attitude.pointing.surroundings import SunMoonEarth, Surroundings, moon_hidden, vector_angles
 from attitude.trajectory.trajectory import Trajectory
 
@@ -126,6 +126,7 @@ def pointing_samples(
     seconds = np.asarray(seconds, dtype=np.float64).ravel()
     if seconds.size == 0:
         raise InputError("seconds: no times to sample")
+    spec = for_scenario(spec, trajectory.scenario)  # the scenario's orbit, if the spec has none
     if seconds.size == 1:
         # One epoch is evaluated as a pair and the first kept: numpy's one-row products
         # take another path (gemv), which can differ in the last bit, and a stream's

@@ -49,7 +49,7 @@ from attitude.environment.timescales import SECONDS_PER_DAY
 from attitude.pointing.eclipse import SUN_RADIUS_M
 from attitude.pointing.extrema import Extremum, Problem, least_of_each
 from attitude.pointing.intervals import Interval, difference, find_all_intervals, join, union
-from attitude.pointing.spec import BodyVector, PointingSpec, interval_precision
+from attitude.pointing.spec import BodyVector, PointingSpec, for_scenario, interval_precision
 from attitude.pointing.surroundings import SunMoonEarth, moon_hidden, scenario_jd, vector_angles
 from attitude.solver.euler_solver import EulerSolver
 from attitude.trajectory.trajectory import Trajectory
@@ -235,6 +235,7 @@ def search_grid(
     span by default), from the rates of the motion and the orbit (see the module notes).
     """
     scenario = trajectory.scenario
+    spec = for_scenario(spec, scenario)  # the scenario's orbit, when the spec has none
     start_s = scenario.start_s if start_s is None else float(start_s)
     stop_s = scenario.stop_s if stop_s is None else float(stop_s)
     body = _body_rate(trajectory, start_s, stop_s)
@@ -279,6 +280,7 @@ def check_pointing(
     search grid of :func:`pointing_analysis` (None without pointing).
     """
     scenario = trajectory.scenario
+    spec = for_scenario(spec, scenario)  # the scenario's orbit, when the spec has none
     if spec.is_empty:
         return [], None
     notes = []
@@ -610,6 +612,7 @@ def pointing_analysis(
     intervals found.  Interval ends are refined to ``spec.interval_precision_s``,
     extrema to 1 µs.
     """
+    spec = for_scenario(spec, trajectory.scenario)  # the scenario's orbit, if the spec has none
     if grid is None:
         grid = search_grid(trajectory, spec, start_s, stop_s)
     search = _Search(trajectory, spec, grid)

@@ -17,6 +17,7 @@ degrees the user wrote, for the reports.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from dataclasses import dataclass, field
@@ -28,12 +29,14 @@ from numpy.typing import NDArray
 from attitude.base.errors import InputError
 from attitude.base.quantities import as_si_scalar, as_vector3
 from attitude.environment.orbit import Orbit, TleOrbit
+from attitude.scenario.scenario import Scenario, orbit_disagreement
 
 __all__ = [
     "KINDS",
     "BodyVector",
     "PointingSpec",
     "describe_lines",
+    "for_scenario",
     "interval_precision",
 ]
 
@@ -153,8 +156,10 @@ class PointingSpec:
     """What pointing outputs a scenario asks for.
 
     ``body_vectors``: the :class:`BodyVector` list.  ``orbit``: an
-    :class:`attitude.environment.orbit.Orbit`, or the two lines of a TLE; None places the
-    spacecraft at the Earth's centre (Sun and Moon directions only).
+    :class:`attitude.environment.orbit.Orbit`, or the two lines of a TLE; None takes the
+    scenario's orbit (``Scenario(..., orbit=...)``, :func:`for_scenario`), and with none
+    there either places the spacecraft at the Earth's centre (Sun and Moon directions
+    only).
     ``interval_precision_s``: the precision to which interval ends are refined.
     ``earth_limb_atmosphere_height_m``: the height above the Earth's equatorial radius
     of the limb that the limb angles are measured from (0: the solid Earth; 50–100 km
@@ -197,15 +202,21 @@ class PointingSpec:
                 "lvlh_euler_sequence must be three axes, all upper case (intrinsic) or all "
                 f"lower case (extrinsic), no axis twice in a row (ZYX, zxz...), got {sequence!r}"
             )
-        if self.orbit is None:
-            needs = [v.name for v in self.body_vectors if v.earth_limb_exclusion_angle_rad]
-            if needs:
-                raise InputError(
-                    f"body vector {needs[0]!r}: an earth limb exclusion needs an orbit "
-                    "(a TLE, an OEM file or Keplerian elements)"
-                )
-            if sequence is not None:
-                raise InputError("lvlh_euler_sequence needs an orbit (LVLH is the orbit's frame)")
+
+    def check_orbit(self) -> None:
+        """Refuse (InputError) what needs an orbit without one: an Earth limb exclusion,
+        the attitude in LVLH.  Checked where the spec meets its scenario
+        (:func:`for_scenario`), whose orbit it takes when it has none of its own."""
+        if self.orbit is not None:
+            return
+        needs = [v.name for v in self.body_vectors if v.earth_limb_exclusion_angle_rad]
+        if needs:
+            raise InputError(
+                f"body vector {needs[0]!r}: an earth limb exclusion needs an orbit "
+                "(a TLE, an OEM file or Keplerian elements)"
+            )
+        if self.lvlh_euler_sequence is not None:
+            raise InputError("lvlh_euler_sequence needs an orbit (LVLH is the orbit's frame)")
 
     @property
     def is_empty(self) -> bool:
@@ -219,6 +230,26 @@ class PointingSpec:
     def tle(self) -> tuple[str, str] | None:
         """The TLE lines, when the orbit is a TLE."""
         return self.orbit.lines if isinstance(self.orbit, TleOrbit) else None
+
+
+def for_scenario(spec: PointingSpec, scenario: Scenario) -> PointingSpec:
+    """``spec`` as it applies to ``scenario``: with the scenario's orbit when the spec
+    gives none (the orbit is given once, to the Scenario), checked for what needs an
+    orbit.  A spec whose own orbit disagrees with the scenario's is refused
+    (:func:`attitude.scenario.scenario.orbit_disagreement`)."""
+    if scenario.orbit is not None:
+        if spec.orbit is None:
+            spec = dataclasses.replace(spec, orbit=scenario.orbit)
+        else:
+            disagreement = orbit_disagreement(scenario.orbit, spec.orbit, scenario)
+            if disagreement:
+                raise InputError(
+                    f"pointing.orbit: the PointingSpec's orbit is not the scenario's: "
+                    f"{disagreement}; give the orbit once, Scenario(..., orbit=...), and "
+                    "leave it out of the PointingSpec"
+                )
+    spec.check_orbit()
+    return spec
 
 
 def describe_lines(spec: PointingSpec) -> list[str]:
