@@ -306,3 +306,21 @@ def test_eclipse_png_on_any_orbit_as_the_docs_say(run):
     docs = (Path(__file__).parents[1] / "docs" / "scenarios.md").read_text()
     row = next(line for line in docs.splitlines() if line.startswith("| `plots` |"))
     assert "TLE" not in row and "`eclipse.png` with an orbit" in row
+
+
+def test_the_monte_carlo_metrics_carry_blinded_and_the_sun_sensor(run):
+    from attitude.montecarlo.metrics import metric_names, pointing_outcome
+    from attitude.outputs.formats import OutputChoice
+    from attitude.report.plan import plan_run
+
+    path, _, _, summary = run
+    loaded = load_scenario(path)
+    plan = plan_run(loaded.scenario, loaded.pointing, OutputChoice(("csv",)), horizon=False)
+    metrics = pointing_outcome(plan)
+    names = metric_names(loaded.scenario, plan.pointing)
+    vectors = summary["pointing"]["body_vectors"]
+    for name, kind in (("tracker", "blinded"), ("sun_sensor", "sun_in_view")):
+        for total in ("count", "total_s", "longest_s", "fraction_of_span"):
+            key = f"{name}_{kind}_{total}"
+            assert key in names and metrics[key] == vectors[name][kind][total], key
+    assert "sun_sensor_blinded_total_s" not in names
