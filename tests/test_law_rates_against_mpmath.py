@@ -23,9 +23,9 @@ The bar of the issue is 1e-12 rad/s.
 
 import math
 
-import mpmath as mp
 import numpy as np
 import pytest
+from law_finite_differences import reference_rates
 from scipy.spatial.transform import Rotation
 
 from attitude.environment.keplerian import KeplerianOrbit
@@ -38,8 +38,6 @@ from attitude.laws.orbit_derivatives import orbit_derivatives
 EPOCH = "2024-06-15T00:00:00"  # UTC: TT 00:01:09.184, 69.184 s after a 600 s node
 MID_PIECE = 230.816  # + 600 k: 300 s from every 600 s node, and so from every hour
 STEP = 2.0
-HALF = 4
-mp.mp.dps = 40
 
 SSO = dict(
     semi_major_axis_m=7_078_137.0,
@@ -72,42 +70,9 @@ LAWS = {
 }
 
 
-def _weights(derivative: int) -> list:
-    """mpmath weights of the 9-point central difference for a derivative, step 1."""
-    nodes = [mp.mpf(k) for k in range(-HALF, HALF + 1)]
-    matrix = mp.matrix([[x**j for x in nodes] for j in range(len(nodes))])
-    rhs = mp.matrix([mp.factorial(derivative) if j == derivative else 0 for j in range(len(nodes))])
-    return list(mp.lu_solve(matrix, rhs))
-
-
-W1, W2 = _weights(1), _weights(2)
-
-
-def _vee(m) -> list:
-    return [(m[2, 1] - m[1, 2]) / 2, (m[0, 2] - m[2, 0]) / 2, (m[1, 0] - m[0, 1]) / 2]
-
-
-def _reference(bound, t0: float) -> tuple[np.ndarray, np.ndarray]:
-    """ω and α (body axes) from the mpmath differences of the law's own attitude."""
-    seconds = t0 + STEP * np.arange(-HALF, HALF + 1)
-    matrices = [mp.matrix(m.tolist()) for m in bound.attitude(seconds).as_matrix()]
-    h = mp.mpf(STEP)
-    r0 = matrices[HALF]
-    first = sum((w * m for w, m in zip(W1, matrices, strict=True)), mp.zeros(3, 3)) / h
-    second = sum((w * m for w, m in zip(W2, matrices, strict=True)), mp.zeros(3, 3)) / h**2
-    omega = mp.matrix(_vee(first * r0.T))
-    alpha = mp.matrix(_vee(second * r0.T + first * first.T))
-    body_omega = r0.T * omega
-    body_alpha = r0.T * alpha
-    return (
-        np.array([float(x) for x in body_omega]),
-        np.array([float(x) for x in body_alpha]),
-    )
-
-
 def _check(bound, t0: float, rate_tolerance: float, acceleration_tolerance: float) -> None:
     state = bound.state([t0])
-    omega, alpha = _reference(bound, t0)
+    omega, alpha = reference_rates(bound, t0, STEP)
     assert np.max(np.abs(state.angular_velocity[0] - omega)) < rate_tolerance
     assert np.max(np.abs(state.angular_acceleration[0] - alpha)) < acceleration_tolerance
 

@@ -55,7 +55,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from attitude.base.errors import InputError
-from attitude.base.jets import Jet, cross, norm, normalized
+from attitude.base.jets import Jet, cross, normalized
 from attitude.environment.timescales import (
     as_time,
     iso_texts,
@@ -351,8 +351,8 @@ class AlignConstrainLaw(AttitudeLaw):
     def _check(self, at: InputsAt, d1: Jet, d2: Jet) -> None:
         """Raise :class:`DegenerateLawError` at the first epoch where a direction has no
         length or the two are parallel."""
-        n1 = norm(d1).value
-        n2 = norm(d2).value
+        n1 = np.linalg.norm(d1.value, axis=-1)
+        n2 = np.linalg.norm(d2.value, axis=-1)
         for which, lengths in (("primary", n1), ("secondary", n2)):
             bad = ~(lengths > 0.0) | ~np.isfinite(lengths)
             if np.any(bad):
