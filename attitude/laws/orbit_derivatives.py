@@ -24,7 +24,9 @@ its second derivative (the velocity, the orbit normal).  Two ways, by source:
   |δṙ|/|r| < 3e-14 rad/s, its angular acceleration by < 1e-15 rad/s².
 
 Near the ends of a span the source may not cover (an OEM file), the stencil is shifted
-inside ``[first, last]`` (one-sided differences: same order, 2–5× larger rounding).
+inside ``[first, last]`` (one-sided differences of the same order: measured as
+accurate as the central ones, within a factor 2), and shortened to fit a span shorter
+than 8 steps, down to 1 s steps.
 """
 
 from __future__ import annotations
@@ -112,8 +114,9 @@ def orbit_derivatives(
     if bounds_jd2 is not None:
         first, last = bounds_jd2
         span_s = (last - first) * SECONDS_PER_DAY
-        if span_s > 0.0:
-            h = np.minimum(h, span_s / (2 * _HALF_WIDTH))
+        # Fit the stencil in the span, but not with steps below 1 s (whose differences
+        # the epochs' rounding would spoil): a shorter span is left at both ends.
+        h = np.minimum(h, max(span_s / (2 * _HALF_WIDTH), 1.0))
         before_s = (jd2 - first) * SECONDS_PER_DAY  # room before and after each epoch
         after_s = (last - jd2) * SECONDS_PER_DAY
         with np.errstate(divide="ignore", invalid="ignore"):
