@@ -19,9 +19,10 @@ events.  With :class:`ScenarioTorques` its segments are propagated by
   the inertia or attitude).
 
 The method: ``order`` 2, 4 (default) or 6, with either a ``step`` (s) or an
-``accuracy`` (rad): with an accuracy, each segment's step is chosen so that the
-estimated attitude error over the segment is within it (``docs/torques.md``, "How the
-step is chosen").  Neither: an accuracy of 1e-6 rad (the AEM's default tolerance).
+``accuracy`` (rad): with an accuracy, the one step of every torqued segment is chosen
+so that the estimated attitude error of the whole run, errors carried across events
+included, is within it (``attitude.trajectory.steps``; ``docs/torques.md``, "The
+scenario route").  Neither: an accuracy of 1e-6 rad (the AEM's default tolerance).
 
 ``horizon_threshold`` (rad, default 1°) is the angle that defines the validity
 horizon of a torque-free scenario that has an orbit: how long until the neglected

@@ -267,16 +267,6 @@ class TorquedMotion:
         body = m if axes.is_diagonal else axes.body_to_principal.inv().apply(m)
         return t, np.linalg.solve(axes.tensor, body[..., None])[..., 0]
 
-    def survey_cost(self) -> int:
-        """The number of dense-output evaluations :attr:`survey` takes (before it is
-        computed: for a budget)."""
-        span = self.end_s - self.t0
-        G = self.angular_momentum_norm
-        if span <= 0.0 or G == 0.0:
-            return 2
-        spacing = 2.0 * math.pi * float(np.min(self.moments_of_inertia)) / G / SURVEY_PER_TURN
-        return max(2, math.ceil(span / spacing) + 1)
-
     def flip_times(self, t_start: float, t_end: float) -> NDArray[np.float64]:
         """The flips in [t_start, t_end] on the propagated motion (TT s): the times at
         which the momentum crosses from one side of the intermediate axis to the other
