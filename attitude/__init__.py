@@ -6,7 +6,8 @@ checks it, and that the README's "Layout" table lists the same layers and module
 
 1. ``attitude.base``: errors, units, quaternions, vectors, the compile policy
 2. ``attitude.elliptic``: Jacobi elliptic functions and elliptic integrals, the phase table
-3. ``attitude.solver``: the exact torque-free solver (``EulerSolver``) and its free flow
+3. ``attitude.solver``: the exact torque-free solver (``EulerSolver``), its free flow and
+   its sensitivities
 4. ``attitude.torques``: torques by splitting with the exact free flow (``TorquedSolver``)
 5. ``attitude.environment``: time scales, the Sun and Moon, the Earth, frames, orbits
 6. ``attitude.scenario``: the spacecraft, its initial state, events, a scenario's torques
@@ -15,8 +16,9 @@ checks it, and that the README's "Layout" table lists the same layers and module
 9. ``attitude.outputs``: CSV, Parquet and AEM files, the output budget and folder
 10. ``attitude.report``: a run's plan, summaries, figures, page and streamed writing
 11. ``attitude.files``: scenario files read and written
-12. ``attitude.montecarlo``: Monte Carlo dispersions on Dask
-13. ``attitude.cli``: the command line
+12. ``attitude.estimation``: spin state and inertia ratios fitted to telemetry
+13. ``attitude.montecarlo``: Monte Carlo dispersions on Dask
+14. ``attitude.cli``: the command line
 
 The names below are importable from ``attitude`` directly; all but the errors are
 loaded on first use, so that ``import attitude`` stays light (numpy, scipy, astropy,
@@ -39,6 +41,7 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.environment.keplerian import KeplerianOrbit
     from attitude.environment.oem import OemOrbit
     from attitude.environment.orbit import TleOrbit
+    from attitude.estimation.fit import FitRefused, SpinStateFit, fit_spin_state
     from attitude.files.scenario_reader import load_scenario
     from attitude.montecarlo.job import run_montecarlo
     from attitude.outputs.aem_writer import write_aem
@@ -51,6 +54,7 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.scenario.spacecraft import Spacecraft
     from attitude.scenario.torques import Burn, ScenarioTorques
     from attitude.solver.euler_solver import EulerSolver
+    from attitude.solver.sensitivities import FlowSensitivities, flow_sensitivities
     from attitude.torques.models import ConstantTorque, GravityGradient, UserTorque
     from attitude.torques.solver import TorquedSolver, departure_time, propagate_batch
     from attitude.trajectory.horizon import validity_horizon
@@ -59,6 +63,11 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
 
 _LAZY = {
     "EulerSolver": "attitude.solver.euler_solver",
+    "FlowSensitivities": "attitude.solver.sensitivities",
+    "flow_sensitivities": "attitude.solver.sensitivities",
+    "fit_spin_state": "attitude.estimation.fit",
+    "SpinStateFit": "attitude.estimation.fit",
+    "FitRefused": "attitude.estimation.fit",
     "TorquedSolver": "attitude.torques.solver",
     "propagate_batch": "attitude.torques.solver",
     "departure_time": "attitude.torques.solver",
@@ -100,6 +109,8 @@ __all__ = [
     "Burn",
     "ConstantTorque",
     "EulerSolver",
+    "FitRefused",
+    "FlowSensitivities",
     "GravityGradient",
     "InertiaChange",
     "InertiaWarning",
@@ -111,6 +122,7 @@ __all__ = [
     "Scenario",
     "ScenarioTorques",
     "Spacecraft",
+    "SpinStateFit",
     "TleOrbit",
     "TorquedSolver",
     "Trajectory",
@@ -118,6 +130,8 @@ __all__ = [
     "__version__",
     "analyze",
     "departure_time",
+    "fit_spin_state",
+    "flow_sensitivities",
     "load_scenario",
     "pointing_analysis",
     "pointing_samples",
