@@ -186,7 +186,7 @@ class SpinStateFit:
                 for v, e in zip(self.angular_velocity, self.angular_velocity_sigma, strict=True)
             ),
         ]
-        if self.principal_moments is not None:
+        if self.principal_moments is not None and self.principal_moments_sigma is not None:
             lines.append(
                 "principal moments (kg m²): "
                 + ", ".join(
@@ -196,7 +196,7 @@ class SpinStateFit:
                     )
                 )
             )
-        if self.attitude is not None:
+        if self.attitude is not None and self.attitude_sigma is not None:
             q = self.attitude.as_quat(scalar_first=True)
             lines.append(
                 f"attitude at t0 (body -> ICRF, scalar first): {np.array2string(q, precision=9)}"
@@ -280,6 +280,13 @@ def fit_spin_state(
             f"{source}: an impulse in inertial axes needs the attitude: give quaternions, or "
             "the impulse in body axes"
         )
+    if torques is not None and not layout.attitude:
+        inertial_burns = any(b.frame != "body" for b in getattr(torques, "burns", ()))
+        if getattr(torques, "gravity_gradient", None) is not None or inertial_burns:
+            raise InputError(
+                f"{source}: a fit under gravity gradient (or an inertial burn) needs attitude "
+                "fixes: the torque depends on the attitude, which rates alone barely show"
+            )
     model = _model(layout, impulse_list, torques, telemetry)
     starts, guess_text = _starts(model, telemetry, guess, principal_axes, data)
     notes.append(guess_text)
@@ -364,7 +371,7 @@ def _attitude_noise(t: NDArray[np.float64], q: NDArray[np.float64]) -> float | N
 
 def _refuse_without_motion(telemetry: Telemetry, data: Data) -> None:
     """A body whose rates do not vary beyond the gyro noise shows no inertia ratio."""
-    if data.rates is None or data.rates.shape[0] < 10:
+    if data.rates is None or data.σ_rates is None or data.rates.shape[0] < 10:
         return
     ω, σ = data.rates, data.σ_rates
     z = (ω - np.median(ω, axis=0)) / σ
@@ -418,7 +425,9 @@ def _model(layout: Layout, impulses, torques, telemetry: Telemetry):
         return ExactModel(layout, impulses)
     from attitude.estimation.scenario_model import ScenarioModel
 
-    return ScenarioModel(layout, impulses, torques, telemetry.epoch, telemetry.span[1])
+    return ScenarioModel(
+        layout, impulses, torques=torques, epoch=telemetry.epoch, end=telemetry.span[1]
+    )
 
 
 def _first_attitude(telemetry: Telemetry, moments, axes: Rotation, ω0) -> Rotation | None:

@@ -240,7 +240,7 @@ def flow_sensitivities(
         elliptic = _Elliptic(J, m0, solver.formula, solver.mc)
         jacobian[:, 3:, 3:] = elliptic.momentum_gradient(τ)
         jacobian[:, 3:, :3] = 0.0
-        if attitude:
+        if rotations is not None:
             Φ = (solver.initial_attitude.inv() * rotations).as_matrix()
             jacobian[:, :3, 3:] = elliptic.attitude_gradient(τ, Φ)
             jacobian[:, :3, :3] = np.swapaxes(Φ, 1, 2)
