@@ -8,6 +8,11 @@ Modules:
   in the moments.
 - ``model``: The motion the fit adjusts: its parameters, and the predicted rates and
   attitudes with their Jacobian.
+- ``report``: The outputs of ``attitude fit``: the fitted scenario, the parameter table,
+  the residuals, the uncertainty growth and a page, written through the output
+  folder's rules.
+- ``scenario_model``: The fitted motion under known torques: gravity gradient on a
+  given orbit, burns, with known impulses, through the splitting of ``TorquedSolver``.
 - ``solve``: Least squares on the exact motion: robust, over a growing arc, from
   several starts, and never stopping in a local minimum.
 - ``statistics``: What a converged fit says about itself: the covariance, the goodness
@@ -15,4 +20,7 @@ Modules:
 - ``telemetry``: Telemetry as the fit takes it: gyro rates and attitude quaternions at
   their times, checked, sorted and cleaned, with a model-free estimate of each sensor's
   noise.
+- ``telemetry_files``: Telemetry files for ``attitude fit``: CSV, Parquet and CCSDS AEM,
+  read into times, body rates and attitude quaternions, with every problem named by
+  file, column, row and value.
 """

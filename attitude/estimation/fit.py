@@ -139,11 +139,30 @@ class SpinStateFit:
         rates, attitude = self._model.predict(self._x, times, times, jacobian=True)
         return _largest_sigma(attitude.dθ, self._cov_x), _largest_sigma(rates.dω, self._cov_x)
 
+    def envelope(self, t: Any, points: int = 24) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """``uncertainty`` at its largest over one cycle of the motion about each of
+        ``t`` (the longer of the body period and one turn, 2π/|ω|, sampled at
+        ``points`` times): the uncertainty oscillates within each cycle, and a curve
+        sampled once per many cycles would alias."""
+        times = np.atleast_1d(as_si_array(t, "time", "t"))
+        turn = 2.0 * math.pi / max(float(np.linalg.norm(self.angular_velocity)), 1e-300)
+        cycle = max(turn, self.period if math.isfinite(self.period) else 0.0)
+        offsets = cycle * (np.arange(points) / points - 0.5)
+        grid = (times[:, None] + offsets[None, :]).ravel()
+        grid = np.maximum(grid, self.span[0])
+        σ_attitude, σ_rate = self.uncertainty(grid)
+        return σ_attitude.reshape(times.size, points).max(axis=1), σ_rate.reshape(
+            times.size, points
+        ).max(axis=1)
+
     def horizon(self, threshold: Any = None, limit: float | None = None) -> float:
         """The first time after the arc (s from ``epoch``) at which the predicted 1σ
-        attitude uncertainty reaches ``threshold`` (an angle: a Quantity, or radians;
-        10° by default); ``inf`` if it stays below until ``limit`` (default: the arc's
-        end plus 10⁶ times its length)."""
+        attitude uncertainty, at its largest over a cycle (``envelope``), reaches
+        ``threshold`` (an angle: a Quantity, or radians; 10° by default); ``inf`` if it
+        stays below until ``limit`` (default: the arc's end plus 10⁶ times its length,
+        or 30 times it under torques, whose propagation costs per second of span).
+        Linear propagation of the covariance: near 10° the first-order phase error is
+        still the whole story for a tumbler, whose error is mostly along its turn."""
         threshold_rad = (
             math.radians(DEFAULT_HORIZON_DEG)
             if threshold is None
@@ -151,14 +170,20 @@ class SpinStateFit:
         )
         start, end = self.span
         length = max(end - start, 1e-9)
-        limit = end + 1e6 * length if limit is None else float(limit)
+        if limit is None:
+            limit = end + (30.0 if getattr(self._model, "torques", None) else 1e6) * length
+        limit = float(limit)
+
+        def σ(t: float) -> float:
+            return float(self.envelope(t)[0][0])
+
         previous = end
-        if self.uncertainty(end)[0][0] >= threshold_rad:
+        if σ(end) >= threshold_rad:
             return end
         k = 0
         while True:
             t = min(end + length * 2.0 ** (k / 2.0 - 2.0), limit)
-            if self.uncertainty(t)[0][0] >= threshold_rad:
+            if σ(t) >= threshold_rad:
                 break
             if t >= limit:
                 return math.inf
@@ -166,11 +191,11 @@ class SpinStateFit:
         low, high = previous, t
         for _ in range(40):
             middle = 0.5 * (low + high)
-            if self.uncertainty(middle)[0][0] >= threshold_rad:
+            if σ(middle) >= threshold_rad:
                 high = middle
             else:
                 low = middle
-            if high - low <= 1e-6 * high:
+            if high - low <= 1e-4 * (high - end):
                 break
         return high
 
