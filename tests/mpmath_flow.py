@@ -13,7 +13,7 @@ import mpmath as mp
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parents[1]))
-from benchmarks import reference  # noqa: E402
+from benchmarks import reference
 
 
 def flow(inertia, momentum, q0, times, dps: int = 50):
@@ -40,7 +40,9 @@ def flow(inertia, momentum, q0, times, dps: int = 50):
         q_init = [mp.mpf(x) for x in q0]
         norm = mp.sqrt(sum(x * x for x in q_init))
         q_init = [x / norm for x in q_init]
-        left = reference._qmul(reference._qmul(q_init, reference._conj(qS)), reference._conj(q_start))
+        left = reference._qmul(
+            reference._qmul(q_init, reference._conj(qS)), reference._conj(q_start)
+        )
         out = []
         for t in times:
             s = G * mp.mpf(float(t)) / scale
@@ -89,4 +91,9 @@ def jacobian(inertia, momentum, q0, times, dps: int = 50, relative_step: float =
                     [(a - b) / (2 * step) for a, b in zip(θ_p + m_p, θ_m + m_m, strict=True)]
                 )
             columns.append(column)
-        return np.array([[[float(columns[k][n][r]) for k in range(9)] for r in range(6)] for n in range(len(times))])
+        return np.array(
+            [
+                [[float(columns[k][n][r]) for k in range(9)] for r in range(6)]
+                for n in range(len(times))
+            ]
+        )

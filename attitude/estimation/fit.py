@@ -37,7 +37,7 @@ from scipy.spatial.transform import Rotation
 
 from attitude.base.errors import InputError
 from attitude.base.quantities import as_si_array, as_si_scalar
-from attitude.estimation.linear_guess import Guess, candidates
+from attitude.estimation.linear_guess import Guess, candidates, impulse_scale
 from attitude.estimation.model import ExactModel, Impulse, Layout
 from attitude.estimation.solve import Data, FitRefused, Solution, fit_from_starts, residuals
 from attitude.estimation.statistics import Goodness, covariance, goodness
@@ -138,6 +138,17 @@ class SpinStateFit:
         times = np.atleast_1d(as_si_array(t, "time", "t"))
         rates, attitude = self._model.predict(self._x, times, times, jacobian=True)
         return _largest_sigma(attitude.dθ, self._cov_x), _largest_sigma(rates.dω, self._cov_x)
+
+    def prediction_covariance(self, t: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """The covariance of the predicted attitude ((N, 3, 3), rad², of the body-axes
+        rotation vector δθ with Q_true = Q_predicted exp([δθ]×)) and of the predicted
+        body rates ((N, 3, 3), (rad/s)²) at ``t``, seconds from ``epoch``."""
+        times = np.atleast_1d(as_si_array(t, "time", "t"))
+        rates, attitude = self._model.predict(self._x, times, times, jacobian=True)
+        return (
+            np.einsum("nip,pq,njq->nij", attitude.dθ, self._cov_x, attitude.dθ),
+            np.einsum("nip,pq,njq->nij", rates.dω, self._cov_x, rates.dω),
+        )
 
     def envelope(self, t: Any, points: int = 24) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """``uncertainty`` at its largest over one cycle of the motion about each of
@@ -472,15 +483,22 @@ def _first_attitude(telemetry: Telemetry, moments, axes: Rotation, ω0) -> Rotat
 
 def _starts(model, telemetry: Telemetry, guess: Any, principal_axes: bool, data: Data):
     """(model, x, label, first arc end) for each start, and the guess's description."""
+    impulses = getattr(model, "impulses", ())
     if guess is not None:
         guesses = [_from_guess(guess)]
         text = "started from the guess given"
     else:
-        guesses, text = candidates(telemetry, principal_axes)
+        guesses, text = candidates(telemetry, principal_axes, tuple(i.t for i in impulses))
     starts = []
     t_first = float(data.times[0])
     for g in guesses:
         Q0 = _first_attitude(telemetry, g.moments, g.axes, g.ω0)
+        if model.layout.scale and impulses:
+            scale = impulse_scale(
+                telemetry, g.moments, g.axes, impulses, _rough_attitude(telemetry)
+            )
+            if scale is not None:
+                g = Guess(g.moments * scale, g.axes, g.ω0, g.label + ", scale from the impulses")
         m, x = model.start(g.moments, g.axes, g.ω0, Q0)
         try:
             period = EulerSolver(g.moments, g.moments * g.axes.inv().apply(g.ω0)).period
@@ -491,6 +509,19 @@ def _starts(model, telemetry: Telemetry, guess: Any, principal_axes: bool, data:
         first_end = t_first + (0.5 * period if math.isfinite(period) else math.inf)
         starts.append((m, x, g.label, first_end))
     return starts, text
+
+
+def _rough_attitude(telemetry: Telemetry):
+    """The attitude fix nearest to a time (None without fixes): to turn an impulse
+    given in inertial axes into body axes for the first guess."""
+    a = telemetry.attitude
+    if a is None:
+        return None
+
+    def at(t: float) -> Rotation:
+        return Rotation.from_quat(a.values[int(np.argmin(np.abs(a.t - t)))], scalar_first=True)
+
+    return at
 
 
 def _from_guess(guess: Any) -> Guess:

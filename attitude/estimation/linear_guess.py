@@ -22,6 +22,7 @@ the other side, where the motion circulates about the other axis.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -65,9 +66,10 @@ def _window(dt: float, speed: float, length: int) -> int:
     return w if w % 2 else w - 1
 
 
-def measured_rates(telemetry: Telemetry) -> Rates | None:
+def measured_rates(telemetry: Telemetry, breaks: tuple[float, ...] = ()) -> Rates | None:
     """Body rates and ω̇ from the gyro (or, without one, from dense quaternions), over
-    each evenly sampled run long enough for the filter; None if no run is."""
+    each evenly sampled run long enough for the filter, the runs cut at ``breaks``
+    (the times of impulses, where the rates jump); None if no run is."""
     t_parts, ω_parts, dω_parts = [], [], []
     if telemetry.gyro is not None and len(telemetry.gyro) >= 7:
         t, ω, source = telemetry.gyro.t, telemetry.gyro.values, "gyro"
@@ -81,7 +83,12 @@ def measured_rates(telemetry: Telemetry) -> Rates | None:
     else:
         return None
     speed = float(np.median(np.linalg.norm(ω, axis=1)))
+    runs = []
     for run in _uniform_runs(t):
+        cuts = [run.start, *(int(np.searchsorted(t, b)) for b in breaks), run.stop]
+        cuts = sorted(c for c in set(cuts) if run.start <= c <= run.stop)
+        runs += [slice(a, b) for a, b in itertools.pairwise(cuts) if b > a]
+    for run in runs:
         n = run.stop - run.start
         if n < 7:
             continue
@@ -129,13 +136,15 @@ def _positive(v: NDArray[np.float64]) -> NDArray[np.float64] | None:
     return v if np.all(v > 0) else None
 
 
-def candidates(telemetry: Telemetry, principal_axes: bool) -> tuple[list[Guess], str]:
+def candidates(
+    telemetry: Telemetry, principal_axes: bool, breaks: tuple[float, ...] = ()
+) -> tuple[list[Guess], str]:
     """The starts of the fit, best first, and a line describing the linear guess.
 
     Raises :class:`InputError` if the telemetry gives no rates to solve for (sparse
     attitude fixes alone: give the fit a guess) or the rates fit no rigid body.
     """
-    rates = measured_rates(telemetry)
+    rates = measured_rates(telemetry, breaks)
     if rates is None:
         raise InputError(
             f"{telemetry.source}: the samples are too sparse for the linear first guess (it "
@@ -209,3 +218,37 @@ def _mirror(moments: NDArray[np.float64], ω: NDArray[np.float64]) -> NDArray[np
     out = moments.copy()
     out[order[1]] = mirrored
     return out
+
+
+def impulse_scale(
+    telemetry: Telemetry, moments: NDArray[np.float64], axes: Rotation, impulses, attitude
+) -> float | None:
+    """The first moment I1 (kg m²) that makes the measured jumps of the rates at known
+    impulses match Δω = I⁻¹ ΔH for the guessed ratios: a linear least squares in 1/I1
+    on the rates extrapolated to each impulse from either side; None if no jump is
+    measured.  ``attitude``: Q(0) and a rough Q(t) (for impulses in inertial axes)."""
+    rates = measured_rates(telemetry, tuple(i.t for i in impulses))
+    if rates is None:
+        return None
+    a_rows, jumps = [], []
+    for impulse in impulses:
+        before = np.flatnonzero(rates.t < impulse.t)
+        after = np.flatnonzero(rates.t >= impulse.t)
+        if before.size == 0 or after.size == 0:
+            continue
+        b, c = before[-1], after[0]
+        ω_before = rates.ω[b] + rates.ω_dot[b] * (impulse.t - rates.t[b])
+        ω_after = rates.ω[c] + rates.ω_dot[c] * (impulse.t - rates.t[c])
+        ΔH = impulse.vector
+        if impulse.frame != "body":
+            if attitude is None:
+                continue
+            ΔH = attitude(impulse.t).inv().apply(ΔH)
+        # In principal axes: Δω_p = ΔH_p / (I1 r), r the ratios.
+        a_rows.append(axes.inv().apply(ΔH) / moments)
+        jumps.append(axes.inv().apply(ω_after - ω_before))
+    if not a_rows:
+        return None
+    a, Δω = np.concatenate(a_rows), np.concatenate(jumps)
+    u = float(a @ Δω) / float(a @ a) if float(a @ a) > 0 else 0.0
+    return 1.0 / u if u > 0 else None

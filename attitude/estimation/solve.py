@@ -155,15 +155,29 @@ class Solution:
 
 
 def _solve(model, x0, data: Data, robust: bool, max_nfev: int = 100):
-    def fun(x):
-        return residuals(model, x, data, False)
+    """Least squares from ``x0`` on ``data``.  Parameters the data do not touch (a zero
+    column of the Jacobian: the moments' scale before the arc reaches the impulse that
+    shows it, the attitude before the first fix) are held where they are."""
+    _, J0 = residuals(model, x0, data, True)
+    norms = np.linalg.norm(J0, axis=0)
+    active = norms > 1e-12 * max(float(norms.max()), 1e-300)
+    if not np.any(active):
+        return x0
 
-    def jac(x):
-        return residuals(model, x, data, True)[1]
+    def full(z):
+        x = x0.copy()
+        x[active] = z
+        return x
+
+    def fun(z):
+        return residuals(model, full(z), data, False)
+
+    def jac(z):
+        return residuals(model, full(z), data, True)[1][:, active]
 
     result = least_squares(
         fun,
-        x0,
+        x0[active],
         jac,
         method="trf",
         loss="soft_l1" if robust else "linear",
@@ -171,7 +185,7 @@ def _solve(model, x0, data: Data, robust: bool, max_nfev: int = 100):
         x_scale="jac",
         max_nfev=max_nfev,
     )
-    return result.x
+    return full(result.x)
 
 
 def _rms(r: NDArray[np.float64]) -> float:
