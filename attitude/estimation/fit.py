@@ -51,6 +51,8 @@ RATIO_LIMIT = 0.10
 SCALE_LIMIT = 0.10
 AXES_LIMIT_RAD = math.radians(10.0)
 DEFAULT_HORIZON_DEG = 10.0
+# Rates beyond this are refused: their squares (Euler's equations) leave the float range.
+MAX_RATE = 1e100
 
 
 @dataclass
@@ -301,6 +303,13 @@ def fit_spin_state(
     local minima, a parameter the data leave undetermined.
     """
     telemetry = prepare_telemetry(times, angular_velocity, quaternions, source)
+    if telemetry.gyro is not None:
+        fastest = float(np.max(np.abs(telemetry.gyro.values)))
+        if fastest > MAX_RATE:
+            raise InputError(
+                f"{source}: angular_velocity reaches {fastest:.3g} rad/s: beyond what a fit "
+                f"can handle (up to {MAX_RATE:g} rad/s: Euler's equations square the rates)"
+            )
     notes = list(telemetry.notes)
     data, noise = _data(telemetry, gyro_sigma, attitude_sigma)
     _refuse_without_motion(telemetry, data)
@@ -598,12 +607,13 @@ def _result(
         values.append(J[order[0]])
         rows.append(J[order[0]] * lnJ_d[order[0]])
     w = L.block("w")
+    ω0 = model.rate(x)
     for k, axis in enumerate("xyz"):
         names.append(f"omega_{axis}")
         units.append("rad/s")
-        values.append(x[w][k])
+        values.append(ω0[k])
         row = np.zeros(x.size)
-        row[w.start + k] = 1.0
+        row[w.start + k] = model.rate_unit
         rows.append(row)
     A = model.axes(x).as_matrix()
     for block, label, transform in (("θ", "attitude", np.eye(3)), ("α", "axes", A)):
@@ -647,7 +657,7 @@ def _result(
         principal_moments_sigma=moments_sigma,
         principal_axes=axes_rows,
         principal_axes_sigma=axes_sigma,
-        angular_velocity=x[w].copy(),
+        angular_velocity=ω0,
         angular_velocity_sigma=np.array([σ_y[index[f"omega_{a}"]] for a in "xyz"]),
         attitude=attitude,
         attitude_sigma=attitude_sigma,

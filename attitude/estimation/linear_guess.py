@@ -45,6 +45,8 @@ class Rates:
     ω: NDArray[np.float64]
     ω_dot: NDArray[np.float64]
     source: str  # "gyro" or "quaternions"
+    W: float  # the typical rate, rad/s
+    ω_dot_scaled: NDArray[np.float64]  # ω̇ / W², computed without underflow
 
 
 @dataclass(frozen=True)
@@ -70,7 +72,7 @@ def measured_rates(telemetry: Telemetry, breaks: tuple[float, ...] = ()) -> Rate
     """Body rates and ω̇ from the gyro (or, without one, from dense quaternions), over
     each evenly sampled run long enough for the filter, the runs cut at ``breaks``
     (the times of impulses, where the rates jump); None if no run is."""
-    t_parts, ω_parts, dω_parts = [], [], []
+    t_parts, ω_parts, dω_parts, scaled_parts = [], [], [], []
     if telemetry.gyro is not None and len(telemetry.gyro) >= 7:
         t, ω, source = telemetry.gyro.t, telemetry.gyro.values, "gyro"
     elif telemetry.attitude is not None and len(telemetry.attitude) >= 8:
@@ -82,7 +84,9 @@ def measured_rates(telemetry: Telemetry, breaks: tuple[float, ...] = ()) -> Rate
         ω, source = increments / dt[:, None], "quaternions"
     else:
         return None
-    speed = float(np.median(np.linalg.norm(ω, axis=1)))
+    # |ω| within a factor √3, and no square to underflow (a norm of 1e-200 rad/s is 0).
+    speed = float(np.median(np.max(np.abs(ω), axis=1)))
+    W = speed or 1.0
     runs = []
     for run in _uniform_runs(t):
         cuts = [run.start, *(int(np.searchsorted(t, b)) for b in breaks), run.stop]
@@ -99,9 +103,18 @@ def measured_rates(telemetry: Telemetry, breaks: tuple[float, ...] = ()) -> Rate
         t_parts.append(t[run])
         ω_parts.append(savgol_filter(ω[run], w, 3, axis=0))
         dω_parts.append(savgol_filter(ω[run], w, 3, deriv=1, delta=dt, axis=0))
+        # d(ω/W)/d(t W) = ω̇/W²: of order one whatever the units.
+        scaled_parts.append(savgol_filter(ω[run] / W, w, 3, deriv=1, delta=dt * W, axis=0))
     if not t_parts:
         return None
-    return Rates(np.concatenate(t_parts), np.concatenate(ω_parts), np.concatenate(dω_parts), source)
+    return Rates(
+        np.concatenate(t_parts),
+        np.concatenate(ω_parts),
+        np.concatenate(dω_parts),
+        source,
+        W,
+        np.concatenate(scaled_parts),
+    )
 
 
 def _principal_rows(ω: NDArray[np.float64], dω: NDArray[np.float64]) -> NDArray[np.float64]:
@@ -151,13 +164,17 @@ def candidates(
             "needs runs of 7 or more evenly spaced gyro readings or 8 quaternions close enough "
             "to differentiate): give a guess (an EulerSolver or an earlier fit)"
         )
-    ω, dω = rates.ω, rates.ω_dot
+    # Euler's equations are homogeneous of degree 2 in (ω, ω̇/W): scaled by the typical
+    # rate W, the rows are of order one whatever the units (no underflow or overflow).
+    ω, dω = rates.ω / rates.W, rates.ω_dot_scaled
     rows = _tensor_rows(ω, dω) if principal_axes else _principal_rows(ω, dω)
+    if not np.all(np.isfinite(rows)):
+        raise InputError(f"{telemetry.source}: the rates' products overflow: rates too large")
     scale = np.linalg.norm(rows, axis=0)
     scale[scale == 0.0] = 1.0
     _, s, Vt = np.linalg.svd(rows / scale, full_matrices=False)
     null = Vt / scale  # rows: singular vectors in the original units
-    ω0 = ω[0]
+    ω0 = rates.ω[0]
     guesses: list[tuple[NDArray[np.float64], Rotation, str]] = []
 
     def add(vector: NDArray[np.float64], label: str) -> None:

@@ -5,7 +5,9 @@ Parameters (the vector ``x``, in this order; each block present or not, ``Layout
 
 - ``θ`` (3): the attitude at t = 0, body → ICRF, as Q0 = Q_ref exp([θ]×) (body axes);
   only when attitude quaternions are fitted (gyro rates alone cannot see it);
-- ``w`` (3): the body angular velocity at t = 0, rad/s, in the telemetry's body axes;
+- ``w`` (3): the body angular velocity at t = 0 in the telemetry's body axes, in units
+  of ``rate_unit`` (a power of two near the rate: every parameter is then of order one,
+  whatever the units of the telemetry);
 - ``ρ`` (2): the logarithms of the second and third principal moments over the first,
   J = e^σ (1, e^ρ2, e^ρ3) along the principal axes;
 - ``σ`` (1): the logarithm of the first moment in kg m², only when the absolute moments
@@ -138,16 +140,19 @@ class ExactModel:
     impulses: tuple[Impulse, ...] = ()
     Q_ref: Rotation = field(default_factory=Rotation.identity)
     A_ref: Rotation = field(default_factory=Rotation.identity)
+    rate_unit: float = 1.0  # rad/s
 
     # ------------------------------------------------------------------ parameters
 
     def start(self, moments: NDArray[np.float64], axes: Rotation, ω0, attitude) -> tuple:
         """(model, x) for a start: moments along the principal axes ``axes``
         (principal → body), body rate ω0 and attitude (None without quaternions)."""
-        model = replace(self, Q_ref=attitude or Rotation.identity(), A_ref=axes)
+        largest = float(np.max(np.abs(ω0)))
+        unit = 2.0 ** round(np.log2(largest)) if largest > 0.0 else 1.0
+        model = replace(self, Q_ref=attitude or Rotation.identity(), A_ref=axes, rate_unit=unit)
         x = np.zeros(self.layout.size)
         L = self.layout
-        x[L.block("w")] = ω0
+        x[L.block("w")] = ω0 / unit
         x[L.block("ρ")] = np.log(moments[1:] / moments[0])
         if L.scale:
             x[L.block("σ")] = np.log(moments[0])
@@ -166,6 +171,10 @@ class ExactModel:
             A_ref = A_ref * Rotation.from_rotvec(x[L.block("α")])
             x[L.block("α")] = 0.0
         return replace(self, Q_ref=Q_ref, A_ref=A_ref), x
+
+    def rate(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
+        """The body angular velocity at t = 0, rad/s."""
+        return x[self.layout.block("w")] * self.rate_unit
 
     def moments(self, x: NDArray[np.float64]) -> NDArray[np.float64]:
         """J along the principal axes (kg m² with a scale, else in units of J1)."""
@@ -188,7 +197,7 @@ class ExactModel:
         """The motion up to the first impulse as an ``EulerSolver`` at t = 0, in the
         telemetry's body axes (a full tensor when the principal axes are rotated)."""
         J, R = self.moments(x), self.axes(x).as_matrix()
-        ω0 = x[self.layout.block("w")]
+        ω0 = self.rate(x)
         if np.array_equal(R, np.eye(3)):
             return EulerSolver(J, J * ω0, self.initial_attitude(x))
         tensor = R @ np.diag(J) @ R.T
@@ -204,7 +213,7 @@ class ExactModel:
         J = self.moments(x)
         A = self.axes(x)
         Ar = A.as_matrix()
-        ω_p = Ar.T @ x[L.block("w")]
+        ω_p = Ar.T @ self.rate(x)
         m_p = J * ω_p
         Q_p = self.initial_attitude(x) * A
         D = np.zeros((9, n))
@@ -215,7 +224,7 @@ class ExactModel:
             dlnJ[:, L.block("σ").start] = 1.0
         dJ = J[:, None] * dlnJ
         D[6:9] = dJ
-        D[3:6, L.block("w")] = J[:, None] * Ar.T
+        D[3:6, L.block("w")] = J[:, None] * Ar.T * self.rate_unit
         D[3:6] += ω_p[:, None] * dJ
         if L.attitude:
             D[0:3, L.block("θ")] = Ar.T @ right_jacobian(x[L.block("θ")])

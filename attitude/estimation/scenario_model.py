@@ -33,8 +33,8 @@ from attitude.trajectory.trajectory import Trajectory, propagate
 
 __all__ = ["ScenarioModel"]
 
-# Forward-difference steps: of the rotation vectors and logarithms (1), and of the
-# rates relative to their size.
+# Forward-difference step: the parameters are all of order one (rotation vectors,
+# logarithms, rates in units of their size).
 _STEP = 1e-7
 
 
@@ -62,9 +62,7 @@ class ScenarioModel(ExactModel):
         R = A.as_matrix()
         tensor = R @ np.diag(J) @ R.T
         inertia = J if np.array_equal(R, np.eye(3)) else 0.5 * (tensor + tensor.T)
-        state = InitialState(
-            self.initial_attitude(x), angular_velocity=x[self.layout.block("w")].copy()
-        )
+        state = InitialState(self.initial_attitude(x), angular_velocity=self.rate(x))
         events = [
             AngularImpulse(time_from_tt_seconds(self.epoch, i.t), i.vector, i.frame)
             for i in self.impulses
@@ -106,10 +104,8 @@ class ScenarioModel(ExactModel):
             rates.dω = np.empty((*rates.ω.shape, n))
         if attitude.attitude is not None:
             attitude.dθ = np.empty((len(attitude.attitude), 3, n))
-        w = self.layout.block("w")
-        scale = float(np.max(np.abs(x[w]))) or 1.0
         for k in range(n):
-            h = _STEP * (scale if w.start <= k < w.stop else 1.0)
+            h = _STEP  # every parameter is of order one (model.py)
             shifted = x.copy()
             shifted[k] += h
             r, a = self._values(shifted, t_rates, t_attitude, end)

@@ -36,6 +36,7 @@ from scipy.spatial.transform import Rotation
 
 from attitude.base.errors import InputError
 from attitude.estimation.model import left_jacobian_inverse
+from attitude.estimation.statistics import covariance
 
 __all__ = [
     "OUTLIER_SIGMA",
@@ -204,7 +205,7 @@ def _next_end(model, x, data: Data, arc: Data, t_end: float) -> tuple[float, flo
     longer, and reaching the next sample), and the predicted 1σ there if that sample
     lies beyond what the covariance predicts (a gap bridged)."""
     r, J = residuals(model, x, arc, True)
-    cov = np.linalg.pinv(J.T @ J) * max(1.0, _rms(r) ** 2)
+    cov = covariance(J)[0] * max(1.0, _rms(r) ** 2)
     times = data.times
     t_first, t_last = float(times[0]), float(times[-1])
     length = max(t_end - t_first, 1e-9)

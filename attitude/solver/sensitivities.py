@@ -285,9 +285,17 @@ class _Elliptic:
         self.case_ii = case_ii
         self.axis = 2 if case_ii else 0  # the preferred axis a (carries dn), ≥ 0
         # Inputs as jets: the gradient of m_k (preferred) is row k of S in the m0
-        # columns; that of I_k is the unit vector of the body axis order[k].
+        # columns; that of I_k is the unit vector of the body axis order[k].  The
+        # momentum is carried divided by a power of two near |m| (exact), so that its
+        # squares neither underflow nor overflow: the rate λ and the ψ rate are scaled
+        # back below, the rest of the formula is homogeneous of degree zero in m.
         eye = np.eye(_P)
-        m1, m2, m3 = (_constant(S[k] @ m0, np.concatenate([S[k], np.zeros(3)])) for k in range(3))
+        G_value = math.hypot(*m0)
+        self.scale = 2.0 ** round(math.log2(G_value)) if G_value > 0.0 else 1.0
+        m1, m2, m3 = (
+            _constant(S[k] @ m0 / self.scale, np.concatenate([S[k] / self.scale, np.zeros(3)]))
+            for k in range(3)
+        )
         I1, I2, I3 = (_constant(J[order[k]], eye[3 + order[k]]) for k in range(3))
         self.m_pref0 = np.array([m1.v, m2.v, m3.v])
         self.I = (I1, I2, I3)
@@ -326,6 +334,8 @@ class _Elliptic:
             self.ψ_rate = G / I3
             self.κ_sign = -1.0
             sin_ν, cos_ν = m2 / B2, m3 / B31
+        self.λ = self.λ * self.scale
+        self.ψ_rate = self.ψ_rate * self.scale
         self.G, self.B13, self.B31, self.B2 = G, B13, B31, B2
         self.K = float(complete_first_kind(mc))
         self.m = 1.0 - mc  # the parameter, as a float (only multiplies)
@@ -360,8 +370,8 @@ class _Elliptic:
         return φ_d, sn, cn, dn
 
     def _momentum(self, τ: NDArray[np.float64]):
-        """The momentum in the preferred axes as three jets over the samples, with
-        what the attitude needs of the phase."""
+        """The momentum in the preferred axes, divided by ``scale``, as three jets over
+        the samples, with what the attitude needs of the phase."""
         u, j, r, sn_r, cn_r, dn_r = self._phase(τ)
         φ_d, sn, cn, dn = self._amplitude(u, j, sn_r, cn_r, dn_r)
         m = self.m
@@ -378,7 +388,7 @@ class _Elliptic:
     def momentum_gradient(self, τ: NDArray[np.float64]) -> NDArray[np.float64]:
         """(N, 3, 6): ∂m_body(t)/∂(m0, J)."""
         components, _ = self._momentum(τ)
-        d_pref = np.stack([c.d for c in components], axis=1)  # (N, 3, 6)
+        d_pref = self.scale * np.stack([c.d for c in components], axis=1)  # (N, 3, 6)
         return np.einsum("ki,nkp->nip", self.S, d_pref)  # body = Sᵀ preferred
 
     def _angle(self, τ: NDArray[np.float64], phase) -> NDArray[np.float64]:
