@@ -32,6 +32,7 @@ from scipy.signal import savgol_filter
 from scipy.spatial.transform import Rotation
 
 from attitude.base.errors import InputError
+from attitude.environment.timescales import SAME_INSTANT_S
 from attitude.estimation.telemetry import Telemetry, _uniform_runs
 
 __all__ = ["Guess", "Rates", "candidates", "measured_rates"]
@@ -89,7 +90,11 @@ def measured_rates(telemetry: Telemetry, breaks: tuple[float, ...] = ()) -> Rate
     W = speed or 1.0
     runs = []
     for run in _uniform_runs(t):
-        cuts = [run.start, *(int(np.searchsorted(t, b)) for b in breaks), run.stop]
+        cuts = [
+            run.start,
+            *(int(np.searchsorted(t, b - SAME_INSTANT_S)) for b in breaks),
+            run.stop,
+        ]
         cuts = sorted(c for c in set(cuts) if run.start <= c <= run.stop)
         runs += [slice(a, b) for a, b in itertools.pairwise(cuts) if b > a]
     for run in runs:
@@ -241,21 +246,28 @@ def impulse_scale(
     telemetry: Telemetry, moments: NDArray[np.float64], axes: Rotation, impulses, attitude
 ) -> float | None:
     """The first moment I1 (kg m²) that makes the measured jumps of the rates at known
-    impulses match Δω = I⁻¹ ΔH for the guessed ratios: a linear least squares in 1/I1
-    on the rates extrapolated to each impulse from either side; None if no jump is
-    measured.  ``attitude``: Q(0) and a rough Q(t) (for impulses in inertial axes)."""
-    rates = measured_rates(telemetry, tuple(i.t for i in impulses))
-    if rates is None:
+    impulses match Δω = I⁻¹ ΔH for the guessed ratios: a linear least squares in 1/I1,
+    with each side's rate at the impulse from a quadratic through its five nearest gyro
+    readings; None without a gyro reading on both sides.  ``attitude``: a rough Q(t)
+    (for impulses in inertial axes), or None."""
+    gyro = telemetry.gyro
+    if gyro is None:
         return None
     a_rows, jumps = [], []
     for impulse in impulses:
-        before = np.flatnonzero(rates.t < impulse.t)
-        after = np.flatnonzero(rates.t >= impulse.t)
-        if before.size == 0 or after.size == 0:
+        sides = []
+        at = impulse.t - SAME_INSTANT_S  # a reading a nanosecond before is after it
+        for mask in (gyro.t < at, gyro.t >= at):
+            index = np.flatnonzero(mask)
+            nearest = index[np.argsort(np.abs(gyro.t[index] - impulse.t))[:5]]
+            if nearest.size < 3:
+                break
+            τ = gyro.t[nearest] - impulse.t
+            design = np.stack([np.ones_like(τ), τ, τ * τ], axis=1)
+            coefficients, *_ = np.linalg.lstsq(design, gyro.values[nearest], rcond=None)
+            sides.append(coefficients[0])  # the quadratic's value at the impulse
+        if len(sides) < 2:
             continue
-        b, c = before[-1], after[0]
-        ω_before = rates.ω[b] + rates.ω_dot[b] * (impulse.t - rates.t[b])
-        ω_after = rates.ω[c] + rates.ω_dot[c] * (impulse.t - rates.t[c])
         ΔH = impulse.vector
         if impulse.frame != "body":
             if attitude is None:
@@ -263,7 +275,7 @@ def impulse_scale(
             ΔH = attitude(impulse.t).inv().apply(ΔH)
         # In principal axes: Δω_p = ΔH_p / (I1 r), r the ratios.
         a_rows.append(axes.inv().apply(ΔH) / moments)
-        jumps.append(axes.inv().apply(ω_after - ω_before))
+        jumps.append(axes.inv().apply(sides[1] - sides[0]))
     if not a_rows:
         return None
     a, Δω = np.concatenate(a_rows), np.concatenate(jumps)

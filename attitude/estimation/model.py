@@ -35,6 +35,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
+from attitude.environment.timescales import SAME_INSTANT_S
 from attitude.solver.euler_solver import EulerSolver
 from attitude.solver.sensitivities import flow_sensitivities, skew
 
@@ -250,7 +251,9 @@ class ExactModel:
         rates, attitudes = Prediction(), Prediction()
         pieces = {"rates": [], "attitude": []}
         events = sorted(self.impulses, key=lambda i: i.t)
-        bounds = [-np.inf] + [e.t for e in events] + [np.inf]
+        # A sample within a nanosecond before an impulse is at it, and after it (the
+        # scenarios' rule: an epoch's outputs are the post-event state).
+        bounds = [-np.inf] + [e.t - SAME_INSTANT_S for e in events] + [np.inf]
         t0 = 0.0
         for k in range(len(bounds) - 1):
             solver = EulerSolver(J, m_p, Q_p, t0)

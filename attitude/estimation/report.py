@@ -303,12 +303,11 @@ def _residuals_csv(fit: SpinStateFit, path: Path) -> None:
         "sensor,t_s,residual_x,residual_y,residual_z,normalized_x,normalized_y,normalized_z,inlier",
     ]
     for sensor, block in fit.residuals.items():
-        for t, r, z, ok in zip(
-            block["t"], block["residual"], block["normalized"], block["inlier"], strict=True
-        ):
-            lines.append(
-                f"{sensor},{t!r},{r[0]!r},{r[1]!r},{r[2]!r},{z[0]:.6g},{z[1]:.6g},{z[2]:.6g},{int(ok)}"
-            )
+        rows = zip(block["t"], block["residual"], block["normalized"], block["inlier"], strict=True)
+        for t, r, z, ok in rows:
+            values = ",".join(repr(float(v)) for v in (t, *r))
+            normalized = ",".join(f"{float(v):.6g}" for v in z)
+            lines.append(f"{sensor},{values},{normalized},{int(ok)}")
     path.write_text("\n".join(lines) + "\n", encoding="utf-8")
 
 

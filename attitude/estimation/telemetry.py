@@ -141,7 +141,7 @@ def _sensor(
             k = int(same[~equal][0])
             raise InputError(
                 f"{source}: rows {int(order[k])} and {int(order[k + 1])} give {name} at the same "
-                f"time ({ts[k]!r} s) with different values, {vs[k].tolist()} and "
+                f"time ({float(ts[k])!r} s) with different values, {vs[k].tolist()} and "
                 f"{vs[k + 1].tolist()}: a stuck clock? Remove one of them"
             )
         keep = np.ones(ts.size, dtype=bool)

@@ -374,6 +374,18 @@ def _aem(path: Path) -> TelemetryFile:
         rates.append(ω)
     from astropy.time import Time
 
+    from attitude.environment.timescales import SAME_INSTANT_S, tt_seconds
+
+    notes = []
+    for k in range(len(times) - 1):  # segments that meet: the later one is in force
+        if (
+            len(times[k])
+            and abs(float(tt_seconds(times[k + 1][0], times[k][-1]))) <= SAME_INSTANT_S
+        ):
+            times[k], quats[k], rates[k] = times[k][:-1], quats[k][:-1], rates[k][:-1]
+            notes.append(
+                f"segments {k} and {k + 1} meet: the record of segment {k + 1} is used there"
+            )
     with offline_time():  # the segments' epochs as one Time, exactly (two-part TT dates)
         tt = [t.tt for t in times]
         all_times = Time(
@@ -383,7 +395,7 @@ def _aem(path: Path) -> TelemetryFile:
             scale="tt",
         )
     ω_all = np.concatenate(rates)
-    notes = [f"{len(message.segments)} AEM segment(s), {len(ω_all)} records"]
+    notes.insert(0, f"{len(message.segments)} AEM segment(s), {len(ω_all)} records")
     has_rates = bool(np.any(np.isfinite(ω_all[:, 0])))
     return TelemetryFile(
         path, all_times, ω_all if has_rates else None, np.concatenate(quats), notes
