@@ -10,7 +10,7 @@ import pytest
 from fit_cases import BODIES, Q0, Body, _separatrix_rate
 from scipy.spatial.transform import Rotation
 
-from attitude import AngularImpulse, EulerSolver, fit_spin_state
+from attitude import AngularImpulse, EulerSolver, FitRefused, fit_spin_state
 
 
 def _close(value, truth, sigma, k=5.0):
@@ -153,3 +153,20 @@ def test_attitude_fixes_days_apart_from_an_earlier_fit():
     _close(fit.inertia_ratios[1:], body.ratios[1:], fit.inertia_ratios_sigma[1:])
     assert np.all(fit.inertia_ratios_sigma[1:] < 0.7 * first.inertia_ratios_sigma[1:])
     assert fit.horizon() > 20.0 * first.horizon()
+
+
+def test_a_gyro_bias_is_estimated_when_asked():
+    """A bias of 50 σ on each axis: without gyro_bias the motion is no rigid body's (refused,
+    or residuals far above the noise); with it, the bias and the ratios come back."""
+    body = BODIES["generic"]
+    rng = np.random.default_rng(9)
+    bias = 50.0 * body.gyro_sigma * np.array([1.0, -0.6, 0.4])
+    ω = body.gyro(rng) + bias
+    try:
+        unbiased = fit_spin_state(body.times, angular_velocity=ω, gyro_sigma=body.gyro_sigma)
+        assert unbiased.reduced_chi2 > 1.5
+    except FitRefused:
+        pass
+    fit = fit_spin_state(body.times, angular_velocity=ω, gyro_sigma=body.gyro_sigma, gyro_bias=True)
+    _close(fit.gyro_bias, bias, fit.gyro_bias_sigma)
+    _assert_fit(fit, body)

@@ -1,7 +1,8 @@
 """``attitude fit``: the spin state and inertia ratios fitted to a telemetry file.
 
     attitude fit TELEMETRY --out DIR [--gyro-sigma "1e-4 rad/s"] [--attitude-sigma "5 arcsec"]
-                 [--principal-axes] [--scenario FILE.toml] [--time-scale utc] [--epoch ISO]
+                 [--principal-axes] [--gyro-bias] [--scenario FILE.toml] [--time-scale utc]
+                 [--epoch ISO]
 
 TELEMETRY is a CSV, Parquet or CCSDS AEM file (attitude.estimation.telemetry_files).
 ``--scenario`` names a scenario file of the spacecraft whose orbit (``[pointing]``),
@@ -46,6 +47,7 @@ def add_parser(commands) -> None:
         action="store_true",
         help="also estimate the principal axes in the telemetry's body axes (a misaligned sensor)",
     )
+    fit.add_argument("--gyro-bias", action="store_true", help="also estimate a constant gyro bias")
     fit.add_argument(
         "--scenario",
         type=Path,
@@ -161,6 +163,7 @@ def command(args: argparse.Namespace) -> int:
             gyro_sigma=gyro_sigma,
             attitude_sigma=attitude_sigma,
             principal_axes=args.principal_axes,
+            gyro_bias=args.gyro_bias,
             impulses=impulses or (),
             torques=torques,
             source=args.telemetry.name,

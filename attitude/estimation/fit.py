@@ -79,6 +79,8 @@ class SpinStateFit:
     principal_axes_sigma: NDArray[np.float64] | None  # rad, body axes, when estimated
     angular_velocity: NDArray[np.float64]  # body, rad/s at t = 0
     angular_velocity_sigma: NDArray[np.float64]
+    gyro_bias: NDArray[np.float64] | None  # rad/s, body axes, when estimated
+    gyro_bias_sigma: NDArray[np.float64] | None
     attitude: Rotation | None  # body → ICRF at t = 0, when observable
     attitude_sigma: NDArray[np.float64] | None  # rad, body axes
     parameter_names: list[str]
@@ -224,6 +226,14 @@ class SpinStateFit:
                 for v, e in zip(self.angular_velocity, self.angular_velocity_sigma, strict=True)
             ),
         ]
+        if self.gyro_bias is not None and self.gyro_bias_sigma is not None:
+            lines.append(
+                "gyro bias (body, rad/s): "
+                + ", ".join(
+                    f"{v:.6g} ± {e:.2g}"
+                    for v, e in zip(self.gyro_bias, self.gyro_bias_sigma, strict=True)
+                )
+            )
         if self.principal_moments is not None and self.principal_moments_sigma is not None:
             lines.append(
                 "principal moments (kg m²): "
@@ -261,6 +271,7 @@ def fit_spin_state(
     gyro_sigma: Any = None,
     attitude_sigma: Any = None,
     principal_axes: bool = False,
+    gyro_bias: bool = False,
     impulses: Any = (),
     guess: Any = None,
     torques: Any = None,
@@ -284,6 +295,10 @@ def fit_spin_state(
     principal_axes
         Also estimate the principal axes in the telemetry's body axes (a misaligned
         gyro or star tracker); otherwise the body axes are taken as principal.
+    gyro_bias
+        Also estimate a constant gyro bias (rad/s, body axes), which the rates then
+        have subtracted; otherwise the gyro is taken as unbiased (a bias then shows as
+        residuals above the noise, and the fit is refused).
     impulses
         Known angular impulses in the arc: ``attitude.AngularImpulse`` events (epoch a
         ``Time``, or seconds from the first sample), body or inertial.  They make the
@@ -315,10 +330,13 @@ def fit_spin_state(
     _refuse_without_motion(telemetry, data)
     impulse_list = _impulses(impulses, telemetry)
     has_burns = torques is not None and bool(getattr(torques, "burns", ()))
+    if gyro_bias and telemetry.gyro is None:
+        raise InputError(f"{source}: gyro_bias needs gyro rates")
     layout = Layout(
         attitude=telemetry.attitude is not None,
         scale=bool(impulse_list) or has_burns,
         axes=bool(principal_axes),
+        bias=bool(gyro_bias),
     )
     if any(i.frame != "body" for i in impulse_list) and not layout.attitude:
         raise InputError(
@@ -616,7 +634,8 @@ def _result(
         row[w.start + k] = model.rate_unit
         rows.append(row)
     A = model.axes(x).as_matrix()
-    for block, label, transform in (("θ", "attitude", np.eye(3)), ("α", "axes", A)):
+    blocks = (("θ", "attitude", np.eye(3)), ("α", "axes", A))
+    for block, label, transform in blocks:
         part = L.block(block)
         if part.stop == part.start:
             continue
@@ -626,6 +645,15 @@ def _result(
             values.append(0.0)
             row = np.zeros(x.size)
             row[part] = transform[k]
+            rows.append(row)
+    if L.bias:
+        bias = x[L.block("b")] * model.rate_unit
+        for k, axis in enumerate("xyz"):
+            names.append(f"gyro_bias_{axis}")
+            units.append("rad/s")
+            values.append(bias[k])
+            row = np.zeros(x.size)
+            row[L.block("b").start + k] = model.rate_unit
             rows.append(row)
     G = np.array(rows)
     cov_y = G @ cov_x @ G.T
@@ -659,6 +687,8 @@ def _result(
         principal_axes_sigma=axes_sigma,
         angular_velocity=ω0,
         angular_velocity_sigma=np.array([σ_y[index[f"omega_{a}"]] for a in "xyz"]),
+        gyro_bias=bias if L.bias else None,
+        gyro_bias_sigma=np.array([σ_y[index[f"gyro_bias_{a}"]] for a in "xyz"]) if L.bias else None,
         attitude=attitude,
         attitude_sigma=attitude_sigma,
         parameter_names=names,

@@ -14,7 +14,9 @@ Parameters (the vector ``x``, in this order; each block present or not, ``Layout
   are observable (a known angular impulse or burn in the arc); otherwise J1 = 1 and the
   moments are in units of the first;
 - ``α`` (3): the principal axes, A = A_ref exp([α]×) taking principal to body axes,
-  only when the fit estimates them (a misaligned gyro or star tracker).
+  only when the fit estimates them (a misaligned gyro or star tracker);
+- ``b`` (3): a constant gyro bias, in units of ``rate_unit``, added to the predicted
+  rates, only when the fit estimates it.
 
 Logarithms keep the moments positive; a rotation vector about a reference that the fit
 moves between its stages (``recentred``) keeps the attitude and the axes away from
@@ -90,10 +92,11 @@ class Layout:
     attitude: bool
     scale: bool
     axes: bool
+    bias: bool = False
 
     @property
     def size(self) -> int:
-        return 5 + 3 * self.attitude + self.scale + 3 * self.axes
+        return 5 + 3 * self.attitude + self.scale + 3 * self.axes + 3 * self.bias
 
     def block(self, name: str) -> slice:
         start = 0
@@ -103,6 +106,7 @@ class Layout:
             ("ρ", 2, True),
             ("σ", 1, self.scale),
             ("α", 3, self.axes),
+            ("b", 3, self.bias),
         ):
             if key == name:
                 return slice(start, start + width) if present else slice(start, start)
@@ -118,6 +122,8 @@ class Layout:
             out += ["ln_J1"]
         if self.axes:
             out += ["axes_x", "axes_y", "axes_z"]
+        if self.bias:
+            out += ["bias_x", "bias_y", "bias_z"]
         return out
 
 
@@ -291,6 +297,8 @@ class ExactModel:
                     dY_all[inside] = dY
             ω_p = m_all * ω_scale
             rates.ω = ω_p @ Ar.T
+            if L.bias:  # what the gyro reads: the rate plus its bias
+                rates.ω = rates.ω + x[L.block("b")] * self.rate_unit
             if jacobian:
                 dJ = D[6:9]  # the moments do not change at an impulse
                 dω_p = (
@@ -301,6 +309,8 @@ class ExactModel:
                 if L.axes:
                     Jr_α = right_jacobian(x[L.block("α")])
                     rates.dω[:, :, L.block("α")] -= np.einsum("ij,njk,kl->nil", Ar, skew(ω_p), Jr_α)
+                if L.bias:
+                    rates.dω[:, :, L.block("b")] += np.eye(3) * self.rate_unit
         if t_attitude is not None:
             quats = np.empty((t_attitude.size, 4))
             dθ = np.empty((t_attitude.size, 3, L.size)) if jacobian else None

@@ -210,6 +210,8 @@ def _summary(fit: SpinStateFit, horizon_s: float, source: str) -> dict[str, Any]
         "principal_axes_body": fit.principal_axes,
         "angular_velocity_rad_s": fit.angular_velocity,
         "angular_velocity_sigma_rad_s": fit.angular_velocity_sigma,
+        "gyro_bias_rad_s": fit.gyro_bias,
+        "gyro_bias_sigma_rad_s": fit.gyro_bias_sigma,
         "attitude_q_body_to_icrf_wxyz": None
         if fit.attitude is None
         else fit.attitude.as_quat(scalar_first=True),

@@ -120,6 +120,8 @@ class ScenarioModel(ExactModel):
         rates, attitude = Prediction(), Prediction()
         if t_rates is not None:
             rates.ω = trajectory.angular_velocity(t_rates)
+            if self.layout.bias:
+                rates.ω = rates.ω + x[self.layout.block("b")] * self.rate_unit
         if t_attitude is not None:
             attitude.attitude = Rotation.from_quat(
                 trajectory.attitude_quaternion(t_attitude, scalar_first=False)
