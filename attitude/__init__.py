@@ -43,6 +43,7 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.environment.oem import OemOrbit
     from attitude.environment.orbit import TleOrbit
     from attitude.estimation.fit import FitRefused, SpinStateFit, fit_spin_state
+    from attitude.estimation.telemetry_files import TelemetryFile, read_telemetry
     from attitude.files.scenario_reader import load_scenario
     from attitude.laws.align_constrain import (
         AlignConstrainLaw,
@@ -79,6 +80,8 @@ _LAZY = {
     "fit_spin_state": "attitude.estimation.fit",
     "SpinStateFit": "attitude.estimation.fit",
     "FitRefused": "attitude.estimation.fit",
+    "read_telemetry": "attitude.estimation.telemetry_files",
+    "TelemetryFile": "attitude.estimation.telemetry_files",
     "TorquedSolver": "attitude.torques.solver",
     "propagate_batch": "attitude.torques.solver",
     "departure_time": "attitude.torques.solver",
@@ -161,6 +164,7 @@ __all__ = [
     "SpinStateFit",
     "SunLaw",
     "TargetLaw",
+    "TelemetryFile",
     "TleOrbit",
     "TorquedSolver",
     "Trajectory",
@@ -175,6 +179,7 @@ __all__ = [
     "pointing_samples",
     "propagate",
     "propagate_batch",
+    "read_telemetry",
     "run_montecarlo",
     "validity_horizon",
     "visible_intervals",
