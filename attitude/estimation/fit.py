@@ -63,12 +63,16 @@ class SpinStateFit:
     telemetry in relative seconds), which is t = 0 of ``solver``.  Vectors are in the
     telemetry's body axes; attitudes are body → ICRF.
 
+    ``solver`` is the fitted motion as an ``EulerSolver`` at t = 0: torque-free, and up
+    to the first known impulse; ``predict``, ``uncertainty`` and ``horizon`` follow the
+    whole fitted model (impulses, and the torques of a fit under torques).
+
     The parameters, their 1σ and ``covariance`` are listed by ``parameter_names`` (with
     ``parameter_units``): the ratios I2/I1 and I3/I1 of the principal moments sorted
     ascending; I1 (kg m²) when the absolute moments are observable; the body rate at
     t = 0; with attitude fixes, the attitude error at t = 0 (a body-axes rotation
     vector about ``attitude``); with the principal axes estimated, their error (a
-    body-axes rotation vector about ``principal_axes``).
+    body-axes rotation vector about ``principal_axes``); with a gyro bias, the bias.
     """
 
     inertia_ratios: NDArray[np.float64]  # (1, I2/I1, I3/I1)
@@ -531,9 +535,12 @@ def _starts(model, telemetry: Telemetry, guess: Any, principal_axes: bool, data:
             period = EulerSolver(g.moments, g.moments * g.axes.inv().apply(g.ω0)).period
         except InputError:
             period = math.inf
-        # Half a period of the guessed motion: short enough that its phase error stays
-        # small (the arc then grows as the covariance allows, attitude.estimation.solve).
-        first_end = t_first + (0.5 * period if math.isfinite(period) else math.inf)
+        # Half a period of the guessed motion, and at most one turn: short enough that
+        # the guess's phase errors stay small (the arc then grows as the covariance
+        # allows, attitude.estimation.solve).
+        speed = float(np.max(np.abs(g.ω0)))
+        turn = 2.0 * math.pi / speed if speed > 0.0 else math.inf
+        first_end = t_first + min(0.5 * period if math.isfinite(period) else math.inf, turn)
         starts.append((m, x, g.label, first_end))
     return starts, text
 

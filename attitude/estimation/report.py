@@ -113,9 +113,11 @@ def scenario_document(
         "quaternion": q.tolist(),
         "angular_velocity": fit.angular_velocity.tolist(),
     }
-    duration = min(
-        max(horizon_s if math.isfinite(horizon_s) else MAX_DURATION_S, end), MAX_DURATION_S
-    )
+    # Beyond the horizon search (30 arcs under torques, whose propagation costs per
+    # second of span), the span stops where the search did.
+    searched = (30.0 if getattr(fit._model, "torques", None) else 1e6) * (end - fit.span[0])
+    reach = horizon_s if math.isfinite(horizon_s) else end + searched
+    duration = min(max(reach, end), MAX_DURATION_S)
     period = fit.period if math.isfinite(fit.period) else duration
     step = min(duration / 1000.0, period / 20.0)
     document["output"] = {"duration": float(duration), "step": float(step)}
