@@ -300,3 +300,81 @@ def test_ctrl_c_leaves_nothing_behind(tmp_path):
         "attitude: error: interrupted; nothing of this run was left behind"
     )
     assert not out.exists()
+
+
+GRAVITY_GRADIENT = """
+[scenario]
+name = "tumbler under gravity gradient"
+epoch = "2027-03-01T00:00:00"
+
+[spacecraft]
+name = "tumbler"
+principal_moments = [100.0, 200.0, 260.0]
+
+[initial_state]
+quaternion = [0.9515485246437885, 0.2392983377447303, 0.18930785741199993, 0.03813457647485015]
+angular_velocity = [0.02, 0.01, 0.015]
+
+[torques]
+gravity_gradient = true
+step = 5.0
+
+[output]
+duration = 1200.0
+step = 4.0
+
+[pointing.keplerian]
+semi_major_axis = { value = 7000.0, unit = "km" }
+eccentricity = 0.0
+inclination = { value = 51.6, unit = "deg" }
+raan = { value = 0.0, unit = "deg" }
+argument_of_perigee = { value = 0.0, unit = "deg" }
+mean_anomaly = { value = 0.0, unit = "deg" }
+"""
+
+
+@pytest.mark.slow  # 8 s of CPU: the API's fit under gravity gradient runs by default
+def test_gravity_gradient_from_the_scenario_file(tmp_path):
+    """The telemetry of a run under gravity gradient (5 s step), fitted with the orbit and
+    the torques of the same file (--scenario, at 20 s): the moments' ratios come back,
+    and the fitted scenario keeps the orbit and the torques."""
+    (tmp_path / "truth.toml").write_text(GRAVITY_GRADIENT)
+    run = tmp_path / "run"
+    assert (
+        main(
+            [
+                "run",
+                str(tmp_path / "truth.toml"),
+                "--out",
+                str(run),
+                "--quiet",
+                "--formats",
+                "parquet",
+            ]
+        )
+        == 0
+    )
+    context = tmp_path / "context.toml"
+    context.write_text(GRAVITY_GRADIENT.replace("step = 5.0", "step = 20.0"))
+    out = tmp_path / "fit"
+    code = main(
+        [
+            "fit",
+            str(run / "timeseries.parquet"),
+            "--out",
+            str(out),
+            "--scenario",
+            str(context),
+            "--gyro-sigma",
+            "1e-6 rad/s",
+            "--attitude-sigma",
+            "1e-5 rad",
+            "--quiet",
+        ]
+    )
+    assert code == 0
+    summary = _fit_json(out)
+    np.testing.assert_allclose(summary["inertia_ratios"], [1.0, 2.0, 2.6], rtol=1e-4)
+    assert summary["goodness"]["reduced_chi2"] < 2.0
+    text = (out / "fitted_scenario.toml").read_text()
+    assert "gravity_gradient = true" in text and "[pointing.keplerian]" in text

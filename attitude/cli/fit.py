@@ -126,7 +126,7 @@ def _context(path: Path):
         burns=burns,
     )
     torques = scenario.torques if scenario.torques.any else None
-    return context, tuple(impulses), torques
+    return context, tuple(impulses), torques, scenario.orbit
 
 
 def command(args: argparse.Namespace) -> int:
@@ -146,9 +146,9 @@ def command(args: argparse.Namespace) -> int:
         gyro_sigma = _quantity(args.gyro_sigma, "angular_velocity", "--gyro-sigma")
         attitude_sigma = _quantity(args.attitude_sigma, "angle", "--attitude-sigma")
         claim(args.out, OUTPUT_NAMES, dry_run=True)  # a folder that is not ours: say so first
-        context = impulses = torques = None
+        context = impulses = torques = orbit = None
         if args.scenario is not None:
-            context, impulses, torques = _context(args.scenario)
+            context, impulses, torques, orbit = _context(args.scenario)
         telemetry = read_telemetry(args.telemetry, args.time_scale, args.epoch)
         if not hasattr(telemetry.times, "jd1"):
             raise InputError(
@@ -166,6 +166,7 @@ def command(args: argparse.Namespace) -> int:
             gyro_bias=args.gyro_bias,
             impulses=impulses or (),
             torques=torques,
+            orbit=orbit,
             source=args.telemetry.name,
         )
         fit.notes[:0] = telemetry.notes

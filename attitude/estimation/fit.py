@@ -279,6 +279,7 @@ def fit_spin_state(
     impulses: Any = (),
     guess: Any = None,
     torques: Any = None,
+    orbit: Any = None,
     source: str = "telemetry",
 ) -> SpinStateFit:
     """Fit the exact torque-free motion to gyro rates and/or attitude quaternions.
@@ -312,8 +313,11 @@ def fit_spin_state(
         body axes, or an earlier ``SpinStateFit``): for attitude fixes too sparse to
         differentiate.
     torques
-        A ``ScenarioTorques`` (gravity gradient on an orbit, burns) fitted through the
-        splitting (``TorquedSolver``); None for the torque-free motion.
+        A ``ScenarioTorques`` (gravity gradient, burns) fitted through the splitting
+        (``TorquedSolver``); None for the torque-free motion.
+    orbit
+        The orbit the gravity gradient acts on (``gravity_gradient=True``), as
+        ``Scenario(orbit=...)`` takes it.
     source
         The name used in messages (the file the telemetry came from).
 
@@ -354,7 +358,7 @@ def fit_spin_state(
                 f"{source}: a fit under gravity gradient (or an inertial burn) needs attitude "
                 "fixes: the torque depends on the attitude, which rates alone barely show"
             )
-    model = _model(layout, impulse_list, torques, telemetry)
+    model = _model(layout, impulse_list, torques, telemetry, orbit)
     starts, guess_text = _starts(model, telemetry, guess, principal_axes, data)
     notes.append(guess_text)
     solution = fit_from_starts(starts, data)
@@ -487,13 +491,18 @@ def _impulses(impulses: Any, telemetry: Telemetry) -> tuple[Impulse, ...]:
     return tuple(out)
 
 
-def _model(layout: Layout, impulses, torques, telemetry: Telemetry):
+def _model(layout: Layout, impulses, torques, telemetry: Telemetry, orbit=None):
     if torques is None or not getattr(torques, "any", True):
         return ExactModel(layout, impulses)
     from attitude.estimation.scenario_model import ScenarioModel
 
     return ScenarioModel(
-        layout, impulses, torques=torques, epoch=telemetry.epoch, end=telemetry.span[1]
+        layout,
+        impulses,
+        torques=torques,
+        epoch=telemetry.epoch,
+        end=telemetry.span[1],
+        orbit=orbit,
     )
 
 

@@ -45,6 +45,7 @@ class ScenarioModel(ExactModel):
     to ``end`` (s)."""
 
     torques: Any = None
+    orbit: Any = None  # the scenario's orbit, for gravity_gradient=True
     epoch: Any = None
     end: float = 0.0
     steps: list[float | None] | None = None
@@ -78,6 +79,7 @@ class ScenarioModel(ExactModel):
             events,
             duration=max(self.end, end or 0.0),
             torques=self.torques,
+            orbit=self.orbit,
         )
         trajectory = propagate(scenario, self.steps)
         if self.steps is None:  # the step chosen now is kept for every later motion
