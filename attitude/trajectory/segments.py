@@ -18,7 +18,7 @@ interpolate the motion (the AEM) end their pieces there.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -143,7 +143,7 @@ def check_resolved(segment: Segment, where: str) -> None:
 def segments(
     scenario: Scenario,
     models: list[tuple[float, float, Torque]],
-    step: float | None,
+    step: float | Sequence[float | None] | None,
     checked: bool = True,
 ) -> Iterator[tuple[Segment, str]]:
     """The segments of ``scenario`` in time order, each with the name of the state that
@@ -151,7 +151,8 @@ def segments(
     time: the next is made when it is asked for, from this one's state at its end.
 
     ``models``: the scenario's torques (``scenario_torque_models``); ``step``: the
-    torqued segments' step (s).  ``checked``: refuse a segment that turns faster than
+    torqued segments' step (s), or one per segment (None where no torque acts: a run
+    made before, rerun at its own steps).  ``checked``: refuse a segment that turns faster than
     TT seconds follow (:func:`check_resolved`) before yielding it, which propagates a
     torqued one to its end; a caller that compares runs as they go checks later.
     Errors are :class:`InputError` naming the state whose motion the solver refuses.
@@ -160,13 +161,18 @@ def segments(
     ends = [offset for offset, _ in scenario.events] + [scenario.stop_s]
     state = initial_state(scenario)
     where = "initial_state"
-    solver = _solver(state, 0.0, ends[0], where, models, step, order)
+    per_segment = (
+        list(step) if isinstance(step, list | tuple) else [step] * (len(scenario.events) + 1)
+    )
+    solver = _solver(state, 0.0, ends[0], where, models, per_segment[0], order)
     segment = Segment(0.0, ends[0], solver, state)
     if checked:
         check_resolved(segment, where)
     yield segment, where
     indices = getattr(scenario, "event_indices", range(len(scenario.events)))
-    for (offset, event), index, end in zip(scenario.events, indices, ends[1:], strict=True):
+    for k, ((offset, event), index, end) in enumerate(
+        zip(scenario.events, indices, ends[1:], strict=True), start=1
+    ):
         named = f"events[{index}] ({event.kind} at {scenario.format_epoch(offset)})"
         try:  # the segment before, propagated to its end
             before = State(solver.attitude(offset), solver.angular_momentum(offset), state.inertia)
@@ -174,7 +180,7 @@ def segments(
             raise InputError(f"{where}: {exc}") from None
         state = event.apply(before)
         where = f"the state after {named}"
-        solver = _solver(state, offset, end, where, models, step, order)
+        solver = _solver(state, offset, end, where, models, per_segment[k], order)
         segment = Segment(offset, end, solver, state, event, before)
         if checked:
             check_resolved(segment, where)

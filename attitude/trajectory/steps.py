@@ -172,7 +172,7 @@ def _growth(times: list[float], worst: list[float], until: float) -> float:
 def measure(
     scenario: Scenario,
     models: list[tuple[float, float, Torque]],
-    step: float,
+    step: float | list[float | None],
     *,
     fine: list[tuple[Segment, str]] | None = None,
     budget_s: float | None = None,
@@ -194,7 +194,10 @@ def measure(
     fine_runs: Iterator[tuple[Segment, str]] = (
         iter(fine) if fine is not None else segments(scenario, models, step, checked=False)
     )
-    coarse_runs = segments(scenario, models, 2.0 * step, checked=False)
+    coarse: float | list[float | None] = (
+        [None if h is None else 2.0 * h for h in step] if isinstance(step, list) else 2.0 * step
+    )
+    coarse_runs = segments(scenario, models, coarse, checked=False)
     done: list[tuple[Segment, str]] = []
     done_steps = 0
     per_segment: list[float | None] = []
@@ -205,7 +208,9 @@ def measure(
     def result(ended: str, until: float, steps: int) -> Measurement:
         growth = _growth(times, envelope, until) if ended != "span" else 1.0
         found = Measurement(
-            step,
+            max((h for h in step if h is not None), default=0.0)
+            if isinstance(step, list)
+            else step,
             worst,
             until,
             scenario.stop_s,

@@ -47,13 +47,19 @@ _SPAN_TOLERANCE_S = SAME_INSTANT_S
 _CHECK_TRAJECTORY_S = 1.0
 
 
-def propagate(scenario: Scenario, *, check: bool = False) -> Trajectory:
+def propagate(
+    scenario: Scenario, steps: list[float | None] | None = None, *, check: bool = False
+) -> Trajectory:
     """The motion of ``scenario`` over [epoch, stop], through its events.
 
     Without torques, the exact solver between events.  Under torques
     (``attitude.scenario.torques``), the torqued segments at ``[torques] step``, or at
     the step chosen for ``[torques] accuracy`` so that the run's estimated error meets
     it (``attitude.trajectory.steps``): :attr:`Trajectory.steps` says how.
+
+    ``steps``: per segment, the torqued step to use (None where no torque acts), as
+    a run made before chose them (``[s.solver.step for s in trajectory.segments]``): the
+    same motion again, for a fit that varies the state and not the method.
 
     ``check``: what ``attitude check`` needs, within seconds: the search (or, with a
     given step, the run's estimate) within check's CPU budget; when that does not
@@ -68,6 +74,17 @@ def propagate(scenario: Scenario, *, check: bool = False) -> Trajectory:
     if not models:
         return Trajectory(scenario, list(segments(scenario, models, None)))
     settings = scenario.torques
+    if steps is not None:
+        given = [h for h in steps if h is not None]
+        choice = RunSteps(
+            max(given, default=0.0),
+            settings.order,
+            True,
+            None,
+            grid_steps=sum(predicted_steps(scenario, models, h) for h in set(given)),
+        )
+        run = list(segments(scenario, models, list(steps)))
+        return Trajectory(scenario, run, choice, given_steps=list(steps))
     if settings.step is not None:
         step = float(settings.step)
         choice = RunSteps(
@@ -112,6 +129,7 @@ class Trajectory:
         run: list[tuple[Segment, str]],
         steps: RunSteps | None = None,
         approximate_step_s: float | None = None,
+        given_steps: list[float | None] | None = None,
     ) -> None:
         self.scenario = scenario
         self.segments = [segment for segment, _ in run]
@@ -120,6 +138,7 @@ class Trajectory:
         self.steps = steps
         # Set when `attitude check` propagated at a longer step than the run's.
         self.approximate_step_s = approximate_step_s
+        self._given_steps = given_steps  # per segment, when propagate was given them
         if steps is not None and steps.measurement is not None:
             self._share_estimates(steps)
         # Segment k is in force from _starts[k] on (an event's epoch gets its post-event state).
@@ -243,7 +262,8 @@ class Trajectory:
         if found is not None and (found.complete or self.approximate or not steps.settled):
             return steps
         models = scenario_torque_models(self.scenario)
-        found, _ = measure(self.scenario, models, steps.step_s, fine=self._named)
+        step = steps.step_s if self._given_steps is None else self._given_steps
+        found, _ = measure(self.scenario, models, step, fine=self._named)
         steps = replace(
             steps,
             measurement=found,
