@@ -83,8 +83,8 @@ def propagate(
             None,
             grid_steps=sum(predicted_steps(scenario, models, h) for h in set(given)),
         )
-        run = list(segments(scenario, models, list(steps)))
-        return Trajectory(scenario, run, choice, given_steps=list(steps))
+        again = list(segments(scenario, models, list(steps)))
+        return Trajectory(scenario, again, choice, given_steps=list(steps))
     if settings.step is not None:
         step = float(settings.step)
         choice = RunSteps(
