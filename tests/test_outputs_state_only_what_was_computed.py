@@ -98,3 +98,21 @@ def test_check_says_one_body_vector(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "1 body vector," in out and "1 body vectors" not in out
     assert re.search(r"run cost +about [\d.]+ (s|min|h) of CPU", out), out
+
+
+def test_a_survey_read_in_chunks_finds_the_same_flips_and_rate(tmp_path, monkeypatch):
+    """A survey too long to keep is read a chunk at a time, in bounded memory: the same
+    flips and the same largest rate as the survey read whole."""
+    import attitude.trajectory.torqued as torqued
+    from attitude.trajectory.motion import analyze, largest_rate_of
+    from attitude.trajectory.trajectory import propagate
+
+    scenario = load_scenario(_short_example(tmp_path)).scenario
+    whole = analyze(propagate(scenario))
+    monkeypatch.setattr(torqued, "_SURVEY_CHUNK", 97)
+    monkeypatch.setattr(torqued, "_SURVEY_KEPT", 10)
+    chunked = analyze(propagate(scenario))
+    for a, b in zip(whole, chunked, strict=True):
+        assert a.flip_count == b.flip_count and a.flip_count
+        np.testing.assert_array_equal(a.flip_times_s, b.flip_times_s)
+    assert largest_rate_of(whole) == largest_rate_of(chunked)

@@ -82,9 +82,9 @@ def angular_velocity_envelope(
         solver = segment.solver
         if isinstance(solver, TorquedMotion):
             # The survey the flips and the largest rate were found on: no new propagation.
-            t, ω = solver.survey_angular_velocity()
-            inside = (t >= a) & (t <= b)
-            envelope.add(t[inside], {axis: ω[inside, i] for i, axis in enumerate("xyz")})
+            for t, _, ω in solver.survey():
+                inside = (t >= a) & (t <= b)
+                envelope.add(t[inside], {axis: ω[inside, i] for i, axis in enumerate("xyz")})
             continue
         period = item.period_s
         # Closed columns: a segment starting on an edge also ends the column before.

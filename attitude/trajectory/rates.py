@@ -13,7 +13,7 @@ with two equal moments, a steady spin or a body at rest has a constant |ω|.  Th
 separatrix (no period) is searched as under torques.
 
 **Under torques** (:class:`~attitude.trajectory.torqued.TorquedMotion`).  |ω| is
-sampled on the segment's survey (32 samples a turn at the largest rate: the torques
+read on the segment's survey (32 samples a turn at the largest rate: the torques
 perturb the free motion slowly, so |ω| has no other extrema than the free motion's,
 half a body period apart); every local maximum of the samples within 1 % of the
 largest, and both ends, is refined by golden-section search on the dense output over
@@ -177,17 +177,38 @@ def _refine(solver, t: NDArray[np.float64], rates: NDArray[np.float64]) -> tuple
         found, where = _golden(solver, t[inner - 1], t[inner + 1])
         values += found.tolist()
         times += where.tolist()
-    values_array, times_array = np.array(values), np.array(times)
-    top = float(np.max(values_array))
-    first = int(np.flatnonzero(values_array == top)[np.argmin(times_array[values_array == top])])
-    return top, float(times_array[first])
+    return _first_largest(np.array(values), np.array(times))
 
 
 def _torqued(solver: TorquedMotion, start_s: float, end_s: float) -> tuple[float, float]:
-    t, _ = solver.survey
-    inside = t[(t > start_s) & (t < end_s)]
-    t = np.concatenate([[start_s], inside, [end_s]])
-    return _refine(solver, t, _rate(solver, t))
+    """The survey's local maxima within _KEEP of its largest, and the ends, refined."""
+    ends = _rate(solver, np.array([start_s, end_s]))
+    peaks: list[NDArray] = []
+    brackets: list[NDArray] = []
+    for t, _, ω in solver.survey():
+        rate = _norm(ω)
+        inner = np.flatnonzero((rate[1:-1] >= rate[:-2]) & (rate[1:-1] >= rate[2:])) + 1
+        inner = inner[(t[inner] > start_s) & (t[inner] < end_s)]
+        peaks.append(rate[inner])
+        brackets.append(np.column_stack([t[inner - 1], t[inner + 1]]))
+    values = np.concatenate(peaks)
+    around = np.concatenate(brackets) if brackets else np.empty((0, 2))
+    best = max(float(np.max(values, initial=0.0)), float(np.max(ends)))
+    keep = values >= best * (1.0 - _KEEP)
+    found_values, found_times = [float(ends[0]), float(ends[1])], [start_s, end_s]
+    if np.any(keep):
+        low = np.maximum(around[keep, 0], start_s)
+        high = np.minimum(around[keep, 1], end_s)
+        refined, where = _golden(solver, low, high)
+        found_values += refined.tolist()
+        found_times += where.tolist()
+    return _first_largest(np.array(found_values), np.array(found_times))
+
+
+def _first_largest(values: NDArray[np.float64], times: NDArray[np.float64]) -> tuple[float, float]:
+    """The largest value and the earliest time at which it is found."""
+    top = float(np.max(values))
+    return top, float(np.min(times[values == top]))
 
 
 def _searched(segment: Segment, start_s: float, end_s: float) -> tuple[float, float]:

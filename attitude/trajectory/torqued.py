@@ -24,13 +24,14 @@ they need not care which one propagated it:
 
 :meth:`TorquedMotion.survey` samples the body momentum densely enough to resolve the
 motion (``SURVEY_PER_TURN`` samples per turn at the fastest rate); the flips, the
-largest rate and the report's figures all read it, so the dense output is evaluated
-once for them.
+largest rate and the report's figure all read it, so the dense output is evaluated
+once for them (for up to a million samples; beyond, once each, in bounded memory).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from functools import cached_property
 from typing import Any
 
@@ -50,6 +51,10 @@ __all__ = ["SURVEY_PER_TURN", "TorquedMotion", "flip_amplitude_exceeds", "scenar
 # Samples of the survey per turn of the body at its largest rate over the segment: the
 # momentum's direction moves by at most 2π/32 in the body between two of them.
 SURVEY_PER_TURN = 32
+# The survey is evaluated this many samples at a time, and kept when no longer than
+# _SURVEY_KEPT (t, m and ω: 56 bytes a sample).
+_SURVEY_CHUNK = 1 << 16
+_SURVEY_KEPT = 1 << 20
 # Flip times are refined until their bracket is this many float spacings wide.
 _FLIP_SPACINGS = 4.0
 _FLIP_ITERATIONS = 80
@@ -171,6 +176,7 @@ class TorquedMotion:
         # The run's estimated error within this segment (attitude.trajectory.steps).
         self.error_estimate: float | None = None
         self._last: tuple[NDArray, NDArray, NDArray] | None = None
+        self._survey: tuple[NDArray, NDArray, NDArray] | None = None
 
     # ---- states
 
@@ -246,26 +252,48 @@ class TorquedMotion:
 
     # ---- the survey, and what is found on it
 
-    @cached_property
-    def survey(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """(t, m): the principal-axes momentum at evenly spaced times over the segment,
-        ``SURVEY_PER_TURN`` a turn at the largest rate over it (|ω| ≤ G_max/I_min),
-        both ends included."""
+    def _survey_grid(self) -> tuple[int, float]:
+        """(count, spacing) of the survey's evenly spaced times over the segment."""
         span = self.end_s - self.t0
         G = self.angular_momentum_norm
-        if span <= 0.0 or G == 0.0:
-            t = np.array([self.t0, self.end_s]) if span > 0.0 else np.array([self.t0])
-        else:
-            spacing = 2.0 * math.pi * float(np.min(self.moments_of_inertia)) / G / SURVEY_PER_TURN
-            t = np.linspace(self.t0, self.end_s, max(2, math.ceil(span / spacing) + 1))
-        return t, self.principal_momentum(t)
+        if span <= 0.0:
+            return 1, 0.0
+        if G == 0.0:
+            return 2, span
+        spacing = 2.0 * math.pi * float(np.min(self.moments_of_inertia)) / G / SURVEY_PER_TURN
+        count = max(2, math.ceil(span / spacing) + 1)
+        return count, span / (count - 1)
 
-    def survey_angular_velocity(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """(t, ω): :attr:`survey` as body angular velocities (rad/s, body axes)."""
-        t, m = self.survey
-        axes = self.state.inertia
-        body = m if axes.is_diagonal else axes.body_to_principal.inv().apply(m)
-        return t, np.linalg.solve(axes.tensor, body[..., None])[..., 0]
+    def survey(self) -> Iterator[tuple[NDArray, NDArray, NDArray]]:
+        """The survey in chunks, in time order: (t, principal-axes momentum, body angular
+        velocity) at evenly spaced times over the segment, ``SURVEY_PER_TURN`` a turn at
+        the largest rate over it (|ω| ≤ G_max/I_min), both ends included.  Consecutive
+        chunks share their last two samples with the next one's first two (a sample
+        and its neighbours are then always in one chunk).  Kept once computed when it
+        has at most _SURVEY_KEPT samples (64 MB), so that the flips, the largest rate
+        and the figure read one evaluation of the dense output; a longer one is
+        computed again for each, a chunk at a time, in bounded memory."""
+        if self._survey is not None:
+            yield self._survey
+            return
+        count, spacing = self._survey_grid()
+        kept: list[tuple[NDArray, NDArray, NDArray]] = []
+        first = 0
+        while True:
+            stop = min(first + _SURVEY_CHUNK, count)
+            t = self.t0 + spacing * np.arange(first, stop, dtype=np.float64)
+            if stop == count:
+                t[-1] = self.end_s
+            m = self.principal_momentum(t)
+            chunk = (t, m, self.angular_velocity(t))
+            if count <= _SURVEY_KEPT:
+                kept.append(chunk if first == 0 else tuple(a[2:] for a in chunk))
+            yield chunk
+            if stop == count:
+                break
+            first = stop - 2
+        if kept:
+            self._survey = tuple(np.concatenate(parts) for parts in zip(*kept, strict=True))
 
     def flip_times(self, t_start: float, t_end: float) -> NDArray[np.float64]:
         """The flips in [t_start, t_end] on the propagated motion (TT s): the times at
@@ -274,7 +302,7 @@ class TorquedMotion:
         state there swings that axis beyond 45° of the momentum
         (:func:`flip_amplitude_exceeds`), as ``EulerSolver.flip_times`` defines a flip.
 
-        Found on :attr:`survey` (a sign change between samples a fraction of a turn
+        Found on :meth:`survey` (a sign change between samples a fraction of a turn
         apart; two flips are half a body period apart) and refined by bisection on the
         dense output to a few float spacings.  Empty for a body without a distinct
         intermediate axis.
@@ -284,13 +312,19 @@ class TorquedMotion:
         if not moments[ranked[0]] < moments[ranked[1]] < moments[ranked[2]]:
             return np.empty(0)
         middle = int(ranked[1])
-        t, m = self.survey
-        component = m[:, middle]
-        change = np.flatnonzero(np.signbit(component[1:]) != np.signbit(component[:-1]))
-        if change.size == 0:
+        lows, highs, signs = [], [], []
+        for t, m, _ in self.survey():
+            component = m[:, middle]
+            change = np.flatnonzero(np.signbit(component[1:]) != np.signbit(component[:-1]))
+            if t[-1] < self.end_s:  # the last pair is the next chunk's first
+                change = change[change < t.size - 2]
+            lows.append(t[change])
+            highs.append(t[change + 1])
+            signs.append(np.signbit(component[change]))
+        low, high = np.concatenate(lows), np.concatenate(highs)
+        if low.size == 0:
             return np.empty(0)
-        low, high = t[change].copy(), t[change + 1].copy()
-        low_sign = np.signbit(component[change])
+        low_sign = np.concatenate(signs)
         for _ in range(_FLIP_ITERATIONS):
             wide = high - low > _FLIP_SPACINGS * np.spacing(np.abs(high))
             if not np.any(wide):
