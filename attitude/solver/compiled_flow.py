@@ -40,6 +40,7 @@ import math
 
 import numpy as np
 
+from attitude.base import double_double
 from attitude.base.double_double import (
     dd_over_dd,
     dd_plus_dd,
@@ -48,7 +49,7 @@ from attitude.base.double_double import (
     two_prod,
     two_sum,
 )
-from attitude.base.jit import jit
+from attitude.base.jit import inline, jit
 from attitude.elliptic.compiled import (
     AGM_LEVELS,
     agm,
@@ -60,6 +61,8 @@ from attitude.elliptic.compiled import (
 )
 
 __all__ = ["flow_many", "flow_one"]
+
+inline(double_double.FUNCTIONS)
 
 
 # As attitude.solver.invariants: the double-double error allowed per chain (64 u²).
