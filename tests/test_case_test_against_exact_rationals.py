@@ -151,7 +151,7 @@ def test_a_batch_is_exact(kind):
 
 @pytest.mark.parametrize("kind", list(STATES))
 def test_the_compiled_case_test_is_exact_where_it_says_certain(kind):
-    from attitude.solver.compiled_flow import _case_test
+    from attitude.solver.numba_backend import _case_test
 
     certain_count = 0
     for state in STATES[kind]:
@@ -172,7 +172,7 @@ def test_the_compiled_case_test_is_exact_where_it_says_certain(kind):
 def test_the_case_chosen_is_the_sign_of_the_exact_delta2(kind):
     """EulerSolver (one state, the integers) and advance's batch (the double-double and
     the integers) choose the formula of the exact sign; the moments in any order."""
-    from attitude.solver.closed_form import ManyStates
+    from attitude.solver.numpy_backend import ManyStates
 
     expected = {-1: "i", 1: "ii", 0: "iii"}
     rng = np.random.default_rng(5)

@@ -1,6 +1,6 @@
 """Compiled (numba) elliptic kernels for one parameter and one argument at a time.
 
-The exact free flow of one state (attitude.solver.compiled_flow) needs, per step, the AGM of
+The exact free flow of one state (attitude.solver.numba_backend) needs, per step, the AGM of
 its parameter, K, Bulirsch's sn, cn, dn at two arguments, F for the phase, Π − K and
 Carlson's R_J twice.  In numpy on a batch of 1000 states, each of these costs a few
 hundred numpy calls per flow, ~2 µs a state in all (docs/benchmarks.md); compiled,

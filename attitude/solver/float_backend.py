@@ -1,0 +1,281 @@
+"""The float backend: the formula set of attitude.solver.closed_form on Python floats.
+
+Runs the formulas with ``xp = attitude.base.float_math.FLOAT`` (``math`` on floats, with
+numpy's IEEE results where ``math`` would raise).  Why a backend of its own: a numpy
+call costs 0.3 to 2 µs whatever the size of its arrays, 10 to 100 times the arithmetic
+of one state, while an operation on a float costs ~30 ns.
+
+Takes every case (both elliptic cases, the separatrix, steady, rest, mc of any size),
+for one state at a time:
+
+- ``OneState``: the case test of one state (the exact integers of
+  attitude.solver.invariants) and its formula and frame;
+- ``motion``: one state's ``Motion``, the constants ``EulerSolver`` keeps;
+- ``quaternion``, ``body_vector``: the attitude and a body vector at one time;
+- ``advance_one``, ``advance``: the flow of one state, and of a few states one at a
+  time: the states the numba backend leaves, when they are fewer than
+  attitude.solver.backends.SMALL_BATCH.
+
+Leaves nothing; it is chosen for one state at one time (attitude.solver.backends).
+Results beyond the float range raise ``closed_form.NotRepresentable``.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
+
+from attitude.base.float_math import FLOAT
+from attitude.base.quaternions import left_matrix, right_matrix
+from attitude.elliptic.functions import NEAR_ONE_MC
+from attitude.solver.closed_form import (
+    FLIP_23,
+    FLIP_NONE,
+    RELABEL,
+    CaseFormula,
+    Elliptic,
+    Motion,
+    NotRepresentable,
+    Rest,
+    Separatrix,
+    Steady,
+    hamilton,
+    norm,
+    p_quaternion,
+    preferred_flips,
+    step,
+    y_times_p,
+)
+from attitude.solver.invariants import invariants
+
+__all__ = ["OneState", "advance", "advance_one", "body_vector", "motion", "quaternion"]
+
+
+class OneState:
+    """The case formula of a single state and its frame, on Python floats.
+
+    ``moments`` are principal moments along the principal axes (any order),
+    ``momentum`` the momentum in those axes.  ``index``/``sign``: the signed permutation
+    to the P-frame, P[k] = sign[k] · principal[index[k]] (a proper rotation).
+    """
+
+    formula: CaseFormula
+
+    def __init__(self, moments: tuple[float, float, float], momentum: tuple[float, ...]) -> None:
+        order = sorted(range(3), key=moments.__getitem__)  # stable, as numpy's
+        o0, o1, o2 = order
+        odd = (o1 - o0) * (o2 - o0) * (o2 - o1) < 0
+        sorted_signs = (1.0, -1.0 if odd else 1.0, 1.0)
+        I1, I2, I3 = moments[o0], moments[o1], moments[o2]
+        m1, m2, m3 = momentum[o0], sorted_signs[1] * momentum[o1], momentum[o2]
+        G = norm(m1, m2, m3, FLOAT)
+        self.G, self.I = G, (I1, I2, I3)
+        if G == 0.0:
+            case, flips = "rest", FLIP_NONE
+        elif I1 == I3:
+            case, flips = "steady", (FLIP_23 if m3 < 0.0 else FLIP_NONE)
+        else:
+            inv = invariants(I1, I2, I3, m1, m2, m3, FLOAT)
+            if inv.sign == 0.0:
+                case = "iii"
+                flips = preferred_flips(m1 < 0.0, m3 < 0.0, FLOAT)
+            else:
+                case = "ii" if inv.sign > 0.0 else "i"
+                flips = preferred_flips(case == "i" and m1 < 0.0, case == "ii" and m3 < 0.0, FLOAT)
+        m1, m2, m3 = flips[0] * m1, flips[1] * m2, flips[2] * m3
+        formula: CaseFormula
+        if case in ("i", "ii"):
+            formula = Elliptic(
+                I1, I2, I3, m1, m2, m3, G, inv, case == "ii", inv.mc < NEAR_ONE_MC, FLOAT
+            )
+            if formula.λ == 0.0:  # underflows: see Steady
+                case, more = "steady", (FLIP_23 if m3 < 0.0 else FLIP_NONE)
+                flips = tuple(f * g for f, g in zip(flips, more, strict=True))
+                m1, m2, m3 = (f * m for f, m in zip(more, (m1, m2, m3), strict=True))
+        if case == "iii":
+            formula = Separatrix(I1, I2, I3, m1, m2, m3, G, inv, FLOAT)
+            if formula.onto_e1:
+                case = "iii-e1"
+        if case == "steady":
+            formula = Steady(I1, I2, I3, m1, m2, m3, G, FLOAT)
+        if case == "rest":
+            formula = Rest()
+        self.formula = formula
+        self.preferred = (m1, m2, m3)
+        # P[k] = r_sign[k] f[r_index[k]] s[r_index[k]] principal[order[r_index[k]]].
+        (r0, r1, r2), (rs0, rs1, rs2) = RELABEL[case]
+        self.index = (order[r0], order[r1], order[r2])
+        self.sign = (
+            rs0 * flips[r0] * sorted_signs[r0],
+            rs1 * flips[r1] * sorted_signs[r1],
+            rs2 * flips[r2] * sorted_signs[r2],
+        )
+
+
+# ----------------------------------------------------------------- one state's Motion
+
+
+@functools.lru_cache(maxsize=64)
+def _permutation_quaternion(
+    index: tuple[int, int, int], sign: tuple[float, float, float]
+) -> NDArray[np.float64]:
+    """The quaternion (scalar first) of the signed permutation S[k, index[k]] = sign[k]:
+    one of 24 rotations, each converted once by scipy (read-only)."""
+    matrix = np.zeros((3, 3))
+    matrix[np.arange(3), index] = sign
+    quaternion = Rotation.from_matrix(matrix).as_quat(scalar_first=True)
+    quaternion.flags.writeable = False
+    return quaternion
+
+
+def motion(
+    moments: tuple[float, float, float],
+    momentum: tuple[float, float, float],
+    q0: tuple[float, float, float, float],
+    t0: float,
+    body_to_principal: NDArray[np.float64] | None = None,
+) -> Motion:
+    """One state's ``Motion``: ``moments`` along the principal axes (any order), the
+    ``momentum`` in those axes, the attitude ``q0`` (body → inertial, scalar first) at
+    ``t0``, and the rotation matrix from body to principal axes (None: they are the
+    body axes)."""
+    state = OneState(moments, momentum)
+    formula = state.formula
+    # S: the signed permutation of the principal axes onto the formula's frame, after
+    # the body → principal rotation of a tensor.  Row vectors go back to the body as
+    # v_frame @ S (exact for a signed permutation).
+    S_matrix = np.zeros((3, 3))
+    S_matrix[np.arange(3), state.index] = state.sign
+    if body_to_principal is None:
+        S = _permutation_quaternion(state.index, state.sign)
+    else:
+        S_matrix = np.ascontiguousarray(S_matrix @ body_to_principal)
+        S = Rotation.from_matrix(S_matrix).as_quat(scalar_first=True)
+    columns = S_matrix.T.tolist()  # column k of S: its non-zero entries (i, S_ik)
+    S_columns = tuple(
+        tuple((i, column[i]) for i in range(3) if column[i] != 0.0 or body_to_principal is not None)
+        for column in columns
+    )
+    I_frame = tuple(float(moments[k]) for k in state.index)
+    # R = Q0 ∘ S⁻¹ ∘ P(t0)⁻¹, folded with S into one 4×4 matrix M:
+    # q(t) = R ⊗ (Y ⊗ P)(t) ⊗ S = L(R) Rr(S) (Y ⊗ P)(t) = M (Y ⊗ P)(t), scalar first.
+    a, b, c, ψ_t0 = formula.momentum_and_angle(0.0, FLOAT)
+    if isinstance(formula, Rest):
+        P0 = np.array([1.0, 0.0, 0.0, 0.0])
+    else:
+        P0 = np.array([*p_quaternion(a, b, c, state.G, FLOAT), 0.0])
+    conjugate = np.array([1.0, -1.0, -1.0, -1.0])
+    R = left_matrix(q0) @ left_matrix(S * conjugate) @ (P0 * conjugate)
+    M = left_matrix(R) @ right_matrix(S)
+    return Motion(
+        formula=formula,
+        G=state.G,
+        t0=t0,
+        moments=state.I,
+        preferred=state.preferred,
+        S_matrix=S_matrix,
+        S_columns=S_columns,
+        I_frame=np.array(I_frame),
+        I_frame_floats=I_frame,
+        M=M,
+        M_rows=tuple(tuple(row) for row in M.tolist()),
+        ψ_t0=float(ψ_t0),
+        q0=q0,
+    )
+
+
+# ----------------------------------------------------------------- one time
+
+
+def quaternion(motion: Motion, τ: float) -> tuple[float, float, float, float]:
+    """The unit attitude quaternion (w, x, y, z), body → inertial, at τ = t − t0: the
+    formulas of numpy_backend's ``quaternion_chunk`` on floats."""
+    f = motion.formula
+    if isinstance(f, Rest):
+        return motion.q0
+    try:
+        a, b, c, ψ = f.momentum_and_angle(τ, FLOAT)
+        yp = y_times_p(0.5 * (ψ - motion.ψ_t0), *p_quaternion(a, b, c, motion.G, FLOAT), FLOAT)
+    except (ValueError, OverflowError):  # math on an angle beyond the float range
+        raise NotRepresentable from None
+    q = [yp[0] * M0 + yp[1] * M1 + yp[2] * M2 + yp[3] * M3 for M0, M1, M2, M3 in motion.M_rows]
+    norm_q = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    if not math.isfinite(norm_q):
+        raise NotRepresentable
+    return q[0] / norm_q, q[1] / norm_q, q[2] / norm_q, q[3] / norm_q
+
+
+def body_vector(
+    motion: Motion, τ: float, divisors: tuple[float, float, float] | None = None
+) -> NDArray[np.float64]:
+    """The body momentum (or, with ``divisors`` the moments of the frame, the angular
+    velocity) at τ: numpy_backend's ``write_body`` on floats."""
+    try:
+        v = motion.formula.momentum(τ, FLOAT)
+    except (ValueError, OverflowError):  # math on an angle beyond the float range
+        raise NotRepresentable from None
+    if divisors is not None:
+        v = tuple(c / d for c, d in zip(v, divisors, strict=True))
+    out = np.empty(3)
+    for k, column in enumerate(motion.S_columns):
+        if len(column) == 1:
+            i, S_ik = column[0]
+            out[k] = v[i] * S_ik
+        else:
+            out[k] = (v[0] * column[0][1] + v[1] * column[1][1]) + v[2] * column[2][1]
+    if not np.isfinite(out).all():
+        raise NotRepresentable
+    return out
+
+
+# ----------------------------------------------------------------- one state's flow
+
+
+def advance(
+    inertia: NDArray[np.float64], m: NDArray[np.float64], q: NDArray[np.float64], τ: NDArray
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """A few states (arrays (n, 3), (n, 3), (n, 4), (n,)) after their steps, one at a
+    time (``advance_one``); NotRepresentable names the first state beyond the float
+    range."""
+    n = inertia.shape[0]
+    m_new, q_new = np.empty((n, 3)), np.empty((n, 4))
+    for k in range(n):
+        try:
+            m_new[k], q_new[k] = advance_one(
+                tuple(inertia[k].tolist()), tuple(m[k].tolist()), tuple(q[k].tolist()), float(τ[k])
+            )
+        except NotRepresentable:
+            raise NotRepresentable(k) from None
+    return m_new, q_new
+
+
+def advance_one(
+    inertia: tuple[float, float, float],
+    m: tuple[float, float, float],
+    q0: tuple[float, float, float, float],
+    τ: float,
+) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+    """One state after its step τ (``closed_form.step``), on floats throughout: tuples
+    in, tuples out."""
+    state = OneState(inertia, m)
+    if isinstance(state.formula, Rest):
+        return (0.0, 0.0, 0.0), q0
+    try:
+        m_frame, step_q = step(state.formula, state.G, τ, FLOAT)
+    except (ValueError, OverflowError):  # math on an angle beyond the float range
+        raise NotRepresentable from None
+    # Back to the body: x_body[index[k]] = sign[k] x_frame[k].
+    m_new = [0.0, 0.0, 0.0]
+    v = [0.0, 0.0, 0.0]
+    (i0, i1, i2), (s0, s1, s2) = state.index, state.sign
+    m_new[i0], m_new[i1], m_new[i2] = s0 * m_frame[0], s1 * m_frame[1], s2 * m_frame[2]
+    v[i0], v[i1], v[i2] = s0 * step_q[1], s1 * step_q[2], s2 * step_q[3]
+    w, x, y, z = hamilton(q0, (step_q[0], v[0], v[1], v[2]))
+    norm_q = math.sqrt(w * w + x * x + y * y + z * z)  # 1 to a few ulps; kept from drifting
+    if not (math.isfinite(norm_q) and all(map(math.isfinite, m_new))):
+        raise NotRepresentable
+    return (m_new[0], m_new[1], m_new[2]), (w / norm_q, x / norm_q, y / norm_q, z / norm_q)
