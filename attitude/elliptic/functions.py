@@ -190,9 +190,9 @@ def _bulirsch(z: Any, mc: Any, xp: Any, agm: tuple | None = None) -> tuple[Any, 
     """
     a_seq, b_seq, c, levels = _agm(mc, xp) if agm is None else agm
     x = z * c  # |x| ≤ π/4, since c K = π/2
-    a = 1.0 / xp.tan(x)  # cot x: one tangent (numpy's is vectorized; sin, cos are not)
+    a: Any = 1.0 / xp.tan(x)  # cot x: one tangent (numpy's is vectorized; sin, cos are not)
     c = c * a
-    d = 1.0
+    d: Any = 1.0
     shared = len(a_seq) if levels is None else int(levels.min())  # levels every element has
     for i in range(len(a_seq) - 1, -1, -1):
         a_i, b_i = a_seq[i], b_seq[i]
@@ -272,7 +272,7 @@ def reduced_sn_cn_dn(
     if not np.any(far):
         return s, c, d
     shifted = _quarter_shift(np.copysign(1.0, r), mc, s, c, d, np)
-    return tuple(np.where(far, f, g) for f, g in zip(shifted, (s, c, d), strict=True))
+    return np.where(far, shifted[0], s), np.where(far, shifted[1], c), np.where(far, shifted[2], d)
 
 
 def _reduced_sn_cn_dn_positive_mc(
@@ -394,9 +394,7 @@ def elliptic_f(phi: ArrayLike, mc: ArrayLike) -> NDArray[np.float64]:
         return np.where(j == 0.0, f, f + 2.0 * j * complete_first_kind(mc))
 
 
-def pi_minus_f(
-    j: ArrayLike, sn: ArrayLike, cn: ArrayLike, dn: ArrayLike, n: ArrayLike, mc: ArrayLike
-) -> NDArray[np.float64]:
+def pi_minus_f(j: Any, sn: Any, cn: Any, dn: Any, n: Any, mc: Any) -> Any:
     """Π(φ, n|m) − F(φ|m) at the amplitude φ = jπ + φr, given sin φr, cos φr ≥ 0, Δ(φr).
 
     From [OLBC10] 19.25.14 (Carlson form of Π, valid for |φr| ≤ π/2):
@@ -465,11 +463,12 @@ def _cel(kc: Any, p: Any, a: Any, b: Any, xp: Any = np) -> Any:
     """
     sqrt = xp.sqrt
     e = kc
-    mean = 1.0
+    mean: Any = 1.0
     p = sqrt(p)
     a = a + 0.0 * kc
     b = b / p
-    final = pending = None
+    final: list[Any] | None = None
+    pending: Any = None
     for _ in range(40):
         f = a
         a = a + b / p
@@ -505,7 +504,7 @@ def _cel(kc: Any, p: Any, a: Any, b: Any, xp: Any = np) -> Any:
 # ----------------------------------------------------------------- m within 2^-128 of 1
 
 
-def complete_first_kind_near_one(log_mc: ArrayLike) -> NDArray[np.float64]:
+def complete_first_kind_near_one(log_mc: Any) -> Any:
     """K from ln mc, for mc < ``NEAR_ONE_MC``: K = ln 4 − ½ ln mc.
 
     [OLBC10] 19.12.1: K = ln(4/k') + O(k'² ln k') with k' = √mc; the neglected term is
@@ -598,6 +597,7 @@ class JacobiParameter:
         self.mc = mc
         self.log_mc = log_mc
         self.near_one = near_one
+        self.K: Any
         if near_one:
             self.K = complete_first_kind_near_one(log_mc)
         elif xp is FLOAT:
@@ -611,6 +611,7 @@ class JacobiParameter:
     def jacobi(self, u: Any, xp: Any) -> tuple[Any, Any, Any, Any, Any]:
         """j, r, sn r, cn r, dn r for u = 2jK + r, |r| ≤ K."""
         K = self.K
+        j: Any
         if xp is FLOAT:
             j = float(round(u / (2.0 * K)))
             r = u - j * (2.0 * K)

@@ -107,9 +107,15 @@ class CaseFormula(Protocol):
     c ≥ 0; ``momentum_and_angle`` adds ψ(τ).  ``τ`` broadcasts with the constants.
     """
 
-    name: str
-    period: Any
-    mc: Any  # the complementary parameter 1 − m (0 on the separatrix, NaN if none)
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def period(self) -> Any: ...
+
+    @property
+    def mc(self) -> Any:  # the complementary parameter 1 − m (0 on the separatrix, NaN if none)
+        ...
 
     def momentum(self, τ: Any, xp: Any) -> tuple[Any, Any, Any]: ...
 

@@ -89,13 +89,14 @@ class OneState:
         m1, m2, m3 = flips[0] * m1, flips[1] * m2, flips[2] * m3
         formula: CaseFormula
         if case in ("i", "ii"):
-            formula = Elliptic(
+            elliptic = Elliptic(
                 I1, I2, I3, m1, m2, m3, G, inv, case == "ii", inv.mc < NEAR_ONE_MC, FLOAT
             )
-            if formula.λ == 0.0:  # underflows: see Steady
+            formula = elliptic
+            if elliptic.λ == 0.0:  # underflows: see Steady
                 case, more = "steady", (FLIP_23 if m3 < 0.0 else FLIP_NONE)
-                flips = tuple(f * g for f, g in zip(flips, more, strict=True))
-                m1, m2, m3 = (f * m for f, m in zip(more, (m1, m2, m3), strict=True))
+                flips = (flips[0] * more[0], flips[1] * more[1], flips[2] * more[2])
+                m1, m2, m3 = more[0] * m1, more[1] * m2, more[2] * m3
         if case == "iii":
             formula = Separatrix(I1, I2, I3, m1, m2, m3, G, inv, FLOAT)
             if formula.onto_e1:
@@ -160,7 +161,8 @@ def motion(
         tuple((i, column[i]) for i in range(3) if column[i] != 0.0 or body_to_principal is not None)
         for column in columns
     )
-    I_frame = tuple(float(moments[k]) for k in state.index)
+    i0, i1, i2 = state.index
+    I_frame = (float(moments[i0]), float(moments[i1]), float(moments[i2]))
     # R = Q0 ∘ S⁻¹ ∘ P(t0)⁻¹, folded with S into one 4×4 matrix M:
     # q(t) = R ⊗ (Y ⊗ P)(t) ⊗ S = L(R) Rr(S) (Y ⊗ P)(t) = M (Y ⊗ P)(t), scalar first.
     a, b, c, ψ_t0 = formula.momentum_and_angle(0.0, FLOAT)

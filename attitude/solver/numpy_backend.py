@@ -310,7 +310,7 @@ def _group_formulas(
     onto e1 gets the case code iii-e1 (its relabelling).
     """
 
-    def constants(k):
+    def constants(k: np.ndarray) -> tuple[Any, Any, Any, Any, Any, Any, Any, Invariants]:
         return _constants(k, moments, m, G, inv)
 
     with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
@@ -329,7 +329,9 @@ def _group_formulas(
     return groups
 
 
-def _constants(k: np.ndarray, moments, m: np.ndarray, G: np.ndarray, inv: Invariants) -> tuple:
+def _constants(
+    k: np.ndarray, moments: tuple, m: np.ndarray, G: np.ndarray, inv: Invariants
+) -> tuple[Any, Any, Any, Any, Any, Any, Any, Invariants]:
     """I1, I2, I3, m1, m2, m3, G and the invariants of the states ``k``, as the formulas
     take them (every state: the arrays themselves, no gather)."""
     I1, I2, I3 = moments
@@ -340,7 +342,11 @@ def _constants(k: np.ndarray, moments, m: np.ndarray, G: np.ndarray, inv: Invari
 
 
 def _elliptic_groups(
-    constants: Any, mc: np.ndarray, case: np.ndarray, flips: np.ndarray, m: np.ndarray
+    constants: Callable[[np.ndarray], tuple[Any, Any, Any, Any, Any, Any, Any, Invariants]],
+    mc: np.ndarray,
+    case: np.ndarray,
+    flips: np.ndarray,
+    m: np.ndarray,
 ) -> list[tuple[np.ndarray, CaseFormula]]:
     """The elliptic formulas, one per regime of the kernels (mc above or below
     ``NEAR_ONE_MC``).  A state whose rate λ underflows cannot move (``Steady``): it is
