@@ -51,6 +51,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import special
+from scipy.special import cython_special
 
 from attitude.base.float_math import FLOAT
 
@@ -374,11 +375,18 @@ def _split_angle(phi: ArrayLike) -> tuple[NDArray[np.float64], ...]:
     return j, np.sin(phir), np.cos(phir)
 
 
-def _f_of_sin_cos(s: Any, c: Any, mc: Any) -> Any:
+def _f_of_sin_cos(s: Any, c: Any, mc: Any, xp: Any = np) -> Any:
     """F(φ|m) for |φ| ≤ π/2 from s = sin φ and c = cos φ ≥ 0: [OLBC10] 19.25.5,
     F = s R_F(c², c² + mc s², 1) (``c² + mc s²`` is 1 − m s² without cancellation)."""
     c2 = c * c
-    return s * special.elliprf(c2, c2 + mc * s * s, 1.0)
+    return s * _special(xp).elliprf(c2, c2 + mc * s * s, 1.0)
+
+
+def _special(xp: Any) -> Any:
+    """scipy's special functions for arrays (ufuncs), or for floats their Cython
+    versions (``scipy.special.cython_special``: the same code and bits, a float in and
+    out, without the ufunc's dispatch, a third of its cost on one float)."""
+    return cython_special if xp is FLOAT else special
 
 
 def elliptic_f(phi: ArrayLike, mc: ArrayLike) -> NDArray[np.float64]:
@@ -601,7 +609,7 @@ class JacobiParameter:
         if near_one:
             self.K = complete_first_kind_near_one(log_mc)
         elif xp is FLOAT:
-            self.K = float(special.ellipkm1(mc))
+            self.K = cython_special.ellipkm1(mc)
         else:
             self.K = special.ellipkm1(mc)
         self.kc = xp.exp(0.5 * log_mc)  # k' = √mc (0 below the float range)
@@ -659,8 +667,8 @@ class JacobiParameter:
             incomplete = 0.0 * r
         else:
             c2, s2 = cn * cn, sn * sn
-            r_j = special.elliprj(c2, dn * dn, 1.0, c2 + (1.0 - n) * s2)
-            incomplete = (n / 3.0) * sn * s2 * (float(r_j) if xp is FLOAT else r_j)
+            r_j = _special(xp).elliprj(c2, dn * dn, 1.0, c2 + (1.0 - n) * s2)
+            incomplete = (n / 3.0) * sn * s2 * r_j
         return incomplete + 2.0 * j * complete
 
     def f_of_sin_cos(self, s: Any, c: Any, xp: Any) -> Any:
@@ -670,7 +678,5 @@ class JacobiParameter:
         beyond.  Working from (s, c) rather than from φ = atan2 keeps F accurate near
         φ = ±π/2, where dF/dφ = 1/dn is large close to the separatrix.
         """
-        f = _f_of_sin_cos(s, abs(c), self.mc)
-        if xp is FLOAT:
-            f = float(f)
+        f = _f_of_sin_cos(s, abs(c), self.mc, xp)
         return xp.where(c >= 0.0, f, xp.copysign(2.0 * self.K, s) - f)

@@ -57,6 +57,7 @@ References
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 from typing import Any, Protocol
@@ -249,7 +250,7 @@ class Elliptic:
         return self._evaluate(τ, xp, with_ψ=True)
 
     def _evaluate(self, τ: Any, xp: Any, with_ψ: bool):
-        j, r, sn_r, cn_r, dn_r = self.phase(τ, xp)
+        j, r, sn_r, cn_r, dn_r = self.parameter.jacobi(self.λ * τ - self.ν, xp)  # phase()
         a, b, c = self.momentum_of_phase(j, sn_r, cn_r, dn_r, xp)
         if not with_ψ:
             return a, b, c, None
@@ -492,10 +493,13 @@ class Motion:
     The attitude is q(t) = r ⊗ Y(ψ(τ) − ψ(0)) ⊗ P(m(τ)) ⊗ s ([Leroy] "An alternative
     quaternionic solution", with R = Q0 ∘ S⁻¹ ∘ P(m(0))⁻¹ so that q(t0) = Q0), that is
     ``M`` (Y ⊗ P)(τ) with the constant 4×4 matrix M = L(r) R(s) (docs/derivation.md
-    §10).  A vector of the formula's frame goes back to the body as v_frame @ S
-    (``S_columns``: the non-zero entries of each column of S).  Built by
-    ``float_backend.motion``; the backends evaluate it (``table`` is the table
-    backend's, made on demand).
+    §10; ``M_rows``, its rows as floats).  S is the signed permutation
+    P[k] = sign[k] · principal[index[k]] onto the formula's frame, after the rotation
+    ``body_to_principal`` of a tensor (None for principal body axes); a vector of the
+    formula's frame goes back to the body as v_frame @ S (``S_columns``: the non-zero
+    entries (i, S_ik) of each column k of S).  Built by ``float_backend.motion``; the
+    backends evaluate it.  What only arrays need (``S_matrix``, ``I_frame``, ``M``) is
+    made at first use, and ``table`` is the table backend's.
     """
 
     formula: CaseFormula
@@ -503,15 +507,34 @@ class Motion:
     t0: float
     moments: tuple[float, float, float]  # I1 ≤ I2 ≤ I3
     preferred: tuple[float, float, float]  # m at t0 in the preferred (sorted, flipped) axes
-    S_matrix: NDArray[np.float64]  # body → the formula's frame
+    index: tuple[int, int, int]
+    sign: tuple[float, float, float]
+    body_to_principal: NDArray[np.float64] | None
     S_columns: tuple[tuple[tuple[int, float], ...], ...]
-    I_frame: NDArray[np.float64]  # the moments along the axes of the formula's frame
-    I_frame_floats: tuple[float, float, float]
-    M: NDArray[np.float64]
+    I_frame_floats: tuple[float, float, float]  # the moments along the frame's axes
     M_rows: tuple[tuple[float, float, float, float], ...]
     ψ_t0: float
     q0: tuple[float, float, float, float]  # the attitude at t0, scalar first
     table: Any = None
+
+    @functools.cached_property
+    def S_matrix(self) -> NDArray[np.float64]:
+        """S as a 3×3 matrix (body → the formula's frame)."""
+        S = np.zeros((3, 3))
+        S[np.arange(3), self.index] = self.sign
+        if self.body_to_principal is not None:
+            S = np.ascontiguousarray(S @ self.body_to_principal)
+        return S
+
+    @functools.cached_property
+    def I_frame(self) -> NDArray[np.float64]:
+        """The moments along the axes of the formula's frame, as an array."""
+        return np.array(self.I_frame_floats)
+
+    @functools.cached_property
+    def M(self) -> NDArray[np.float64]:
+        """M as a 4×4 array."""
+        return np.array(self.M_rows)
 
     @property
     def fastest_rate(self) -> float:

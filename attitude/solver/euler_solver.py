@@ -60,9 +60,35 @@ except ImportError:  # pragma: no cover
     _NUMPY_NAMESPACE = None
 
 
-def _as_rotation(attitude: Any) -> Rotation:
+def _three_floats(value: Any) -> tuple[float, float, float] | None:
+    """``value`` as three finite Python floats when it is plainly three numbers (a list
+    or tuple of floats and ints, or a float64 array of shape (3,)), else None: the
+    general checks of attitude.base.quantities then run (Quantities, other types, and
+    every error message).  They cost more than the rest of the construction."""
+    if type(value) is np.ndarray:
+        if value.shape != (3,) or value.dtype != np.float64:
+            return None
+        a, b, c = value.tolist()
+    elif type(value) in (list, tuple) and len(value) == 3:
+        a, b, c = value
+        for v in (a, b, c):
+            if not (type(v) is float or type(v) is int or type(v) is np.float64):
+                return None
+        try:
+            a, b, c = float(a), float(b), float(c)
+        except OverflowError:  # an int beyond the float range: refused by the checks
+            return None
+    else:
+        return None
+    if not (math.isfinite(a) and math.isfinite(b) and math.isfinite(c)):
+        return None
+    return a, b, c
+
+
+def _attitude_quaternion(attitude: Any) -> tuple[float, float, float, float]:
+    """The attitude at t0 as a unit quaternion (w, x, y, z), checked."""
     if attitude is None:
-        return Rotation.identity()
+        return 1.0, 0.0, 0.0, 0.0
     if not isinstance(attitude, Rotation):
         raise InputError(
             "attitude must be a scipy.spatial.transform.Rotation (body -> inertial), "
@@ -70,10 +96,10 @@ def _as_rotation(attitude: Any) -> Rotation:
         )
     if not attitude.single:
         raise InputError(f"attitude must be a single rotation, got a stack of {len(attitude)}")
-    q = attitude.as_quat(scalar_first=True)
-    if not np.all(np.isfinite(q)):
-        raise InputError(f"attitude must be finite, got quaternion {q.tolist()}")
-    return attitude
+    x, y, z, w = attitude.as_quat().tolist()  # scalar last: scipy's own order, no copy
+    if not (math.isfinite(w) and math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
+        raise InputError(f"attitude must be finite, got quaternion {[w, x, y, z]}")
+    return w, x, y, z
 
 
 def _one_rotation(q_scalar_last: NDArray[np.float64]) -> Rotation:
@@ -126,13 +152,29 @@ class EulerSolver:
         attitude: Rotation | None = None,
         t0: float = 0.0,
     ) -> None:
-        axes = principal_axes(inertia)
-        m_body = as_vector3(angular_momentum, "angular_momentum", "angular_momentum")
-        self._initial_attitude = _as_rotation(attitude)
-        self._t0 = as_si_scalar(t0, "time", "t0")
-        self._axes = axes
+        # Three plain positive moments (the usual case) need neither the checks of
+        # principal_axes nor its rotation; a tensor, a Quantity or anything else does.
+        moments = _three_floats(inertia)
+        self._axes: PrincipalAxes | None = None
+        if moments is None or not (moments[0] > 0.0 and moments[1] > 0.0 and moments[2] > 0.0):
+            self._axes = principal_axes(inertia)
+            moments = _three_floats(self._axes.moments)
+            assert moments is not None
+        self._moments = moments
+        m_body = _three_floats(angular_momentum)
+        if m_body is None:
+            m_body = _three_floats(
+                as_vector3(angular_momentum, "angular_momentum", "angular_momentum")
+            )
+            assert m_body is not None
+        q0 = _attitude_quaternion(attitude)
+        self._initial_attitude = attitude
+        if type(t0) is float and math.isfinite(t0):
+            self._t0 = t0
+        else:
+            self._t0 = as_si_scalar(t0, "time", "t0")
         self._initial_angular_momentum = m_body
-        self._motion = self._solve(axes, m_body, self._initial_attitude, self._t0)
+        self._motion = self._solve(moments, m_body, q0, self._t0, self._axes)
         self._formula: CaseFormula = self._motion.formula
         self._G = self._motion.G
         I1, I2, I3 = self._motion.moments
@@ -141,35 +183,39 @@ class EulerSolver:
         x1, x2, x3 = (m1 / G, m2 / G, m3 / G) if G > 0.0 else (0.0, 0.0, 0.0)
         # 2T = G² Σ xj²/Ij; Python floats: an energy beyond the float range is inf.
         self._kinetic_energy = 0.5 * G * (G * (x1 * x1 / I1 + x2 * x2 / I2 + x3 * x3 / I3))
-        self._inertial_angular_momentum = self._initial_attitude.apply(m_body)
 
     @staticmethod
     def _solve(
-        axes: PrincipalAxes, m_body: NDArray[np.float64], attitude: Rotation, t0: float
+        moments: tuple[float, float, float],
+        m_body: tuple[float, float, float],
+        q0: tuple[float, float, float, float],
+        t0: float,
+        axes: PrincipalAxes | None,
     ) -> Motion:
         """The state's ``Motion`` (attitude.solver.float_backend.motion): its case,
         formula and frame, and the constant rotations.
 
         Refuses a state whose angular velocity |m|/I1 is beyond the float range.
         """
-        m_principal = m_body if axes.is_diagonal else axes.body_to_principal.apply(m_body)
-        I1, I2, I3 = axes.moments
-        moments = (float(I1), float(I2), float(I3))
-        momentum = (float(m_principal[0]), float(m_principal[1]), float(m_principal[2]))
+        V = None if axes is None or axes.is_diagonal else axes.body_to_principal
+        momentum = m_body
+        if V is not None:
+            a, b, c = V.apply(np.array(m_body)).tolist()
+            momentum = (a, b, c)
         G = math.hypot(*momentum)  # math.hypot scales: no overflow of the squares
         if not math.isfinite(G / min(moments)):
             raise InputError(
-                f"angular_momentum {m_body.tolist()} with moments {axes.moments.tolist()}: the "
+                f"angular_momentum {list(m_body)} with moments {list(moments)}: the "
                 f"angular velocity |m|/I1 = {G / min(moments):g} rad/s is beyond the float range"
             )
-        q0 = attitude.as_quat(scalar_first=True).tolist()
-        return float_backend.motion(
-            moments,
-            momentum,
-            (q0[0], q0[1], q0[2], q0[3]),
-            t0,
-            None if axes.is_diagonal else axes.body_to_principal.as_matrix(),
-        )
+        return float_backend.motion(moments, momentum, q0, t0, V)
+
+    @property
+    def _principal_axes(self) -> PrincipalAxes:
+        """The inertia's principal axes (made at first use for three plain moments)."""
+        if self._axes is None:
+            self._axes = principal_axes(np.array(self._moments))
+        return self._axes
 
     @classmethod
     def from_angular_velocity(
@@ -180,9 +226,14 @@ class EulerSolver:
         t0: float = 0.0,
     ) -> EulerSolver:
         """Build the solver from the body angular velocity at ``t0`` (rad/s)."""
+        moments, ω = _three_floats(inertia), _three_floats(angular_velocity)
+        if moments is not None and ω is not None and min(moments) > 0.0:
+            # tensor @ ω of a diagonal tensor, term by term
+            m = [moments[0] * ω[0], moments[1] * ω[1], moments[2] * ω[2]]
+            return cls(moments, m, attitude, t0)
         tensor = principal_axes(inertia).tensor
-        ω = as_vector3(angular_velocity, "angular_velocity", "angular_velocity")
-        return cls(inertia, tensor @ ω, attitude, t0)
+        ω_array = as_vector3(angular_velocity, "angular_velocity", "angular_velocity")
+        return cls(inertia, tensor @ ω_array, attitude, t0)
 
     # ----------------------------------------------------------------- evaluation
 
@@ -416,21 +467,23 @@ class EulerSolver:
     @property
     def moments_of_inertia(self) -> NDArray[np.float64]:
         """Principal moments, kg m²: as given, or ascending for a tensor."""
-        return self._axes.moments.copy()
+        return np.array(self._moments)
 
     @property
     def inertia_tensor(self) -> NDArray[np.float64]:
         """The inertia tensor in body axes, kg m²."""
-        return self._axes.tensor.copy()
+        return self._principal_axes.tensor.copy()
 
     @property
     def initial_angular_momentum(self) -> NDArray[np.float64]:
         """Body-frame angular momentum at ``t0``, N m s."""
-        return self._initial_angular_momentum.copy()
+        return np.array(self._initial_angular_momentum)
 
     @property
     def initial_attitude(self) -> Rotation:
         """Attitude (body → inertial) at ``t0``."""
+        if self._initial_attitude is None:
+            self._initial_attitude = Rotation.identity()
         return self._initial_attitude
 
     @property
@@ -452,8 +505,8 @@ class EulerSolver:
             x2_over_I = (m1 / G) ** 2 / I1 + (m2 / G) ** 2 / I2 + (m3 / G) ** 2 / I3
             log10_T = 2.0 * math.log10(G) + math.log10(0.5 * x2_over_I)
             raise InputError(
-                f"the kinetic energy of angular_momentum {self._initial_angular_momentum.tolist()}"
-                f" with moments {self._axes.moments.tolist()}, about 1e{log10_T:.0f} J, is "
+                f"the kinetic energy of angular_momentum {list(self._initial_angular_momentum)}"
+                f" with moments {list(self._moments)}, about 1e{log10_T:.0f} J, is "
                 "beyond the float range"
             )
         return self._kinetic_energy
@@ -461,11 +514,11 @@ class EulerSolver:
     @property
     def inertial_angular_momentum(self) -> NDArray[np.float64]:
         """The angular momentum in inertial axes, N m s (conserved)."""
-        return self._inertial_angular_momentum.copy()
+        return self.initial_attitude.apply(np.array(self._initial_angular_momentum))
 
     def __repr__(self) -> str:
         return (
-            f"EulerSolver(inertia={self._axes.moments.tolist()}, "
-            f"angular_momentum={self._initial_angular_momentum.tolist()}, t0={self._t0}, "
+            f"EulerSolver(inertia={list(self._moments)}, "
+            f"angular_momentum={list(self._initial_angular_momentum)}, t0={self._t0}, "
             f"formula={self.formula!r}, period={self.period:.6g} s)"
         )

@@ -30,7 +30,6 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from attitude.base.float_math import FLOAT
-from attitude.base.quaternions import left_matrix, right_matrix
 from attitude.elliptic.functions import NEAR_ONE_MC
 from attitude.solver.closed_form import (
     FLIP_23,
@@ -123,14 +122,30 @@ class OneState:
 @functools.lru_cache(maxsize=64)
 def _permutation_quaternion(
     index: tuple[int, int, int], sign: tuple[float, float, float]
-) -> NDArray[np.float64]:
+) -> tuple[float, float, float, float]:
     """The quaternion (scalar first) of the signed permutation S[k, index[k]] = sign[k]:
-    one of 24 rotations, each converted once by scipy (read-only)."""
+    one of 24 rotations, each converted once by scipy."""
     matrix = np.zeros((3, 3))
     matrix[np.arange(3), index] = sign
-    quaternion = Rotation.from_matrix(matrix).as_quat(scalar_first=True)
-    quaternion.flags.writeable = False
-    return quaternion
+    w, x, y, z = Rotation.from_matrix(matrix).as_quat(scalar_first=True).tolist()
+    return w, x, y, z
+
+
+def _constant_matrix(
+    r: tuple[float, float, float, float], s: tuple[float, float, float, float]
+) -> tuple[tuple[float, float, float, float], ...]:
+    """The rows of M = L(r) R(s), the 4×4 matrix of v ↦ r ⊗ v ⊗ s (docs/derivation.md
+    §10): its column j is r ⊗ (e_j ⊗ s), e_j ⊗ s being s with its components permuted
+    and signed."""
+    sw, sx, sy, sz = s
+    columns = (
+        hamilton(r, s),
+        hamilton(r, (-sx, sw, -sz, sy)),  # i ⊗ s
+        hamilton(r, (-sy, sz, sw, -sx)),  # j ⊗ s
+        hamilton(r, (-sz, -sy, sx, sw)),  # k ⊗ s
+    )
+    c0, c1, c2, c3 = columns
+    return tuple((c0[i], c1[i], c2[i], c3[i]) for i in range(4))
 
 
 def motion(
@@ -138,53 +153,53 @@ def motion(
     momentum: tuple[float, float, float],
     q0: tuple[float, float, float, float],
     t0: float,
-    body_to_principal: NDArray[np.float64] | None = None,
+    body_to_principal: Rotation | None = None,
 ) -> Motion:
     """One state's ``Motion``: ``moments`` along the principal axes (any order), the
-    ``momentum`` in those axes, the attitude ``q0`` (body → inertial, scalar first) at
-    ``t0``, and the rotation matrix from body to principal axes (None: they are the
-    body axes)."""
+    ``momentum`` in those axes, the attitude ``q0`` (body → inertial, unit, scalar
+    first) at ``t0``, and the rotation from body to principal axes (None: they are the
+    body axes).  On floats: a few tens of microseconds, so that building one solver per
+    state costs little."""
     state = OneState(moments, momentum)
     formula = state.formula
+    index, sign = state.index, state.sign
+    i0, i1, i2 = index
     # S: the signed permutation of the principal axes onto the formula's frame, after
-    # the body → principal rotation of a tensor.  Row vectors go back to the body as
-    # v_frame @ S (exact for a signed permutation).
-    S_matrix = np.zeros((3, 3))
-    S_matrix[np.arange(3), state.index] = state.sign
+    # the body → principal rotation V of a tensor.  Row vectors go back to the body as
+    # v_frame @ S (S_columns: the entries of each column of S, exact for a signed
+    # permutation).
+    S = _permutation_quaternion(index, sign)
+    V: NDArray[np.float64] | None = None
     if body_to_principal is None:
-        S = _permutation_quaternion(state.index, state.sign)
+        position = {i0: 0, i1: 1, i2: 2}  # column k of S: its entry sign[i] at row i
+        S_columns: tuple = tuple(((position[k], sign[position[k]]),) for k in range(3))
     else:
-        S_matrix = np.ascontiguousarray(S_matrix @ body_to_principal)
-        S = Rotation.from_matrix(S_matrix).as_quat(scalar_first=True)
-    columns = S_matrix.T.tolist()  # column k of S: its non-zero entries (i, S_ik)
-    S_columns = tuple(
-        tuple((i, column[i]) for i in range(3) if column[i] != 0.0 or body_to_principal is not None)
-        for column in columns
-    )
-    i0, i1, i2 = state.index
-    I_frame = (float(moments[i0]), float(moments[i1]), float(moments[i2]))
-    # R = Q0 ∘ S⁻¹ ∘ P(t0)⁻¹, folded with S into one 4×4 matrix M:
-    # q(t) = R ⊗ (Y ⊗ P)(t) ⊗ S = L(R) Rr(S) (Y ⊗ P)(t) = M (Y ⊗ P)(t), scalar first.
+        V = body_to_principal.as_matrix()
+        rows = V.tolist()  # row k of S is sign[k] times row index[k] of V
+        S_rows = [[sign[k] * v for v in rows[index[k]]] for k in range(3)]
+        S_columns = tuple(tuple((i, S_rows[i][j]) for i in range(3)) for j in range(3))
+        x, y, z, w = body_to_principal.as_quat().tolist()
+        S = hamilton(S, (w, x, y, z))  # S ∘ V
+    # R = Q0 ∘ S⁻¹ ∘ P(t0)⁻¹, so that q(t0) = Q0; with S, the constant matrix M:
+    # q(t) = R ⊗ (Y ⊗ P)(t) ⊗ S = M (Y ⊗ P)(t), scalar first.
     a, b, c, ψ_t0 = formula.momentum_and_angle(0.0, FLOAT)
     if isinstance(formula, Rest):
-        P0 = np.array([1.0, 0.0, 0.0, 0.0])
+        p0, p1, p2 = 1.0, 0.0, 0.0
     else:
-        P0 = np.array([*p_quaternion(a, b, c, state.G, FLOAT), 0.0])
-    conjugate = np.array([1.0, -1.0, -1.0, -1.0])
-    R = left_matrix(q0) @ left_matrix(S * conjugate) @ (P0 * conjugate)
-    M = left_matrix(R) @ right_matrix(S)
+        p0, p1, p2 = p_quaternion(a, b, c, state.G, FLOAT)
+    R = hamilton(hamilton(q0, (S[0], -S[1], -S[2], -S[3])), (p0, -p1, -p2, -0.0))
     return Motion(
         formula=formula,
         G=state.G,
         t0=t0,
         moments=state.I,
         preferred=state.preferred,
-        S_matrix=S_matrix,
+        index=index,
+        sign=sign,
+        body_to_principal=V,
         S_columns=S_columns,
-        I_frame=np.array(I_frame),
-        I_frame_floats=I_frame,
-        M=M,
-        M_rows=tuple(tuple(row) for row in M.tolist()),
+        I_frame_floats=(float(moments[i0]), float(moments[i1]), float(moments[i2])),
+        M_rows=_constant_matrix(R, S),
         ψ_t0=float(ψ_t0),
         q0=q0,
     )
@@ -204,11 +219,16 @@ def quaternion(motion: Motion, τ: float) -> tuple[float, float, float, float]:
         yp = y_times_p(0.5 * (ψ - motion.ψ_t0), *p_quaternion(a, b, c, motion.G, FLOAT), FLOAT)
     except (ValueError, OverflowError):  # math on an angle beyond the float range
         raise NotRepresentable from None
-    q = [yp[0] * M0 + yp[1] * M1 + yp[2] * M2 + yp[3] * M3 for M0, M1, M2, M3 in motion.M_rows]
-    norm_q = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    y0, y1, y2, y3 = yp
+    r0, r1, r2, r3 = motion.M_rows
+    w = y0 * r0[0] + y1 * r0[1] + y2 * r0[2] + y3 * r0[3]
+    x = y0 * r1[0] + y1 * r1[1] + y2 * r1[2] + y3 * r1[3]
+    y = y0 * r2[0] + y1 * r2[1] + y2 * r2[2] + y3 * r2[3]
+    z = y0 * r3[0] + y1 * r3[1] + y2 * r3[2] + y3 * r3[3]
+    norm_q = math.sqrt(w * w + x * x + y * y + z * z)
     if not math.isfinite(norm_q):
         raise NotRepresentable
-    return q[0] / norm_q, q[1] / norm_q, q[2] / norm_q, q[3] / norm_q
+    return w / norm_q, x / norm_q, y / norm_q, z / norm_q
 
 
 def body_vector(
