@@ -43,9 +43,10 @@ from attitude.solver.closed_form import CaseFormula
 __all__ = ["SMALL_BATCH", "TABLE_MIN_SAMPLES", "select"]
 
 # From this many times in one call, one state's attitude takes ψ's periodic part from
-# a table built once (1000 to 6000 formula evaluations, which cost about as much as
-# this many samples of the formula) instead of one R_J a sample.
-TABLE_MIN_SAMPLES = 16384
+# a table built once instead of one R_J a sample.  The table's 1000 to 6000 formula
+# evaluations pay for themselves within the call from ~6000 to ~8000 samples
+# (benchmarks.solver_speed, section 4; docs/solver.md, "Speed").
+TABLE_MIN_SAMPLES = 8192
 # Below this many states at one time each, the float backend takes them one at a time:
 # numpy's fixed cost (~1 ms for the few hundred calls of a batch) exceeds that of this
 # many states on floats (~40 µs each).
