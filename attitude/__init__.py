@@ -50,6 +50,7 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.scenario.scenario import InitialState, Scenario
     from attitude.scenario.spacecraft import Spacecraft
     from attitude.scenario.torques import Burn, ScenarioTorques
+    from attitude.solver.batch import EulerSolverBatch
     from attitude.solver.euler_solver import EulerSolver
     from attitude.torques.models import ConstantTorque, GravityGradient, UserTorque
     from attitude.torques.solver import TorquedSolver, departure_time, propagate_batch
@@ -59,6 +60,7 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
 
 _LAZY = {
     "EulerSolver": "attitude.solver.euler_solver",
+    "EulerSolverBatch": "attitude.solver.batch",
     "TorquedSolver": "attitude.torques.solver",
     "propagate_batch": "attitude.torques.solver",
     "departure_time": "attitude.torques.solver",
@@ -100,6 +102,7 @@ __all__ = [
     "Burn",
     "ConstantTorque",
     "EulerSolver",
+    "EulerSolverBatch",
     "GravityGradient",
     "InertiaChange",
     "InertiaWarning",

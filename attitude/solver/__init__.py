@@ -4,6 +4,8 @@ use them (``EulerSolver``, ``EulerSolverBatch``, the free-flow map).
 Modules:
 
 - ``backends``: The backends of the formula set, and the one rule that picks them.
+- ``batch``: Many states at many times: ``EulerSolverBatch``, N torque-free rigid
+  bodies at once.
 - ``closed_form``: The formula set: the closed-form motion of a torque-free rigid body,
   one formula per case, its frames, one state's attitude and a step of the flow.
 - ``euler_solver``: The exact motion of a torque-free rigid body from one state:

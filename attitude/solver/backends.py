@@ -53,7 +53,7 @@ TABLE_MIN_SAMPLES = 8192
 SMALL_BATCH = 36
 
 
-def select(states: int, times: int | None, formula: CaseFormula | None = None) -> ModuleType:
+def select(states: int, times: int | None, formula: CaseFormula | None = None) -> ModuleType | None:
     """The backend that evaluates ``states`` states at ``times`` times each.
 
     ``times`` is None for one time per state given as a number (a scalar t, or each
@@ -64,16 +64,15 @@ def select(states: int, times: int | None, formula: CaseFormula | None = None) -
        at a time.
     2. One state at ``TABLE_MIN_SAMPLES`` times or more, whose formula a table takes:
        the table backend.
-    3. Everything else: the numpy backend.
+    3. Several states at ``TABLE_MIN_SAMPLES`` times or more each: None, meaning each
+       state alone, by these rules with its own formula (its table then pays).
+    4. Everything else: the numpy backend.
     """
-    if times is None and states < SMALL_BATCH:
-        return float_backend
-    if (
-        states == 1
-        and times is not None
-        and times >= TABLE_MIN_SAMPLES
-        and formula is not None
-        and table_backend.takes(formula)
-    ):
-        return table_backend
+    if times is None:
+        return float_backend if states < SMALL_BATCH else numpy_backend
+    if times >= TABLE_MIN_SAMPLES:
+        if states > 1:
+            return None
+        if formula is not None and table_backend.takes(formula):
+            return table_backend
     return numpy_backend

@@ -64,6 +64,7 @@ from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
 
 from attitude.base.float_math import FLOAT
 from attitude.elliptic.functions import JacobiParameter, amplitude
@@ -83,6 +84,7 @@ __all__ = [
     "hamilton",
     "norm",
     "p_quaternion",
+    "permutation_quaternion",
     "preferred_flips",
     "step",
     "y_times_p",
@@ -462,6 +464,18 @@ def preferred_flips(flip1: Any, flip3: Any, xp: Any) -> tuple[Any, Any, Any]:
     f3 = w(flip3, -1.0, 1.0)
     f2 = w(flip1 != flip3, -1.0, 1.0)
     return f1, f2, f3
+
+
+@functools.lru_cache(maxsize=64)
+def permutation_quaternion(
+    index: tuple[int, int, int], sign: tuple[float, float, float]
+) -> tuple[float, float, float, float]:
+    """The quaternion (scalar first) of the signed permutation S[k, index[k]] = sign[k]
+    with determinant +1: one of 24 rotations, each converted once by scipy."""
+    matrix = np.zeros((3, 3))
+    matrix[np.arange(3), index] = sign
+    w, x, y, z = Rotation.from_matrix(matrix).as_quat(scalar_first=True).tolist()
+    return w, x, y, z
 
 
 def norm(m1: Any, m2: Any, m3: Any, xp: Any) -> Any:

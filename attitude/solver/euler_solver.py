@@ -263,14 +263,16 @@ class EulerSolver:
         """The body momentum (or angular velocity) at ``t``, shape ``np.shape(t) + (3,)``."""
         if isinstance(t, float) and math.isfinite(t):  # one time: no numpy on the way
             try:
-                return select(1, None).body_vector(
+                return float_backend.body_vector(
                     self._motion, t - self._t0, self._motion.I_frame_floats if velocity else None
                 )
             except NotRepresentable:
                 raise self._too_far(t, 0) from None
         times = self._times(t)
         try:
-            out = select(1, times.size).body_vectors(self._motion, times.ravel(), velocity)
+            backend = select(1, times.size, self._formula)
+            assert backend is not None  # one state
+            out = backend.body_vectors(self._motion, times.ravel(), velocity)
         except NotRepresentable as error:
             raise self._too_far(t, error.index) from None
         return out.reshape((*times.shape, 3))
@@ -318,14 +320,15 @@ class EulerSolver:
 
     def _quaternion_at(self, t_float: float, t: Any) -> tuple[float, float, float, float]:
         """The unit attitude quaternion (w, x, y, z) at one time (the float backend)."""
-        try:
-            return select(1, None).quaternion(self._motion, t_float - self._t0)
+        try:  # one time: the float backend (backends.select's rule 1)
+            return float_backend.quaternion(self._motion, t_float - self._t0)
         except NotRepresentable:
             raise self._too_far(t, 0) from None
 
     def _quaternions(self, t: Any, times: NDArray[np.float64], columns: tuple) -> NDArray:
         """The attitude quaternions at an array of times (the numpy or table backend)."""
         backend = select(1, times.size, self._formula)
+        assert backend is not None  # one state
         try:
             q = backend.quaternions(self._motion, times.ravel(), columns)
         except NotRepresentable as error:

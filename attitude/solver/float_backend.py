@@ -22,7 +22,6 @@ Results beyond the float range raise ``closed_form.NotRepresentable``.
 
 from __future__ import annotations
 
-import functools
 import math
 
 import numpy as np
@@ -45,6 +44,7 @@ from attitude.solver.closed_form import (
     hamilton,
     norm,
     p_quaternion,
+    permutation_quaternion,
     preferred_flips,
     step,
     y_times_p,
@@ -119,18 +119,6 @@ class OneState:
 # ----------------------------------------------------------------- one state's Motion
 
 
-@functools.lru_cache(maxsize=64)
-def _permutation_quaternion(
-    index: tuple[int, int, int], sign: tuple[float, float, float]
-) -> tuple[float, float, float, float]:
-    """The quaternion (scalar first) of the signed permutation S[k, index[k]] = sign[k]:
-    one of 24 rotations, each converted once by scipy."""
-    matrix = np.zeros((3, 3))
-    matrix[np.arange(3), index] = sign
-    w, x, y, z = Rotation.from_matrix(matrix).as_quat(scalar_first=True).tolist()
-    return w, x, y, z
-
-
 def _constant_matrix(
     r: tuple[float, float, float, float], s: tuple[float, float, float, float]
 ) -> tuple[tuple[float, float, float, float], ...]:
@@ -168,7 +156,7 @@ def motion(
     # the body → principal rotation V of a tensor.  Row vectors go back to the body as
     # v_frame @ S (S_columns: the entries of each column of S, exact for a signed
     # permutation).
-    S = _permutation_quaternion(index, sign)
+    S = permutation_quaternion(index, sign)
     V: NDArray[np.float64] | None = None
     if body_to_principal is None:
         position = {i0: 0, i1: 1, i2: 2}  # column k of S: its entry sign[i] at row i

@@ -201,6 +201,7 @@ def _many_compiled(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray):
         return m_new, q_new
     left = np.flatnonzero(~ok)
     backend = select(left.size, None)
+    assert backend is not None  # one time each
     try:
         m_new[left], q_new[left] = backend.advance(inertia[left], m[left], q[left], τ[left])
     except NotRepresentable as error:

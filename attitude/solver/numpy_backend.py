@@ -9,7 +9,9 @@ rest, mc of any size), in any mix:
   samples, whose temporaries stay in the processor's cache;
 - many states, one step each (``advance``): grouped by case (``ManyStates``: the
   batch's case test in double-double, with the exact integers where its bound leaves
-  a doubt), in slices of ``FLOW_CHUNK`` states.
+  a doubt), in slices of ``FLOW_CHUNK`` states;
+- many states at many times each (``Motions``, for attitude.solver.batch), each case's
+  formula over its states and slices of their times.
 
 Leaves nothing.  Its cost is a few hundred numpy calls per evaluation, ~0.3–2 µs each
 whatever their size, plus a few tens of nanoseconds a sample: the backend for arrays
@@ -38,6 +40,7 @@ from attitude.solver.closed_form import (
     hamilton,
     norm,
     p_quaternion,
+    permutation_quaternion,
     preferred_flips,
     step,
     y_times_p,
@@ -48,6 +51,7 @@ __all__ = [
     "CHUNK",
     "FLOW_CHUNK",
     "ManyStates",
+    "Motions",
     "SortedMoments",
     "advance",
     "body_vectors",
@@ -221,6 +225,160 @@ def _advance(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray) -> tuple[NDA
         finite = np.isfinite(q_new).all(axis=1) & np.isfinite(m_new).all(axis=1)
         raise NotRepresentable(int(np.flatnonzero(~finite)[0]))
     return m_new, q_new / np.linalg.norm(q_new, axis=1, keepdims=True)
+
+
+# ----------------------------------------------------------------- many states, many times
+
+
+class Motions:
+    """Many states' motions, each evaluated at many times: ``closed_form.Motion`` for a
+    batch, with every case in any mix (attitude.solver.batch).
+
+    ``moments`` (N, 3): principal moments along the principal axes (any order);
+    ``momentum`` (N, 3): the momentum in those axes; ``q0`` (N, 4): the unit attitudes
+    at ``t0`` (N,), body → inertial, scalar first; ``body_to_principal``: None (the
+    body axes are principal) or the rotations V (N, 3, 3) and their quaternions (N, 4).
+    Each case's formula runs once over its states (``ManyStates``), with the constants
+    of each state in arrays (N,) against times (T, N): the formulas broadcast over
+    them as over a flow's two ends.  Per state, as ``closed_form.Motion``:
+    S = S_perm ∘ V (``S``, (N, 3, 3)), R = Q0 ∘ S⁻¹ ∘ P(m(t0))⁻¹ and M = L(R) R(S)
+    (``M``, (N, 4, 4)), ψ(t0) (``ψ_t0``).
+    """
+
+    def __init__(
+        self,
+        moments: NDArray[np.float64],
+        momentum: NDArray[np.float64],
+        q0: NDArray[np.float64],
+        t0: NDArray[np.float64],
+        body_to_principal: tuple[NDArray[np.float64], NDArray[np.float64]] | None = None,
+    ) -> None:
+        n = moments.shape[0]
+        self.t0 = t0
+        self.q0 = q0
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+            self.states = ManyStates(moments, momentum)
+        index, sign = self.states.index, self.states.sign
+        # The frame's moments and S_perm, each state's signed permutation.
+        self.I_frame = np.take_along_axis(moments, index, axis=1)
+        S_perm = np.zeros((n, 3, 3))
+        np.put_along_axis(S_perm, index[:, :, None], sign[:, :, None], axis=2)
+        S_q = _permutation_quaternions(index, sign)
+        if body_to_principal is None:
+            self.S = S_perm
+        else:
+            V, V_q = body_to_principal
+            self.S = np.einsum("nij,njk->nik", S_perm, V)
+            S_q = np.stack(hamilton(tuple(S_q.T), tuple(V_q.T)), axis=-1)  # S_perm ∘ V
+        # m and ψ at t0 from each state's formula (both ends from the same formula).
+        P0 = np.zeros((n, 4))
+        P0[:, 0] = 1.0  # rest: P is the identity
+        self.ψ_t0 = np.zeros(n)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+            for k, formula in self.states.groups:
+                if isinstance(formula, Rest):
+                    continue
+                a, b, c, ψ = formula.momentum_and_angle(np.zeros(k.size), np)
+                P0[k, :3] = np.stack(p_quaternion(a, b, c, self.states.G[k], np), axis=-1)
+                self.ψ_t0[k] = ψ
+        s = tuple(S_q.T)
+        R = hamilton(hamilton(tuple(q0.T), (s[0], -s[1], -s[2], -s[3])), tuple((P0 * _CONJUGATE).T))
+        # M's column j: R ⊗ (e_j ⊗ S), as closed_form's one-state M.
+        sw, sx, sy, sz = s
+        columns = (
+            hamilton(R, s),
+            hamilton(R, (-sx, sw, -sz, sy)),
+            hamilton(R, (-sy, sz, sw, -sx)),
+            hamilton(R, (-sz, -sy, sx, sw)),
+        )
+        self.M = np.stack([np.stack(column, axis=-1) for column in columns], axis=-1)
+
+    def quaternions(self, τ: NDArray[np.float64], columns: tuple) -> NDArray[np.float64]:
+        """The unit attitude quaternions at τ = t − t0 (N, T), (N, T, 4), component i of
+        (w, x, y, z) in column ``columns[i]``."""
+        out = np.empty((4, τ.shape[1], τ.shape[0]))  # (component, time, state): see _slices
+        for k, formula, τ_slice, times in self._slices(τ):
+            if isinstance(formula, Rest):  # the attitude stays
+                for i in range(4):
+                    out[columns[i]][times, k] = self.q0[k, i]
+                continue
+            a, b, c, ψ = formula.momentum_and_angle(τ_slice, np)
+            ψ -= self.ψ_t0[k]
+            ψ *= 0.5
+            yp = y_times_p(ψ, *p_quaternion(a, b, c, self.states.G[k], np), np)
+            M = self.M[k]
+            q = [
+                yp[0] * M[:, i, 0] + yp[1] * M[:, i, 1] + yp[2] * M[:, i, 2] + yp[3] * M[:, i, 3]
+                for i in range(4)
+            ]
+            norm_q = np.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+            for i in range(4):
+                out[columns[i]][times, k] = q[i] / norm_q
+        return self._finished(out)
+
+    def body_vectors(self, τ: NDArray[np.float64], velocity: bool) -> NDArray[np.float64]:
+        """The body momentum (or angular velocity) at τ (N, T), (N, T, 3)."""
+        out = np.empty((3, τ.shape[1], τ.shape[0]))
+        for k, formula, τ_slice, times in self._slices(τ):
+            components = formula.momentum(τ_slice, np)
+            if velocity:
+                components = tuple(c / self.I_frame[k, i] for i, c in enumerate(components))
+            S = self.S[k]
+            for j in range(3):  # v_body = v_frame @ S
+                body = components[0] * S[:, 0, j] + components[1] * S[:, 1, j]
+                body += components[2] * S[:, 2, j]
+                out[j][times, k] = body
+        return self._finished(out)
+
+    def _slices(self, τ: NDArray[np.float64]):
+        """(states, formula, τ (T', n) of those states, the times' slice) over each
+        case's states and slices of times of about ``CHUNK`` samples in all.
+
+        Time runs along the first axis and the states along the second, so that each
+        state's constants (n,) broadcast over the times as they do over a flow's two
+        ends; the results are written in that layout, (component, time, state), and
+        turned to (state, time, component) once at the end.  A case that every state
+        shares takes slices, not gathers.
+        """
+        τ_T = np.ascontiguousarray(τ.T)
+        n, T = τ.shape
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            for k, formula in self.states.groups:
+                states: Any = slice(None) if k.size == n else k
+                step_T = max(1, CHUNK // k.size)
+                for start in range(0, T, step_T):
+                    times = slice(start, start + step_T)
+                    yield states, formula, τ_T[times, states], times
+
+    @staticmethod
+    def _finished(out: NDArray[np.float64]) -> NDArray[np.float64]:
+        """(component, time, state) as a contiguous (state, time, component) array; a
+        sample beyond the float range raises NotRepresentable with its flat index
+        state × T + time."""
+        result = np.ascontiguousarray(out.transpose(2, 1, 0))
+        finite = np.isfinite(result).all(axis=-1)
+        if not finite.all():
+            raise NotRepresentable(int(np.flatnonzero(~finite.ravel())[0]))
+        return result
+
+
+def _permutation_quaternions(index: NDArray, sign: NDArray) -> NDArray[np.float64]:
+    """The quaternions (N, 4) of each state's signed permutation (one of 24)."""
+    code = (index @ [9, 3, 1]) * 8 + (sign > 0.0) @ [4, 2, 1]
+    _, first, inverse = np.unique(code, return_index=True, return_inverse=True)
+    table = np.array(
+        [
+            permutation_quaternion(
+                (int(index[f, 0]), int(index[f, 1]), int(index[f, 2])),
+                (float(sign[f, 0]), float(sign[f, 1]), float(sign[f, 2])),
+            )
+            for f in first
+        ]
+    )
+    return table[inverse.ravel()]
+
+
+_CONJUGATE = np.array([1.0, -1.0, -1.0, -1.0])
 
 
 # ----------------------------------------------------------------- the case of each state
