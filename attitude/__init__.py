@@ -52,6 +52,7 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.scenario.torques import Burn, ScenarioTorques
     from attitude.solver.batch import EulerSolverBatch
     from attitude.solver.euler_solver import EulerSolver
+    from attitude.solver.free_flow import advance
     from attitude.torques.models import ConstantTorque, GravityGradient, UserTorque
     from attitude.torques.solver import TorquedSolver, departure_time, propagate_batch
     from attitude.trajectory.horizon import validity_horizon
@@ -61,6 +62,7 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
 _LAZY = {
     "EulerSolver": "attitude.solver.euler_solver",
     "EulerSolverBatch": "attitude.solver.batch",
+    "advance": "attitude.solver.free_flow",
     "TorquedSolver": "attitude.torques.solver",
     "propagate_batch": "attitude.torques.solver",
     "departure_time": "attitude.torques.solver",
@@ -119,6 +121,7 @@ __all__ = [
     "Trajectory",
     "UserTorque",
     "__version__",
+    "advance",
     "analyze",
     "departure_time",
     "load_scenario",
