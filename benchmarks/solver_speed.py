@@ -6,8 +6,8 @@ timed alternately with its peer after both were warmed up, and printed with the
 peer's own cost beside the ratio.  The peer is ``scipy.special.ellipj``: one scalar call
 for the per-call figures, a call on as many points for the per-sample ones.  In every
 regime: far from the separatrix, within |Δ2|/G² = 1e-10 of it, the Dzhanibekov case of
-the docs (mc = 2e-6), symmetric tops (I1 = I2 and I2 = I3), and mc below 2^-128 (the
-kernels' ln-mc regime).
+the docs (mc = 2e-6), exactly on it (case iii), symmetric tops (I1 = I2 and I2 = I3),
+and mc below 2^-128 (the kernels' ln-mc regime).
 
 1. construction: ``EulerSolver(inertia, momentum, attitude)`` (three moments; and a
    full tensor), and a fresh solver with one ``attitude(t)``: what building one solver
@@ -68,6 +68,7 @@ CASES: dict[str, tuple[np.ndarray, np.ndarray]] = {
         np.array([1.0, 2.0, 3.0]),
         _near_separatrix(np.array([1.0, 2.0, 3.0]), 1e-10),
     ),
+    "on the separatrix (iii)": (np.array([2.0, 3.0, 6.0]), np.array([1.0, 0.7, -1.0])),
     "Dzhanibekov (mc 2e-6)": (
         np.array([100.0, 200.0, 300.0]),
         np.array([100.0, 200.0, 300.0]) * np.array([1e-3, 1.0, 1e-3]),

@@ -181,8 +181,12 @@ def test_bad_times_are_named():
         batch.attitude_quaternion(np.zeros((3, 4)))
     with pytest.raises(InputError, match="t must be finite"):
         batch.angular_momentum([0.0, np.inf])
-    # λ t beyond the float range for the second state only (EulerSolver refuses it too).
-    with pytest.raises(InputError, match=r"t = 1e\+308 s is too far from t0 = 0\.0 s for state 1"):
-        batch.attitude_quaternion([0.0, 1e308])
-    with pytest.raises(InputError, match="for state 1"):
+    # λ t beyond the float range for the second state only (EulerSolver refuses it too),
+    # a few times (state by state on floats) and many (numpy over the batch).
+    for t in ([0.0, 1e308], np.r_[np.zeros(39), 1e308]):
+        with pytest.raises(InputError, match=r"state 1: t = 1e\+308 s is too far from t0 = 0\.0"):
+            batch.attitude_quaternion(t)
+    with pytest.raises(InputError, match="state 1: t = 1e"):
         batch.angular_momentum([[0.0, 1.0], [0.0, 1e308]])
+    with pytest.raises(InputError, match="state 1: t = 1e"):
+        batch.angular_momentum(np.stack([np.zeros(30), np.r_[np.zeros(29), 1e308]]))

@@ -9,9 +9,9 @@ for small T that is most of the work.  ``EulerSolverBatch`` builds the N states'
 constants in one pass over arrays (each case's formula once over its states, the case
 test in double-double with the exact integers where it is in doubt:
 attitude.solver.numpy_backend) and evaluates each case's formula over its states and
-the times together, a few tens of nanoseconds a sample.  From
-``backends.TABLE_MIN_SAMPLES`` times a state, a state's own table of ψ pays for itself:
-each state is then evaluated alone, as its ``EulerSolver`` (``batch[k]``) would.
+the times together.  From ``backends.TABLE_MIN_SAMPLES`` times a state, a state's own
+table of ψ pays for itself: each state is then evaluated alone, as its ``EulerSolver``
+(``batch[k]``) would (``backends.select``'s rule 3).
 
 Every case, in any mix: both sides of the separatrix and on it, mc below the float
 range, symmetric bodies, the sphere, rest, spin about any axis, tensors.  The results
@@ -189,15 +189,20 @@ class EulerSolverBatch:
             f"times, one row per state; got shape {times.shape}"
         )
 
-    def _evaluate(
-        self, t: Any, width: int, evaluate: Any, alone: Any = None
-    ) -> NDArray[np.float64]:
+    def _evaluate(self, t: Any, width: int, evaluate: Any, alone: Any) -> NDArray[np.float64]:
+        """``evaluate(τ)`` of every state at once (the numpy backend), or ``alone`` of
+        each state's ``EulerSolver`` at its times where ``backends.select`` says so (so
+        many times a state that its own table pays)."""
         times, τ, scalar = self._times(t)
         n, T = τ.shape
-        if alone is not None and select(n, T) is None:  # each state alone: its table pays
+        if select(n, T) is None:  # each state alone
             out = np.empty((n, T, width))
             for k in range(n):
-                out[k] = alone(self[k], times if times.ndim == 1 else times[k])
+                row = times if times.ndim < 2 else times[k]
+                try:
+                    out[k] = alone(self[k], np.atleast_1d(row))
+                except InputError as error:  # a time too far from t0: name the state
+                    raise InputError(f"state {k}: {error}") from None
         else:
             try:
                 out = evaluate(τ)
@@ -205,8 +210,9 @@ class EulerSolverBatch:
                 k, i = divmod(error.index, T)
                 t_bad = times if times.ndim == 0 else (times[i] if times.ndim == 1 else times[k, i])
                 raise InputError(
-                    f"t = {float(t_bad)!r} s is too far from t0 = {float(self._t0[k])!r} s "
-                    f"for state {k}: its angles, times t - t0, exceed the float range (1.8e308)"
+                    f"state {k}: t = {float(t_bad)!r} s is too far from t0 = "
+                    f"{float(self._t0[k])!r} s for this motion: its angles, times t - t0, "
+                    "exceed the float range (1.8e308)"
                 ) from None
         return out[:, 0] if scalar else out
 
@@ -235,11 +241,21 @@ class EulerSolverBatch:
 
     def angular_momentum(self, t: ArrayLike) -> NDArray[np.float64]:
         """Body-frame angular momenta at ``t`` (N m s): (N, T, 3), or (N, 3)."""
-        return self._evaluate(t, 3, lambda τ: self._motions.body_vectors(τ, velocity=False))
+        return self._evaluate(
+            t,
+            3,
+            lambda τ: self._motions.body_vectors(τ, velocity=False),
+            lambda solver, times: solver.angular_momentum(times),
+        )
 
     def angular_velocity(self, t: ArrayLike) -> NDArray[np.float64]:
         """Body-frame angular velocities at ``t`` (rad/s): (N, T, 3), or (N, 3)."""
-        return self._evaluate(t, 3, lambda τ: self._motions.body_vectors(τ, velocity=True))
+        return self._evaluate(
+            t,
+            3,
+            lambda τ: self._motions.body_vectors(τ, velocity=True),
+            lambda solver, times: solver.angular_velocity(times),
+        )
 
     # ----------------------------------------------------------------- properties
 
