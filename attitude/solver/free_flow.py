@@ -264,11 +264,9 @@ def _broadcast(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray):
             f"{m.shape}, quaternion_wxyz {q.shape}, dt {τ.shape}"
         ) from None
     n = N[0] if N else 1
-    return (
-        np.broadcast_to(inertia, (n, 3)),
-        np.broadcast_to(m, (n, 3)),
-        np.broadcast_to(q, (n, 4)),
-        np.broadcast_to(τ, (n,)),
+    return tuple(
+        array if array.shape == shape else np.broadcast_to(array, shape)  # as given, or a view
+        for array, shape in ((inertia, (n, 3)), (m, (n, 3)), (q, (n, 4)), (τ, (n,)))
     )
 
 
