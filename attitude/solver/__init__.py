@@ -21,5 +21,7 @@ Modules:
   a time.
 - ``numpy_backend``: The formula set on numpy arrays: one state at many times, many
   states.
+- ``sensitivities``: Sensitivities of the exact torque-free motion: its Jacobian with
+  respect to the initial attitude, the initial body momentum and the principal moments.
 - ``table_backend``: The numpy backend with ψ's periodic part from a table built once.
 """
