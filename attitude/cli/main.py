@@ -299,9 +299,8 @@ def _checked_run(args, state: dict) -> int:
     except (ScenarioFileError, OutputFolderError) as exc:
         _error(str(exc))
         return 2
-    except InputError as exc:
-        name = state.get("file") or args.scenario.name
-        _error(f"{name}: {exc}")
+    except InputError as exc:  # from the file's values: named after the file, unless it names one
+        _error(str(exc if exc.file else exc.located(file=state.get("file") or args.scenario.name)))
         return 2
     except MemoryError:
         _error(f"{args.scenario.name}: out of memory: use a longer output.step or a shorter span")

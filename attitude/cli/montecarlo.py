@@ -23,14 +23,16 @@ def command(args, loaded: ScenarioFile) -> int:
     mc = plan_montecarlo(loaded, None, args.samples, args.seed)
     if args.emit_scenario is not None or args.sample is not None:
         if args.emit_scenario is None or args.sample is None:
-            raise InputError("--sample K and --emit-scenario DIR go together")
+            raise InputError(
+                "K goes with --emit-scenario DIR: give both or neither", key="--sample"
+            )
         if args.out is not None:
-            raise InputError("--out: runs the job; --emit-scenario writes samples instead")
+            raise InputError("runs the job; --emit-scenario writes samples instead", key="--out")
         for path in emit_samples(mc, args.sample, args.emit_scenario):
             print(path, flush=True)
         return 0
     if args.out is None:
-        raise InputError("--out: the output folder is required (or --emit-scenario)")
+        raise InputError("the output folder is required (or --emit-scenario)", key="--out")
     check_folder(mc, args.out)
     stage = Progress(None if args.quiet else lambda line: print(line, file=sys.stderr))
     bar = None if args.quiet else ProgressBar(sys.stderr)

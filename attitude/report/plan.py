@@ -12,7 +12,8 @@ error estimate of their step); a scenario with an orbit that leaves the gravity
 gradient out (torque-free, or burns alone) gets its validity horizon
 (``attitude.trajectory.horizon.validity_horizon``).  What it refuses, a run would have refused
 later, after computing; what it returns is what the run uses.  Errors are
-``attitude.base.errors.InputError`` whose message starts with the scenario key.
+``attitude.base.errors.InputError`` whose ``key`` is the scenario key that holds the
+bad value.
 """
 
 from __future__ import annotations
@@ -72,6 +73,7 @@ def plan_run(
     samples = scenario.output_count()
     if "parquet" in outputs:
         check_span(scenario.start_s, scenario.stop_s, "--formats parquet")
+    _check_gravity_gradient_orbit(scenario)
     trajectory = propagate(scenario)
     # The size and memory checks come before the analysis and the pointing checks,
     # which do not depend on the output grid but can take a while on a long span.
@@ -91,8 +93,9 @@ def plan_run(
     errors.append(trajectory.error_estimate)
     if not all(math.isfinite(error) for error in errors):
         raise InputError(
-            f"torques: the propagation has no finite error estimate ({errors}): "
-            "give a smaller step or an accuracy"
+            f"the propagation has no finite error estimate ({errors}): "
+            "give a smaller step or an accuracy",
+            key="torques",
         )
     found = None
     # On an orbit, unless the gravity gradient is modelled: a torque-free run, or burns
@@ -132,6 +135,15 @@ def plan_run(
         found,
         horizon_deferred=wanted and not horizon,
     )
+
+
+def _check_gravity_gradient_orbit(scenario: Scenario) -> None:
+    """The orbit the gravity gradient is computed on covers the span (an OEM file that
+    ends early is refused here, naming its key, before the torqued propagation would
+    stop at the first step outside it); its notes are the pointing's to give."""
+    orbit = scenario.torques.gravity_gradient
+    if orbit is not None and hasattr(orbit, "check_span"):
+        orbit.check_span(scenario.times(scenario.start_s), scenario.times(scenario.stop_s))
 
 
 def horizon_beside(plan: RunPlan) -> Beside[ValidityHorizon] | None:
