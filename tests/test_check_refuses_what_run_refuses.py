@@ -369,7 +369,8 @@ def test_year_0001_runs_and_is_written_with_four_digits(tmp_path, capsys):
 
 
 def test_a_precision_finer_than_time_resolves_is_clamped_and_said(tmp_path, capsys):
-    """interval_precision = 1e-13 s used to hang: the bisection cannot get below an ulp."""
+    """interval_precision = 1e-13 s: the bisection cannot get below an ulp, so the
+    precision is clamped to what time resolves, and said."""
     text = _with_tle().replace("[pointing]\n", "[pointing]\ninterval_precision = 1e-13\n")
     path = tmp_path / "fine.toml"
     path.write_text(_replace("duration = 10.0", "duration = 600.0", text))
@@ -411,7 +412,7 @@ def test_check_with_out_refuses_what_run_would(tmp_path, capsys):
 
 
 def test_every_run_error_names_the_file_and_the_key(tmp_path, capsys):
-    """Errors raised after loading (the TLE, the solver, the budget) used to lack both."""
+    """Errors raised after loading (the TLE, the solver, the budget) name both too."""
     for case in ("TLE lines swapped", "1e200 rad/s", "1e11 output epochs", "epoch 2060"):
         path = tmp_path / "bad.toml"
         path.write_text(BAD[case][0], encoding="utf-8")

@@ -76,7 +76,7 @@ def test_a_hair_away_from_a_stable_principal_axis(axis, hair):
     _check_against_dop853(inertia, m0, span=60.0)
 
 
-@pytest.mark.parametrize("hair", [1e-8, -1e-12])
+@pytest.mark.parametrize("hair", [1e-8, pytest.param(-1e-12, marks=pytest.mark.slow)])
 def test_a_hair_away_from_the_intermediate_axis(hair):
     """mc ≈ 1e-17 to 1e-25: the state leaves the axis, flips, and comes back.
 

@@ -2,9 +2,8 @@
 
 The segments without a period (a sphere, a body at rest, a steady spin about the
 intermediate axis, a state exactly on the separatrix, also one reached by an
-attitude reset late in a run) used to stop the run with `t_end must be finite, got
-inf`.  Each now runs, its summary says what the motion is (no period, no flips,
-steady or asymptotic), and the time series agrees with an independent DOP853
+attitude reset late in a run) each run: the summary says what the motion is (no
+period, no flips, steady or asymptotic), and the time series agrees with an independent DOP853
 integration of Euler's equations from the same state (tests/reference_models.py).
 """
 

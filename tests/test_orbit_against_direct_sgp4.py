@@ -6,9 +6,7 @@ eccentric and deep-space ones included.  The reference is skyfield's own
 ``EarthSatellite.at`` at every epoch (SGP4 in TEME, rotated to the GCRS with the full
 IAU 2000A nutation, 45–80 µs an epoch).  ``TleOrbit`` runs the same SGP4 at every epoch
 and interpolates only the TEME → GCRS rotation (whole TT hours, cubic Lagrange).
-Measured over a day at 10 s: ≤ 3 µm and ≤ 0.6 nm/s on every satellite below (the
-issue's targets were 0.4 m and 0.03 m/s; the 60 s Hermite spline this replaces was 7
-to 24 m and 1.7 to 6 m/s off on the eccentric ones).
+Measured over a day at 10 s: ≤ 3 µm and ≤ 0.6 nm/s on every satellite below.
 """
 
 import importlib.resources

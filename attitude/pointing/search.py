@@ -121,11 +121,6 @@ class SearchGrid:
     vector_rates_rad_s: dict[str, float] = field(default_factory=dict, compare=False)
 
     @property
-    def angle_rate_bound(self) -> float:
-        """A bound on how fast any angle between two of our directions changes, rad/s."""
-        return self.body_rate_rad_s + self._geometry_rate
-
-    @property
     def _geometry_rate(self) -> float:
         """How fast the Sun, the Moon and the Earth can move across the sky, rad/s."""
         return (

@@ -82,12 +82,6 @@ class Composition:
         """c_j = a_0 + … + a_{j−1}: the clock of kick j, as a fraction of the step."""
         return np.concatenate([[0.0], np.cumsum(self.flows)])
 
-    @property
-    def flows_per_step(self) -> int:
-        """Free flows a step costs when consecutive steps merge their end flows."""
-        merged = 1 if self.kicks[0] == 0.0 and self.kicks[-1] == 0.0 else 0
-        return len(self.flows) - merged
-
 
 def _symmetric(half: list[float], middle: str) -> list[float]:
     """half + its mirror image; ``middle`` 'once' keeps the last element single."""
