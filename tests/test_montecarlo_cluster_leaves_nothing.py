@@ -18,6 +18,7 @@ import time
 
 import psutil
 from montecarlo_scenarios import write_spinner
+from signal_dispositions import defaults
 
 from attitude.montecarlo.cluster import connect
 
@@ -103,6 +104,7 @@ def test_ctrl_c_closes_the_cluster_and_leaves_nothing(tmp_path):
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,  # its own process group, as a terminal's foreground job
+        preexec_fn=defaults,  # not the ignored SIGINT of a `pytest &`
     )
     lines = []
     try:

@@ -18,6 +18,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from signal_dispositions import defaults
 
 import attitude.outputs.folder
 import attitude.report.run
@@ -227,6 +228,7 @@ def _cli(*args, cwd=None, **kwargs) -> subprocess.Popen:
     """The installed `attitude` command (or `python -m attitude` where there is none)."""
     script = Path(sys.executable).parent / "attitude"
     command = [str(script)] if script.is_file() else [sys.executable, "-m", "attitude"]
+    kwargs.setdefault("preexec_fn", defaults)  # not the ignored SIGINT of a `pytest &`
     return subprocess.Popen(
         [*command, *args],
         cwd=cwd,
@@ -247,6 +249,7 @@ def test_a_full_disk_leaves_nothing(user_folder, formats):
     before = _snapshot(folder)
 
     def limit():
+        defaults()
         resource.setrlimit(resource.RLIMIT_FSIZE, (200_000, 200_000))
 
     process = _cli(

@@ -1,5 +1,5 @@
-"""The shared base: errors, units, quaternions and vectors, float helpers, the compile
-policy and double-double arithmetic. It imports no other layer.
+"""The shared base: errors, signals, units, quaternions and vectors, float helpers, the
+compile policy and double-double arithmetic. It imports no other layer.
 
 Modules:
 
@@ -13,6 +13,8 @@ Modules:
 - ``quantities``: Numbers at the public edge: astropy Quantities to SI floats, and their
   checks.
 - ``quaternions``: Hamilton quaternion algebra, scalar first, vectorized.
+- ``signals``: How a run stops on a signal, and the dispositions a caller set, which
+  the run keeps.
 - ``vectors``: Two small vector helpers: the angle between vectors, and a basis across a
   unit vector.
 - ``version``: The package version (read by pyproject.toml and written into every

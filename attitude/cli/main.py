@@ -21,7 +21,9 @@ Exit status, with one line on stderr and never a traceback:
 0 success; 2 a bad scenario file, a run that cannot fit, or an output folder that is
 not ours (the line names the file, the key and the value); 1 the outputs cannot be
 written (a full disk, a folder we may not write); 130 interrupted (Ctrl-C), 143
-terminated (SIGTERM), 129 hung up (SIGHUP), and nothing of the run is left behind;
+terminated (SIGTERM), 129 hung up (SIGHUP), 128 + N for a process of the run that
+another signal N killed, and nothing of the run is left behind (a signal the caller
+ignores, as ``nohup`` does SIGHUP, stays ignored: ``attitude.base.signals``);
 3 a bug (an exception this tool did not expect; ``ATTITUDE_TRACEBACK=1`` shows its
 traceback).  Warnings are one line each, ``attitude: warning: FILE: KEY: ...``, and so
 are notes (``attitude: note: ...``: a clamped precision, a far TLE epoch).
@@ -42,22 +44,11 @@ from pathlib import Path
 
 __all__ = ["main"]
 
-_SIGNAL_EXIT = {signal.SIGINT: 130, signal.SIGTERM: 143}
-if hasattr(signal, "SIGHUP"):
-    _SIGNAL_EXIT[signal.SIGHUP] = 129
-_SIGNAL_TEXT = {130: "interrupted", 143: "terminated", 129: "hung up"}
-
-
-class _Stopped(BaseException):
-    """A signal asked the run to stop (raised by the handler, like KeyboardInterrupt)."""
-
-    def __init__(self, number: int) -> None:
-        super().__init__(number)
-        self.number = number
-
 
 def _raise_stopped(number: int, frame) -> None:
-    raise _Stopped(number)
+    from attitude.base.signals import Stopped
+
+    raise Stopped(number)
 
 
 def _one_line(text: str) -> str:
@@ -314,23 +305,29 @@ def _checked_run(args, state: dict) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
+    try:  # a few small modules, no numpy: the handlers go in right after
+        from attitude.base.signals import STOPPING, Stopped, caller_ignores
+    except KeyboardInterrupt:
+        _error("interrupted; nothing of this run was left behind")
+        return 130
     state: dict = {}
     previous = {}
     in_main_thread = threading.current_thread() is threading.main_thread()
     try:
         if in_main_thread:
-            for number in _SIGNAL_EXIT:
-                if number != signal.SIGINT:
+            # SIGINT is Python's KeyboardInterrupt; a signal the caller ignores
+            # (nohup's SIGHUP, a background job's SIGINT) stays ignored.
+            for number in STOPPING:
+                if number != signal.SIGINT and not caller_ignores(number):
                     previous[number] = signal.signal(number, _raise_stopped)
         args = _parser().parse_args(argv)
         return _run(args, state)
     except KeyboardInterrupt:
         _error("interrupted; nothing of this run was left behind")
         return 130
-    except _Stopped as stop:
-        code = _SIGNAL_EXIT[stop.number]
-        _error(f"{_SIGNAL_TEXT[code]}; nothing of this run was left behind")
-        return code
+    except Stopped as stop:
+        _error(f"{stop.text}; nothing of this run was left behind")
+        return stop.exit_status
     except BrokenPipeError:  # `attitude check x | head -1`
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())

@@ -39,6 +39,7 @@ from pathlib import Path
 from typing import Any
 
 from attitude.base.errors import InputError
+from attitude.base.signals import STOPPING
 
 __all__ = ["MANIFEST_NAME", "OutputFolder", "OutputFolderError", "claim", "held_signals"]
 
@@ -47,7 +48,7 @@ _FORMAT = "attitude output manifest"
 _FORMAT_VERSION = 1
 _PARTIAL_PREFIX = ".attitude-partial-"
 _PARTIAL = re.compile(re.escape(_PARTIAL_PREFIX) + r"\d+")
-_HELD = (signal.SIGINT, signal.SIGTERM) + ((signal.SIGHUP,) if hasattr(signal, "SIGHUP") else ())
+_HELD = STOPPING
 
 
 class OutputFolderError(InputError):
@@ -76,7 +77,9 @@ def held_signals() -> Iterator[None]:
     previous = {}
     for number in _HELD:
         handler = signal.getsignal(number)
-        if handler is not None:  # None: set outside Python, and could not be restored
+        # None: set outside Python, and could not be restored; SIG_IGN: the caller's
+        # wish (nohup's SIGHUP), nothing to hold (attitude.base.signals).
+        if handler is not None and handler is not signal.SIG_IGN:
             previous[number] = signal.signal(number, lambda n, frame: received.append(n))
     try:
         yield
