@@ -19,7 +19,7 @@ from __future__ import annotations
 import copy
 from typing import Any
 
-__all__ = ["NO_VALUE", "AttitudeError", "InertiaWarning", "InputError"]
+__all__ = ["NO_VALUE", "AttitudeError", "InertiaWarning", "InputError", "OptionError"]
 
 
 class _NoValue:
@@ -90,6 +90,18 @@ class InputError(AttitudeError, ValueError):
             return self.located(key=prefix)
         joiner = "" if self.key.startswith("[") else "."
         return self.located(key=f"{prefix}{joiner}{self.key}")
+
+
+class OptionError(InputError):
+    """A command-line option's value is refused: ``key`` is the option, ``value`` what
+    was given, and the line reads as the command was typed, ``--out results: reason``
+    (with the scenario file first when it has one)."""
+
+    def __str__(self) -> str:
+        if not (self.key and self.has_value):
+            return super().__str__()
+        parts = (self.file, f"{self.key} {self.value}", self.reason)
+        return ": ".join(part for part in parts if part)
 
 
 class InertiaWarning(UserWarning):

@@ -9,6 +9,7 @@ from pathlib import Path
 
 from attitude.base.errors import InputError
 from attitude.files.scenario_reader import ScenarioFile
+from attitude.montecarlo.cluster import check_where
 from attitude.montecarlo.plan import emit_samples, plan_montecarlo
 from attitude.montecarlo.report import check_folder, write_report
 from attitude.montecarlo.simulation import simulate
@@ -20,8 +21,14 @@ __all__ = ["ProgressBar", "command"]
 def command(args, loaded: ScenarioFile) -> int:
     """``attitude montecarlo`` (the command line's options in ``args``): run the job into
     ``--out``, or write samples ``--sample`` into ``--emit-scenario``."""
+    emit = args.emit_scenario is not None or args.sample is not None
+    stage = Progress(None if args.quiet else lambda line: print(line, file=sys.stderr))
+    if not emit:  # where the job runs, checked first: an address tried takes seconds
+        if args.scheduler is not None:
+            stage(f"trying the Dask scheduler at {args.scheduler}")
+        check_where(args.scheduler, args.workers)
     mc = plan_montecarlo(loaded, None, args.samples, args.seed)
-    if args.emit_scenario is not None or args.sample is not None:
+    if emit:
         if args.emit_scenario is None or args.sample is None:
             raise InputError(
                 "K goes with --emit-scenario DIR: give both or neither", key="--sample"
@@ -34,9 +41,8 @@ def command(args, loaded: ScenarioFile) -> int:
     if args.out is None:
         raise InputError("the output folder is required (or --emit-scenario)", key="--out")
     check_folder(mc, args.out)
-    stage = Progress(None if args.quiet else lambda line: print(line, file=sys.stderr))
     bar = None if args.quiet else ProgressBar(sys.stderr)
-    result = simulate(mc, args.scheduler, args.workers, args.batch_size, bar, stage)
+    result = simulate(mc, args.scheduler, args.workers, args.batch_size, bar, stage, probed=True)
     failed = result.failed
     if len(failed) == mc.samples:
         first = failed.iloc[0]

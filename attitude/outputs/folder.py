@@ -38,7 +38,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from attitude.base.errors import InputError
+from attitude.base.errors import OptionError
 from attitude.base.signals import STOPPING
 
 __all__ = ["MANIFEST_NAME", "OutputFolder", "OutputFolderError", "claim", "held_signals"]
@@ -51,17 +51,11 @@ _PARTIAL = re.compile(re.escape(_PARTIAL_PREFIX) + r"\d+")
 _HELD = STOPPING
 
 
-class OutputFolderError(InputError):
+class OutputFolderError(OptionError):
     """The output folder cannot be used without touching files that are not ours.
 
     ``key`` is the command-line option that named the folder (``--out``,
-    ``--emit-scenario``) and ``value`` the folder as given; the line shown is
-    ``OPTION FOLDER: reason``, the way the command was typed."""
-
-    def __str__(self) -> str:
-        if self.key and self.has_value:
-            return f"{self.key} {self.value}: {self.reason}"
-        return super().__str__()
+    ``--emit-scenario``) and ``value`` the folder as given: ``--out results: reason``."""
 
 
 @contextlib.contextmanager
