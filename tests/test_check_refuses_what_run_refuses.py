@@ -11,8 +11,10 @@ check with the folder, `check --out DIR`: those cases are run that way.
 
 import json
 import re
+from pathlib import Path
 
 import pytest
+from cli_lines import said
 
 from attitude.cli.main import main
 
@@ -290,7 +292,8 @@ BAD = {
     ),
 }
 
-# Refused by the disk, which `check` sees only with --out.
+# Refused by the disk: `check --out DIR` names DIR's, `check` alone the current folder's
+# (where a relative --out goes), which it used to leave unchecked and say OK.
 DISK = {"1e12 output epochs", "1e11 output epochs"}
 
 BIG = "1" + "0" * 400  # 10**400, a valid TOML integer
@@ -313,7 +316,7 @@ for _key, (_old, _new) in BIG_KEYS.items():
 def _lines(capsys) -> list[str]:
     err = capsys.readouterr().err
     assert "Traceback" not in err
-    return err.splitlines()
+    return said(err)
 
 
 @pytest.mark.parametrize("case", list(BAD))
@@ -322,17 +325,15 @@ def test_check_and_run_refuse_with_the_same_line(case, tmp_path, capsys):
     path = tmp_path / "bad.toml"
     path.write_text(text, encoding="utf-8")
     out = tmp_path / "out"
-    if case in DISK:
-        assert main(["check", str(path)]) == 0  # states the sizes; the disk needs --out
-        assert "disk        not checked" in capsys.readouterr().out
     for check in (["check", str(path)], ["check", str(path), "--out", str(out)]):
-        if case in DISK and "--out" not in check:
-            continue
         assert main(check) == 2
         checked = _lines(capsys)
         assert len(checked) == 1, checked
         assert re.search(rf"^attitude: error: bad\.toml: {message}", checked[0]), checked[0]
         assert checked[0].count("bad.toml") == 1  # the file named once, not `x: x: key`
+        if case in DISK:
+            where = f"{out}" if "--out" in check else f"the current folder ({Path.cwd()})"
+            assert f"and the disk of {where} has " in checked[0], checked[0]
     assert main(["run", str(path), "--out", str(out), "--quiet"]) == 2
     assert _lines(capsys) == checked
     assert not out.exists() and [p.name for p in tmp_path.iterdir()] == ["bad.toml"]
@@ -379,7 +380,7 @@ def test_a_precision_finer_than_time_resolves_is_clamped_and_said(tmp_path, caps
     assert re.search(r"note .*interval_precision 1e-13 s is finer than TT seconds resolve", out)
     assert main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
     err = capsys.readouterr().err
-    assert len(err.splitlines()) == 1 and "attitude: note: fine.toml: pointing." in err
+    assert len(said(err)) == 1 and "attitude: note: fine.toml: pointing." in err
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["pointing"]["interval_precision_s"] == pytest.approx(2 * 1.1368683772161603e-13)
 
@@ -400,6 +401,8 @@ def test_check_states_the_samples_and_the_sizes(tmp_path, capsys):
     assert re.search(r"outputs +3601 samples; writes about [\d.]+ MB \(timeseries\.csv", out)
     assert "holds about" in out
     assert "Sun exclusion half angle 30 deg" in out  # angles echoed in degrees
+    # Without --out, the disk a run writes to without a path: said, and checked.
+    assert re.search(r"disk +[\d.]+ [kMGT]?B free on the current folder's disk", out), out
 
 
 def test_check_with_out_refuses_what_run_would(tmp_path, capsys):

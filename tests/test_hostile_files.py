@@ -21,6 +21,7 @@ import warnings
 from pathlib import Path
 
 import pytest
+from cli_lines import said
 
 from attitude.base.errors import InputError
 from attitude.cli.main import main
@@ -136,7 +137,7 @@ def _call(capsys, argv) -> tuple[int, list[str], str]:
     code = main(argv)
     captured = capsys.readouterr()
     assert "Traceback" not in captured.err and "Traceback" not in captured.out
-    return code, captured.err.splitlines(), captured.out
+    return code, said(captured.err), captured.out
 
 
 def test_there_are_hostile_files():

@@ -6,6 +6,7 @@ and the value, the same from `check`, `run` and `montecarlo`, before anything ru
 """
 
 import pytest
+from cli_lines import said
 from montecarlo_scenarios import SPINNER
 
 from attitude.cli.main import main
@@ -129,7 +130,7 @@ TABLES = {
 
 def _refused(capsys, argv) -> list[str]:
     code = main(argv)
-    err = capsys.readouterr().err.splitlines()
+    err = said(capsys.readouterr().err)
     assert code == 2, err
     assert len(err) == 1, err
     return err

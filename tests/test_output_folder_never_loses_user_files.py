@@ -18,6 +18,7 @@ import sys
 from pathlib import Path
 
 import pytest
+from cli_lines import said
 from signal_dispositions import defaults
 
 import attitude.outputs.folder
@@ -63,8 +64,8 @@ def _leftovers(folder: Path) -> list[str]:
 def _refused(capsys, argv) -> str:
     assert main(argv) == 2
     err = capsys.readouterr().err
-    assert len(err.splitlines()) == 1 and "Traceback" not in err, err
-    return err
+    assert len(said(err)) == 1 and "Traceback" not in err, err
+    return said(err)[0]
 
 
 @pytest.fixture

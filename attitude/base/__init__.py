@@ -1,5 +1,6 @@
-"""The shared base: errors, signals, units, quaternions and vectors, float helpers, the
-compile policy and double-double arithmetic. It imports no other layer.
+"""The shared base: errors, signals, progress messages, units, quaternions and vectors,
+float helpers, the compile policy and double-double arithmetic. It imports no other
+layer.
 
 Modules:
 
@@ -10,6 +11,8 @@ Modules:
   single state's path.
 - ``jit``: How the package compiles its kernels: ``jit``, numba's ``njit`` with one
   policy.
+- ``progress``: Stage messages for a user who waits: what is being done, and since
+  when.
 - ``quantities``: Numbers at the public edge: astropy Quantities to SI floats, and their
   checks.
 - ``quaternions``: Hamilton quaternion algebra, scalar first, vectorized.

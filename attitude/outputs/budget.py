@@ -178,11 +178,13 @@ def size_text(count: float) -> str:
     return _size(count)
 
 
-def check_fits(budget: OutputBudget, out_dir: str | Path | None = None) -> None:
+def check_fits(
+    budget: OutputBudget, out_dir: str | Path | None = None, shown: str | None = None
+) -> None:
     """Refuse (:class:`ResourceError`) a run whose pointing search is beyond
     :data:`MAX_SEARCH_GRID_POINTS`, that would not fit in :data:`MEMORY_SHARE` of the
     memory available, or in :data:`DISK_SHARE` of the free space of the disk that
-    holds ``out_dir`` (not checked when None)."""
+    holds ``out_dir`` (not checked when None; named ``shown`` in the error if given)."""
     grid = budget.search_grid_points
     if grid > MAX_SEARCH_GRID_POINTS:
         raise ResourceError(
@@ -205,7 +207,8 @@ def check_fits(budget: OutputBudget, out_dir: str | Path | None = None) -> None:
         largest = max(budget.files, key=budget.files.get)
         raise ResourceError(
             f"{budget.samples} samples would take about {_size(budget.disk_bytes)} "
-            f"({largest} {_size(budget.files[largest])}), and the disk of {out_dir} has "
+            f"({largest} {_size(budget.files[largest])}), and the disk of "
+            f"{shown or out_dir} has "
             f"{_size(free)} free: use a longer output.step, a shorter span, fewer --formats "
             "(parquet is smaller than csv) or another disk",
             key="output.step",
