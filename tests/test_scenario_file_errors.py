@@ -184,3 +184,34 @@ def test_a_failed_run_leaves_no_output_and_keeps_the_old_one(tmp_path, monkeypat
     # And into a new folder: nothing at all.
     assert main(["run", str(path), "--out", str(tmp_path / "new"), "--quiet"]) == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "valid.toml"]
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "key", "value"),
+    [
+        ("duration = 100.0", "duration = -5.0", "output.duration", -5.0),
+        ('name = "sat"', 'name = " "', "spacecraft.name", " "),
+        ("impulse = [0.0, 0.0, 1.0]", 'impulse = "1"', "events[0].impulse", "1"),
+        ('epoch = "2027-03-01T12:00:00"', 'epoch = "2027-03-01T12:00:60"', "scenario.epoch", None),
+    ],
+    ids=["duration", "name", "impulse", "epoch"],
+)
+def test_the_error_carries_its_key_file_and_value_as_data(tmp_path, old, new, key, value):
+    """The line a user reads is the data joined, ``file: key: reason``; the data is kept
+    across pickling, as Dask and the process beside a run send an error."""
+    import pickle
+
+    from attitude.files.scenario_reader import ScenarioFileError, load_scenario
+
+    path = tmp_path / "bad.toml"
+    path.write_text(_replace(old, new))
+    with pytest.raises(ScenarioFileError) as caught:
+        load_scenario(path)
+    error = caught.value
+    assert (error.file, error.key) == ("bad.toml", key)
+    if value is not None:
+        assert error.value == value
+    assert str(error) == f"bad.toml: {key}: {error.reason}"
+    again = pickle.loads(pickle.dumps(error))
+    assert type(again) is ScenarioFileError and str(again) == str(error)
+    assert (again.file, again.key, again.reason) == (error.file, error.key, error.reason)

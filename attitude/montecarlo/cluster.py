@@ -118,7 +118,9 @@ def check_where(scheduler: str | None, workers: int | None, probe: bool = True) 
     at exit)."""
     if scheduler is not None:
         if workers is not None:
-            raise InputError("--workers: sets the size of the local cluster; not with --scheduler")
+            raise InputError(
+                "sets the size of the local cluster; not with --scheduler", key="--workers"
+            )
         from distributed.comm.addressing import get_address_host_port
 
         try:
@@ -138,7 +140,9 @@ def check_where(scheduler: str | None, workers: int | None, probe: bool = True) 
         return 0
     count = workers if workers is not None else len(os.sched_getaffinity(0))
     if not 1 <= count <= 4 * (os.cpu_count() or 1):
-        raise InputError(f"--workers: expected 1 to {4 * (os.cpu_count() or 1)}, got {count}")
+        raise InputError(
+            f"expected 1 to {4 * (os.cpu_count() or 1)}, got {count}", key="--workers", value=count
+        )
     return count
 
 
@@ -250,7 +254,9 @@ def connect(
             client = Client(scheduler, timeout=_CONNECT_TIMEOUT_S, set_as_default=False)
         except (OSError, TimeoutError, ValueError, TypeError) as exc:
             text = " ".join(str(exc).split())
-            raise InputError(f"--scheduler {scheduler}: cannot connect: {text}") from None
+            raise OptionError(
+                f"cannot connect: {text}", key="--scheduler", value=scheduler
+            ) from None
         try:
             yield client
         finally:
@@ -297,14 +303,15 @@ def check_workers(client) -> int:
         versions = client.run(_worker_versions)
     except Exception as exc:  # a worker without attitude, say
         text = " ".join(f"{type(exc).__name__}: {exc}".split())
-        raise InputError(f"--scheduler: the workers cannot run attitude ({text})") from None
+        raise InputError(f"the workers cannot run attitude ({text})", key="--scheduler") from None
     if not versions:
-        raise InputError("--scheduler: the cluster has no workers")
+        raise InputError("the cluster has no workers", key="--scheduler")
     for address, theirs in versions.items():
         if tuple(theirs) != here:
             raise InputError(
-                f"--scheduler: worker {address} runs attitude {theirs[0]} with numpy "
+                f"worker {address} runs attitude {theirs[0]} with numpy "
                 f"{theirs[1]} and scipy {theirs[2]}; this is attitude {here[0]} with numpy "
-                f"{here[1]} and scipy {here[2]}: install the same versions on every worker"
+                f"{here[1]} and scipy {here[2]}: install the same versions on every worker",
+                key="--scheduler",
             )
     return sum(w["nthreads"] for w in client.scheduler_info()["workers"].values())

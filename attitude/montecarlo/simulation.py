@@ -170,7 +170,9 @@ def simulate(
 
     stage = stage or (lambda text: None)
     if batch_size is not None and not 1 <= batch_size <= mc.samples:
-        raise InputError(f"--batch-size: expected 1 to {mc.samples}, got {batch_size}")
+        raise InputError(
+            f"expected 1 to {mc.samples}, got {batch_size}", key="--batch-size", value=batch_size
+        )
     if scheduler is not None and not probed:
         stage(f"trying the Dask scheduler at {scheduler}")
     count = check_where(scheduler, workers, probe=not probed)
