@@ -9,14 +9,15 @@ checks it, and that the README's "Layout" table lists the same layers and module
 3. ``attitude.solver``: the exact torque-free solver (``EulerSolver``) and its free flow
 4. ``attitude.torques``: torques by splitting with the exact free flow (``TorquedSolver``)
 5. ``attitude.environment``: time scales, the Sun and Moon, the Earth, frames, orbits
-6. ``attitude.scenario``: the spacecraft, its initial state, events, a scenario's torques
-7. ``attitude.trajectory``: the propagated motion, its validity horizon, its analysis
-8. ``attitude.pointing``: the Sun, Moon and Earth on the body vectors; the exact search
-9. ``attitude.outputs``: CSV, Parquet and AEM files, the output budget and folder
-10. ``attitude.report``: a run's plan, summaries, figures, page and streamed writing
-11. ``attitude.files``: scenario files read and written
-12. ``attitude.montecarlo``: Monte Carlo dispersions on Dask
-13. ``attitude.cli``: the command line
+6. ``attitude.laws``: attitude laws (nadir, Sun, target, align-and-constrain, ...) and their rates
+7. ``attitude.scenario``: the spacecraft, its initial state, events, a scenario's torques
+8. ``attitude.trajectory``: the propagated motion, its validity horizon, its analysis
+9. ``attitude.pointing``: the Sun, Moon and Earth on the body vectors; the exact search
+10. ``attitude.outputs``: CSV, Parquet and AEM files, the output budget and folder
+11. ``attitude.report``: a run's plan, summaries, figures, page and streamed writing
+12. ``attitude.files``: scenario files read and written
+13. ``attitude.montecarlo``: Monte Carlo dispersions on Dask
+14. ``attitude.cli``: the command line
 
 The names below are importable from ``attitude`` directly; all but the errors are
 loaded on first use, so that ``import attitude`` stays light (numpy, scipy, astropy,
@@ -40,6 +41,16 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.environment.oem import OemOrbit
     from attitude.environment.orbit import TleOrbit
     from attitude.files.scenario_reader import load_scenario
+    from attitude.laws.align_constrain import (
+        AlignConstrainLaw,
+        AttitudeLaw,
+        BoundLaw,
+        DegenerateLawError,
+        LawState,
+    )
+    from attitude.laws.directions import CelestialTarget, FixedDirection, GroundSite
+    from attitude.laws.named_laws import InertialLaw, NadirLaw, OrbitFrameLaw, SunLaw, TargetLaw
+    from attitude.laws.visibility import visible_intervals
     from attitude.montecarlo.job import run_montecarlo
     from attitude.outputs.aem_writer import write_aem
     from attitude.pointing.sampling import pointing_samples
@@ -84,6 +95,20 @@ _LAZY = {
     "TleOrbit": "attitude.environment.orbit",
     "KeplerianOrbit": "attitude.environment.keplerian",
     "OemOrbit": "attitude.environment.oem",
+    "AttitudeLaw": "attitude.laws.align_constrain",
+    "AlignConstrainLaw": "attitude.laws.align_constrain",
+    "BoundLaw": "attitude.laws.align_constrain",
+    "DegenerateLawError": "attitude.laws.align_constrain",
+    "LawState": "attitude.laws.align_constrain",
+    "InertialLaw": "attitude.laws.named_laws",
+    "OrbitFrameLaw": "attitude.laws.named_laws",
+    "NadirLaw": "attitude.laws.named_laws",
+    "SunLaw": "attitude.laws.named_laws",
+    "TargetLaw": "attitude.laws.named_laws",
+    "GroundSite": "attitude.laws.directions",
+    "CelestialTarget": "attitude.laws.directions",
+    "FixedDirection": "attitude.laws.directions",
+    "visible_intervals": "attitude.laws.visibility",
     "write_aem": "attitude.outputs.aem_writer",
     "load_scenario": "attitude.files.scenario_reader",
     "write_report": "attitude.report.run",
@@ -93,24 +118,37 @@ _LAZY = {
 # Spelled out (not built from _LAZY) so that linters and IDEs read it statically;
 # tests/test_layering.py checks that it, _LAZY and the TYPE_CHECKING imports agree.
 __all__ = [
+    "AlignConstrainLaw",
     "AngularImpulse",
     "AttitudeError",
+    "AttitudeLaw",
     "AttitudeReset",
     "BodyVector",
+    "BoundLaw",
     "Burn",
+    "CelestialTarget",
     "ConstantTorque",
+    "DegenerateLawError",
     "EulerSolver",
+    "FixedDirection",
     "GravityGradient",
+    "GroundSite",
     "InertiaChange",
     "InertiaWarning",
+    "InertialLaw",
     "InitialState",
     "InputError",
     "KeplerianOrbit",
+    "LawState",
+    "NadirLaw",
     "OemOrbit",
+    "OrbitFrameLaw",
     "PointingSpec",
     "Scenario",
     "ScenarioTorques",
     "Spacecraft",
+    "SunLaw",
+    "TargetLaw",
     "TleOrbit",
     "TorquedSolver",
     "Trajectory",
@@ -125,6 +163,7 @@ __all__ = [
     "propagate_batch",
     "run_montecarlo",
     "validity_horizon",
+    "visible_intervals",
     "write_aem",
     "write_report",
 ]

@@ -9,6 +9,8 @@ Modules:
   systems, epochs, and interpolation.
 - ``earth``: The Earth seen from the spacecraft: its size, its angular radius, nadir and
   the limb.
+- ``earth_rotation``: The Earth's rotation: ITRS → GCRS with its time derivatives,
+  offline; geodetic sites.
 - ``ephemeris``: Sun and Moon vectors from JPL DE421 through skyfield, offline: where
   they appear.
 - ``epoch_texts``: ISO 8601 texts of many epochs, fast: integer nanoseconds and numpy's

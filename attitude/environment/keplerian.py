@@ -25,6 +25,12 @@ frame the elements are in, not the equator of date: 0.3° apart by 2025, which t
 the axis the node turns about by that much).  The velocity is the derivative of this
 position: the rotating node and perigee included.
 
+:meth:`KeplerianOrbit.derivatives_tt` gives the position's time derivatives up to the
+jerk (what the attitude laws differentiate): the same formulas carried through Taylor
+jets (:mod:`attitude.base.jets`), Kepler's equation solved on the jet by Newton steps,
+each of which doubles the number of exact derivatives.  They are exact derivatives of
+the positions :meth:`KeplerianOrbit.state_tt` gives, not of a different model.
+
 Elements are in the ICRF (GCRS axes) or in EME2000, which is rotated to the ICRF by
 the frame bias (:func:`attitude.environment.frames.eme2000_to_icrf`, 23 mas).  μ and J2 are those of
 :mod:`attitude.environment.earth`.  ``tests/test_keplerian_against_numerical_integration.py``
@@ -40,6 +46,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from attitude.base.errors import InputError
+from attitude.base.jets import Jet, sin_cos
 from attitude.base.quantities import as_si_scalar
 from attitude.environment.earth import (
     EARTH_EQUATORIAL_RADIUS_M,
@@ -229,6 +236,42 @@ class KeplerianOrbit(Orbit):
             r = r @ self._bias.T
             v = v @ self._bias.T
         return r, v
+
+    def derivatives_tt(self, jd1, jd2, order: int = 3) -> NDArray[np.float64]:
+        """The position and its first ``order`` time derivatives at the TT Julian dates
+        jd1 + jd2, GCRS: an array ``[r, ṙ, r̈, …]`` of shape (order + 1, n, 3), in m,
+        m/s, m/s², m/s³ (see the module notes: exact, not differenced)."""
+        dt = (
+            (np.asarray(jd1, dtype=np.float64) - self._epoch_jd[0])
+            + (np.asarray(jd2, dtype=np.float64) - self._epoch_jd[1])
+        ) * SECONDS_PER_DAY
+        # M reduced to [−π, π) as solve_kepler reduces it, so that E − e sin E = M holds
+        # for the value the Newton steps start from.
+        M0 = np.remainder(self.m0 + self.mean_anomaly_rate * dt + math.pi, 2 * math.pi) - math.pi
+        M = Jet.linear(M0, self.mean_anomaly_rate, order)
+        raan = Jet.linear(self.raan + self.raan_rate * dt, self.raan_rate, order)
+        argp = Jet.linear(self.argp + self.argp_rate * dt, self.argp_rate, order)
+        # E − e sin E = M on the jet: from the exact value, each Newton step doubles
+        # the number of exact Taylor coefficients (1, 2, 4, ...).
+        E = Jet.constant(solve_kepler(M.value, self.e), order)
+        exact = 1
+        while exact < order + 1:
+            sin_E, cos_E = sin_cos(E)
+            E = E - (E - sin_E * self.e - M) / (1.0 - cos_E * self.e)
+            exact = 2 * exact
+        sin_E, cos_E = sin_cos(E)
+        x_p = (cos_E - self.e) * self.a
+        y_q = sin_E * (self.a * math.sqrt(1.0 - self.e**2))
+        sO, cO = sin_cos(raan)
+        sw, cw = sin_cos(argp)
+        ci, si = math.cos(self.i), math.sin(self.i)
+        # The columns P, Q of R3(−Ω) R1(−i) R3(−ω), as in _perifocal_axes.
+        P = [cO * cw - sO * sw * ci, sO * cw + cO * sw * ci, sw * si]
+        Q = [-(cO * sw) - sO * cw * ci, -(sO * sw) + cO * cw * ci, cw * si]
+        r = np.stack([(x_p * p + y_q * q).c for p, q in zip(P, Q, strict=True)], axis=-1)
+        if self._bias is not None:
+            r = r @ self._bias.T
+        return Jet(r).derivatives()
 
 
 def _perifocal_axes(raan, i: float, argp):

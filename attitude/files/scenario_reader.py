@@ -447,6 +447,7 @@ def _body_vector(item: _Table) -> BodyVector:
         "sun_exclusion_half_angle",
         "moon_exclusion_half_angle",
         "earth_limb_exclusion_angle",
+        "sun_inclusion_half_angle",
     )
     name = item.string("name")
     vector = item.quantity("vector", "dimensionless", (3,))
@@ -455,6 +456,13 @@ def _body_vector(item: _Table) -> BodyVector:
     sun = _angle_deg(item, "sun_exclusion_half_angle", 0.0, 180.0)
     moon = _angle_deg(item, "moon_exclusion_half_angle", 0.0, 180.0)
     limb = _angle_deg(item, "earth_limb_exclusion_angle", -90.0, 180.0)
+    inclusion = _angle_deg(item, "sun_inclusion_half_angle", 0.0, 180.0)
+    if inclusion is not None and sun is not None and inclusion <= sun:
+        item.fail(
+            f"{inclusion!r} deg is within sun_exclusion_half_angle ({sun!r} deg): the Sun "
+            "could never be inside the field of view and outside the exclusion cone",
+            "sun_inclusion_half_angle",
+        )
     kind = item.choice("kind", KINDS, default="other")
 
     def radians(degrees: float | None) -> float | None:
@@ -473,6 +481,8 @@ def _body_vector(item: _Table) -> BodyVector:
         moon_exclusion_half_angle_deg=moon,
         earth_limb_exclusion_angle_rad=radians(limb),
         earth_limb_exclusion_angle_deg=limb,
+        sun_inclusion_half_angle_rad=radians(inclusion),
+        sun_inclusion_half_angle_deg=inclusion,
     )
 
 
@@ -555,7 +565,9 @@ def _pointing(root: _Table, scale: str, epoch, name: str) -> PointingSpec:
     sequence = table.string("lvlh_euler_sequence", required=False)
     if sequence is not None:
         options["lvlh_euler_sequence"] = sequence
-    return _checked(table, None, PointingSpec, vectors, orbit, **options)
+    spec = _checked(table, None, PointingSpec, vectors, orbit, **options)
+    _checked(table, None, spec.check_orbit)
+    return spec
 
 
 def _burn(table: _Table, scale: str) -> Burn:
@@ -598,9 +610,8 @@ def _torques(root: _Table, scale: str, orbit: Orbit | None) -> ScenarioTorques |
     if threshold is not None:
         options["horizon_threshold"] = threshold
     try:
-        return ScenarioTorques(
-            orbit if gravity_gradient else None, tuple(burns), order=order, **options
-        )
+        # True: the scenario's orbit, the one of [pointing] (given once, to the Scenario).
+        return ScenarioTorques(gravity_gradient or None, tuple(burns), order=order, **options)
     except InputError as exc:  # its keys are the file's, from the root (torques.step)
         raise ScenarioFileError(
             exc.reason, key=exc.key, file=table.file.name, value=exc.value
@@ -670,7 +681,9 @@ def scenario_from_document(path: Path, document: dict[str, Any]) -> ScenarioFile
     output.allow("start", "stop", "duration", "step", "formats", "aem_tolerance")
     span = _span(output, scale)
     try:
-        scenario = Scenario(name, spacecraft, epoch, state, events, **span, torques=torques)
+        scenario = Scenario(
+            name, spacecraft, epoch, state, events, **span, torques=torques, orbit=pointing.orbit
+        )
     except InputError as exc:
         end = "stop" if span["stop"] is not None else "duration"
         # Scenario's own names for its arguments, as the file spells them; its other

@@ -706,8 +706,10 @@ def shifted_tle_epoch(line1: str, shift_s: float) -> tuple[str, float]:
         new_year += 1  # rounded up onto the next year's first instant
     if not 1957 <= new_year <= 2056:
         raise InputError(
-            f"pointing.tle_epoch: a shift of {shift_s:g} s moves the TLE epoch to {new_year}, "
-            "which a TLE cannot write (1957-2056)"
+            f"a shift of {shift_s:g} s moves the TLE epoch to {new_year}, "
+            "which a TLE cannot write (1957-2056)",
+            key="dispersions.pointing.tle_epoch",
+            value=shift_s,
         )
     text = f"{line1[:18]}{new_year % 100:02d}{new_days:012.8f}{line1[32:68]}"
     applied = (_days_before(new_year) + new_days - start) * 86400.0

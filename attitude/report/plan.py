@@ -29,7 +29,7 @@ from attitude.outputs.csv import pointing_column_count
 from attitude.outputs.formats import OutputChoice
 from attitude.outputs.parquet import check_span
 from attitude.pointing.search import SearchGrid, check_pointing
-from attitude.pointing.spec import PointingSpec
+from attitude.pointing.spec import PointingSpec, for_scenario
 from attitude.report.beside import Beside
 from attitude.scenario.scenario import Scenario
 from attitude.trajectory.horizon import ValidityHorizon, validity_horizon
@@ -72,7 +72,8 @@ def plan_run(
     ``progress(text)`` is told each stage as it starts (the command line's stderr).
     """
     say = progress or (lambda text: None)
-    pointing = pointing or PointingSpec()
+    # The scenario's orbit, when the pointing gives none (the orbit is given once).
+    pointing = for_scenario(pointing or PointingSpec(), scenario)
     outputs = outputs or OutputChoice()
     samples = scenario.output_count()
     if "parquet" in outputs:
