@@ -224,7 +224,9 @@ class PointingSpec:
         if self.orbit is not None:
             return
         needs = [
-            (index, v) for index, v in enumerate(self.body_vectors) if v.earth_limb_exclusion_angle_rad
+            (index, v)
+            for index, v in enumerate(self.body_vectors)
+            if v.earth_limb_exclusion_angle_rad
         ]
         if needs:
             index, vector = needs[0]
