@@ -41,7 +41,7 @@ def test_a_declared_breakpoint_ends_an_aem_segment(tmp_path):
     state = first.state
     guided = _Guided(state.inertia.tensor, state.angular_momentum, state.attitude, t0=0.0)
     segments = [Segment(first.start_s, first.end_s, guided, state), *plain.segments[1:]]
-    trajectory = Trajectory(scenario, [(s, "") for s in segments])
+    trajectory = Trajectory(scenario, segments)
     assert [b.time_s for b in trajectory.breakpoints()] == [MODE_S]
 
     plan = plan_aem(trajectory, analyze(trajectory), scenario.start_s, scenario.stop_s)

@@ -15,12 +15,14 @@ What it refuses, a run would have refused later, after computing; what it return
 what the run uses.  ``attitude check`` plans with ``check=True``: the same path
 within a budget of steps, with what lies beyond it predicted (a run that measures
 more can still refuse an accuracy that its measurement says is missed).  Errors are
-``attitude.base.errors.InputError`` whose message starts with the scenario key.
+``attitude.base.errors.InputError`` whose ``key`` is the scenario key that holds the
+bad value.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from attitude.base.errors import InputError
@@ -35,6 +37,7 @@ from attitude.report.beside import Beside
 from attitude.scenario.scenario import Scenario
 from attitude.trajectory.horizon import ValidityHorizon, validity_horizon
 from attitude.trajectory.motion import SegmentMotion, analyze, undersampling_note
+from attitude.trajectory.steps import CHECK_BUDGET_S
 from attitude.trajectory.trajectory import Trajectory, propagate
 
 __all__ = ["RunPlan", "horizon_beside", "plan_run"]
@@ -65,6 +68,7 @@ def plan_run(
     pointing: PointingSpec | None = None,
     outputs: OutputChoice | None = None,
     horizon: bool = True,
+    progress: Callable[[str], None] | None = None,
     check: bool = False,
 ) -> RunPlan:
     """Check ``scenario`` (``pointing``, ``outputs``) as a run would, up to the sampling.
@@ -72,6 +76,7 @@ def plan_run(
     ``horizon=False``: the validity horizon, when there is one, is not computed here
     (``horizon_deferred`` says it is wanted): a run computes it beside its outputs
     (``attitude.report.run``), since it checks nothing and takes as long as a day's outputs.
+    ``progress(text)`` is told each stage as it starts (the command line's stderr).
 
     ``check``: for ``attitude check``, which answers in seconds: under torques, the
     step search within its budget (``attitude.trajectory.steps``: what it refuses, the
@@ -80,12 +85,15 @@ def plan_run(
     that read the motion (``Trajectory.approximate``), and the flips under torques
     left to the run.
     """
+    say = progress or (lambda text: None)
     # The scenario's orbit, when the pointing gives none (the orbit is given once).
     pointing = for_scenario(pointing or PointingSpec(), scenario)
     outputs = outputs or OutputChoice()
     samples = scenario.output_count()
     if "parquet" in outputs:
         check_span(scenario.start_s, scenario.stop_s, "--formats parquet")
+    _check_gravity_gradient_orbit(scenario)
+    say(_propagating(scenario, check))
     trajectory = propagate(scenario, check=check)
     # The size and memory checks come before the analysis and the pointing checks,
     # which do not depend on the output grid but can take a while on a long span.
@@ -96,15 +104,21 @@ def plan_run(
     )
     check_fits(budget)
     # The run's estimated error (a given step: measured now; check: within its budget).
+    if not check and trajectory.steps is not None and trajectory.steps.measurement is None:
+        say("estimating the propagation's error: the run again at twice the step")
     steps = trajectory.steps if check else trajectory.measured()
     if steps is not None and steps.measurement is not None:
         if not math.isfinite(steps.measurement.estimate_rad):
             raise InputError(
-                f"torques.step: at {steps.step_s:g} s the propagation has no finite error "
-                "estimate (the run at twice the step runs away): give a smaller step or an "
-                "accuracy"
+                f"at {steps.step_s:g} s the propagation has no finite error estimate (the "
+                "run at twice the step runs away): give a smaller step or an accuracy",
+                key="torques.step",
+                value=steps.step_s,
             )
+    say("analysing the motion (flips, nutation, spin, precession)")
     motion = analyze(trajectory, locate=not check)
+    if not pointing.is_empty:
+        say("checking the pointing: the orbit, the Sun and the Moon over the span")
     notes, search = check_pointing(trajectory, pointing)
     undersampled = undersampling_note(trajectory, motion)
     if undersampled:
@@ -114,9 +128,11 @@ def plan_run(
     # alone, neglects it.
     wanted = pointing.orbit is not None and scenario.torques.gravity_gradient is None
     if wanted and horizon:
+        say("the validity horizon: the run again under the gravity gradient it leaves out")
         found = validity_horizon(trajectory, pointing.orbit)
     aem = None
     if "aem" in outputs:
+        say(f"choosing the AEM's records for {outputs.aem_tolerance_rad:g} rad")
         aem = plan_aem(
             trajectory,
             motion,
@@ -148,6 +164,43 @@ def plan_run(
         horizon_deferred=wanted and not horizon,
         check=check,
     )
+
+
+def _propagating(scenario: Scenario, check: bool) -> str:
+    """The propagation stage in words: the segments, how many are under torques, and
+    how their step is set (chosen for the accuracy, the run's error estimated on the
+    way: ``attitude.trajectory.steps``)."""
+    segments = len(scenario.events) + 1
+    text = f"propagating {segments} segment{'s' if segments > 1 else ''}"
+    what = []
+    if scenario.torques.gravity_gradient is not None:
+        what.append("gravity gradient")
+    if scenario.burns:
+        what.append(f"{len(scenario.burns)} burn{'s' if len(scenario.burns) > 1 else ''}")
+    if not what:
+        return text
+    text += f" under {' and '.join(what)} (splitting)"
+    torques = scenario.torques
+    within = f" within {CHECK_BUDGET_S:g} s of CPU" if check else ""
+    if torques.step is not None:
+        return text + (
+            f" at {torques.step:g} s, and at twice it for the error estimate{within}"
+            if check
+            else f" at {torques.step:g} s"
+        )
+    return text + (
+        f", at the step whose error estimate (the run at h and 2h) meets "
+        f"{torques.accuracy_rad:g} rad{within}"
+    )
+
+
+def _check_gravity_gradient_orbit(scenario: Scenario) -> None:
+    """The orbit the gravity gradient is computed on covers the span (an OEM file that
+    ends early is refused here, naming its key, before the torqued propagation would
+    stop at the first step outside it); its notes are the pointing's to give."""
+    orbit = scenario.torques.gravity_gradient
+    if orbit is not None and hasattr(orbit, "check_span"):
+        orbit.check_span(scenario.times(scenario.start_s), scenario.times(scenario.stop_s))
 
 
 def horizon_beside(plan: RunPlan) -> Beside[ValidityHorizon] | None:

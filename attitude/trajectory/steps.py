@@ -20,7 +20,9 @@ the answer, bisects in log h until they are within 1.25; it adopts the largest s
 that passed, and its run.  A try stops as soon as its estimate exceeds
 :data:`STOP_FACTOR` times the accuracy (it has failed, and the model moves on from
 what it saw), so a step far too long costs little.  A step with more than
-``MAX_STEPS`` steps over the span is refused with the last estimate.
+``MAX_STEPS`` steps over the span is refused with the last estimate, naming the burn
+that spins the body up (``torques.burns[i].torque``) when the body would be slow
+enough without it, else ``torques.accuracy``.
 
 **Check's budget.**  ``attitude check`` answers in seconds: it runs the same search
 with a budget of CPU time (:data:`CHECK_BUDGET_S`).  Its tries are the run's own
@@ -171,34 +173,35 @@ def _growth(times: list[float], worst: list[float], until: float) -> float:
 
 def measure(
     scenario: Scenario,
-    models: list[tuple[float, float, Torque]],
+    models: list[tuple[float, float, Torque, str]],
     step: float | list[float | None],
     *,
-    fine: list[tuple[Segment, str]] | None = None,
+    fine: list[Segment] | None = None,
     budget_s: float | None = None,
     stop_above: float | None = None,
-) -> tuple[Measurement, list[tuple[Segment, str]] | None]:
+) -> tuple[Measurement, list[Segment] | None]:
     """The run's estimate at ``step`` (module docstring): (measurement, the run at
-    ``step`` as (segment, name of its state) pairs, or None when it stopped early).
+    ``step`` as its segments, or None when it stopped early).
 
     ``fine``: the run at ``step`` already made (a trajectory's), compared as it is;
     ``budget_s``: stop after this much CPU time; ``stop_above``: stop as soon as the
     estimate exceeds this (rad).  A run that the torques drive beyond what floats
-    follow is refused, naming its state (an :class:`InputError`); when only the run at
-    2 × step does, the estimate is infinite.
+    follow is refused, naming its state or the burn that spins it up (an
+    :class:`InputError`, ``Segment.refused``); when only the run at 2 × step does, the
+    estimate is infinite.
     """
     started = time.process_time()
     scale = 2.0**scenario.torques.order - 1.0
     checks = _check_times(scenario)
     given = fine is not None
-    fine_runs: Iterator[tuple[Segment, str]] = (
+    fine_runs: Iterator[Segment] = (
         iter(fine) if fine is not None else segments(scenario, models, step, checked=False)
     )
     coarse: float | list[float | None] = (
         [None if h is None else 2.0 * h for h in step] if isinstance(step, list) else 2.0 * step
     )
     coarse_runs = segments(scenario, models, coarse, checked=False)
-    done: list[tuple[Segment, str]] = []
+    done: list[Segment] = []
     done_steps = 0
     per_segment: list[float | None] = []
     times: list[float] = []
@@ -228,7 +231,7 @@ def measure(
     def out_of_time() -> bool:
         return budget_s is not None and time.process_time() - started > budget_s
 
-    for (fine_segment, where), (coarse_segment, _) in zip(fine_runs, coarse_runs, strict=True):
+    for fine_segment, coarse_segment in zip(fine_runs, coarse_runs, strict=True):
         τ = checks[(checks > fine_segment.start_s) & (checks <= fine_segment.end_s)]
         own: float | None = None
         for first in range(0, τ.size, _CHUNK):
@@ -236,7 +239,7 @@ def measure(
             try:
                 q_fine = fine_segment.solver.attitude_quaternion(chunk)
             except InputError as exc:
-                raise InputError(f"{where}: {exc}") from None
+                raise fine_segment.refused(exc) from None
             try:
                 q_coarse = coarse_segment.solver.attitude_quaternion(chunk)
                 found = float(np.max(angles_between(q_fine, q_coarse))) / scale
@@ -258,31 +261,50 @@ def measure(
                 per_segment.append(own)
                 return result("budget", float(chunk[-1]), steps), None
         if not given:
-            check_resolved(fine_segment, where)
+            check_resolved(fine_segment)
         done_steps += _torqued_steps([coarse_segment] if given else [fine_segment, coarse_segment])
         per_segment.append(own)
-        done.append((fine_segment, where))
+        done.append(fine_segment)
         if out_of_time() and len(done) < len(scenario.events) + 1:
             return result("budget", fine_segment.end_s, done_steps), None
     return result("span", scenario.stop_s, done_steps), done
 
 
-def _initial_step(scenario: Scenario, models: list[tuple[float, float, Torque]]) -> float:
-    """Half a quarter turn at the body's largest rate over the span, at most a fortieth
-    of the orbit: |ω| ≤ √(2T/I_min) at the start, and |ω| ≤ (|m0| + ∫|τ| dt)/I_min
-    with the burns' impulse (a burn may spin the body up)."""
+def _impulses(
+    scenario: Scenario, models: list[tuple[float, float, Torque, str]]
+) -> list[tuple[float, str]]:
+    """(angular impulse |τ| Δt within the span, N m s; key) of each burn."""
+    return [
+        (float(np.linalg.norm(torque.torque)) * (min(stop, scenario.stop_s) - max(start, 0.0)), key)
+        for start, stop, torque, key in models
+        if isinstance(torque, ConstantTorque)
+    ]
+
+
+def _largest_rate(
+    scenario: Scenario, models: list[tuple[float, float, Torque, str]], burns: bool = True
+) -> float:
+    """A bound on the body's rate over the span (rad/s): |ω| ≤ √(2T/I_min) at the
+    start, and, with ``burns``, |ω| ≤ (|m0| + ∫|τ| dt)/I_min with the burns' impulse
+    (a burn may spin the body up)."""
     state = initial_state(scenario)
     least = float(np.min(state.inertia.moments))
     rate = math.sqrt(2.0 * state.kinetic_energy / least)
-    impulse = sum(
-        float(np.linalg.norm(torque.torque)) * (min(stop, scenario.stop_s) - max(start, 0.0))
-        for start, stop, torque in models
-        if isinstance(torque, ConstantTorque)
-    )
+    impulse = sum(size for size, _ in _impulses(scenario, models)) if burns else 0.0
     if impulse > 0.0:
         rate = max(rate, (float(np.linalg.norm(state.angular_momentum)) + impulse) / least)
+    return rate
+
+
+def _initial_step(
+    scenario: Scenario, models: list[tuple[float, float, Torque, str]], burns: bool = True
+) -> float:
+    """Half a quarter turn at the body's largest rate over the span
+    (:func:`_largest_rate`; ``burns``: with the burns' impulse), at most a fortieth of
+    the orbit."""
+    rate = _largest_rate(scenario, models, burns)
     candidates = [2.0 * math.pi / rate / 4.0] if rate > 0.0 else []
-    for _, _, torque in models:
+    for _, _, torque, _ in models:
         if isinstance(torque, GravityGradient):
             radius = float(np.linalg.norm(torque.position(np.array([0.0]))[0]))
             candidates.append(2.0 * math.pi * math.sqrt(radius**3 / torque.mu) / 20.0)
@@ -290,24 +312,55 @@ def _initial_step(scenario: Scenario, models: list[tuple[float, float, Torque]])
 
 
 def predicted_steps(
-    scenario: Scenario, models: list[tuple[float, float, Torque]], step: float
+    scenario: Scenario, models: list[tuple[float, float, Torque, str]], step: float
 ) -> int:
     """The grid steps of one run at ``step`` over the span: the span over the step, and
     one more at each torque switch within it (a step ends there)."""
     switches = {
-        b for _, _, torque in models for b in torque.breakpoints if 0.0 < b < scenario.stop_s
+        b for _, _, torque, _ in models for b in torque.breakpoints if 0.0 < b < scenario.stop_s
     }
     return math.ceil(scenario.stop_s / step) + len(switches)
 
 
-def _too_many_steps(scenario: Scenario, step: float, tried) -> InputError:
+def _accuracy_refused(
+    scenario: Scenario, models: list[tuple[float, float, Torque, str]], step: float, reason: str
+) -> InputError:
+    """The refusal of an accuracy that needs a step near ``step`` (more than MAX_STEPS
+    over the span), for ``reason``, naming what holds the bad value: the burn that adds
+    the most momentum (``torques.burns[i].torque``) when, without the burns' impulse,
+    the body would be slow enough (the step scaled by the first try's without and
+    with it, a step ∝ 1/|ω| at the body's rate, within MAX_STEPS), else
+    ``torques.accuracy``: a hopeless accuracy for a body that slow."""
+    impulses = _impulses(scenario, models)
+    if impulses:
+        faster = _initial_step(scenario, models, burns=False) / _initial_step(scenario, models)
+        if scenario.stop_s / (step * faster) <= MAX_STEPS:
+            size, key = max(impulses)
+            return InputError(
+                f"the burns spin the body up to {_largest_rate(scenario, models):.3g} rad/s "
+                f"(this one adds {size:.3g} N m s): {reason}: give a smaller torque, "
+                "torques.step, a looser accuracy or a shorter span",
+                key=key,
+            )
+    return InputError(
+        f"{reason}: give torques.step, a looser accuracy or a shorter span",
+        key="torques.accuracy",
+        value=scenario.torques.accuracy_rad,
+    )
+
+
+def _too_many_steps(
+    scenario: Scenario, models: list[tuple[float, float, Torque, str]], step: float, tried
+) -> InputError:
     last = (
         f"; the run's estimate was {tried[-1][1]:.3g} rad at {tried[-1][0]:.3g} s" if tried else ""
     )
-    return InputError(
-        f"torques.accuracy: {scenario.torques.accuracy_rad:g} rad over {scenario.stop_s:g} s "
-        f"would need a step below {step:.3g} s, more than {MAX_STEPS:g} steps{last}: give "
-        "torques.step, a looser accuracy or a shorter span"
+    return _accuracy_refused(
+        scenario,
+        models,
+        step,
+        f"{scenario.torques.accuracy_rad:g} rad over {scenario.stop_s:g} s would need a step "
+        f"below {step:.3g} s, more than {MAX_STEPS:g} steps{last}",
     )
 
 
@@ -324,6 +377,7 @@ def _predicted(found: Measurement, before: list[Measurement], order: int) -> flo
 
 def _needed_step(
     scenario: Scenario,
+    models: list[tuple[float, float, Torque, str]],
     found: Measurement,
     tried: list[tuple[float, float, str]],
     tolerance: float,
@@ -341,20 +395,22 @@ def _needed_step(
             if found.complete
             else f"by {found.until_s:.6g} s, growing as t^{found.growth:.2g}"
         )
-        raise InputError(
-            f"torques.accuracy: {tolerance:g} rad over {scenario.stop_s:g} s would need a "
-            f"step near {step:.3g} s, more than {MAX_STEPS:g} steps: the run's estimate was "
-            f"{found.estimate_rad:.3g} rad at a step of {found.step_s:.3g} s {where}: give "
-            "torques.step, a looser accuracy or a shorter span"
+        raise _accuracy_refused(
+            scenario,
+            models,
+            step,
+            f"{tolerance:g} rad over {scenario.stop_s:g} s would need a step near {step:.3g} "
+            f"s, more than {MAX_STEPS:g} steps: the run's estimate was "
+            f"{found.estimate_rad:.3g} rad at a step of {found.step_s:.3g} s {where}",
         )
     return step
 
 
 def choose_steps(
     scenario: Scenario,
-    models: list[tuple[float, float, Torque]],
+    models: list[tuple[float, float, Torque, str]],
     budget_s: float | None = None,
-) -> tuple[RunSteps, list[tuple[Segment, str]] | None]:
+) -> tuple[RunSteps, list[Segment] | None]:
     """The step for ``[torques] accuracy`` (module docstring): (how it was chosen, the
     run at that step, or None when check's ``budget_s`` stopped the search)."""
     tolerance = scenario.torques.accuracy_rad
@@ -369,7 +425,7 @@ def choose_steps(
     started = time.process_time()
     for _ in range(_MAX_TRIES):
         if span / step > MAX_STEPS:
-            raise _too_many_steps(scenario, step, tried)
+            raise _too_many_steps(scenario, models, step, tried)
         left = None if budget_s is None else max(budget_s - (time.process_time() - started), 0.0)
         found, run = measure(
             scenario, models, step, budget_s=left, stop_above=STOP_FACTOR * tolerance
@@ -378,7 +434,7 @@ def choose_steps(
             predicted = _predicted(found, seen, order)
             found = Measurement(**{**found.__dict__, "predicted_rad": predicted})
             tried.append((step, predicted, found.ended))
-            needed = _needed_step(scenario, found, tried, tolerance, order)
+            needed = _needed_step(scenario, models, found, tried, tolerance, order)
             cpu = time.process_time() - started
             per_step = found.cpu_s / found.steps if found.steps else 0.0
             grid = predicted_steps(scenario, models, needed)
@@ -390,7 +446,7 @@ def choose_steps(
         error = found.estimate_rad
         tried.append((step, error, found.ended))
         if error > tolerance:
-            _needed_step(scenario, found, tried, tolerance, order)  # refuses a hopeless one
+            _needed_step(scenario, models, found, tried, tolerance, order)  # refuses a hopeless one
         if error <= tolerance:
             assert run is not None
             if good is None or step > good[0]:
@@ -411,11 +467,13 @@ def choose_steps(
     cpu = time.process_time() - started
     if good is None:
         raise InputError(
-            f"torques.accuracy: {tolerance:g} rad over {span:g} s not reached: the run's "
-            f"estimate was {tried[-1][1]:.3g} rad at a step of {tried[-1][0]:.3g} s"
+            f"{tolerance:g} rad over {span:g} s not reached: the run's estimate was "
+            f"{tried[-1][1]:.3g} rad at a step of {tried[-1][0]:.3g} s",
+            key="torques.accuracy",
+            value=tolerance,
         )
     step, found, run = good
-    grid = _torqued_steps(s for s, _ in run)
+    grid = _torqued_steps(run)
     per_step = found.cpu_s / found.steps if found.steps else 0.0
     return RunSteps(
         step, order, False, tolerance, found, tuple(tried), True, grid, per_step, cpu

@@ -60,18 +60,22 @@ _FLIP_SPACINGS = 4.0
 _FLIP_ITERATIONS = 80
 
 
-def scenario_torque_models(scenario: Scenario) -> list[tuple[float, float, Torque]]:
+def scenario_torque_models(scenario: Scenario) -> list[tuple[float, float, Torque, str]]:
     """The scenario's torques as models, each with the span [start, stop) it acts in
-    (TT seconds since the epoch; the gravity gradient over the whole span)."""
+    (TT seconds since the epoch; the gravity gradient over the whole span) and the
+    scenario key that gives it (``torques.burns[2].torque``, ``torques.gravity_gradient``),
+    which errors it causes name."""
     torques: ScenarioTorques = scenario.torques
-    models: list[tuple[float, float, Torque]] = []
+    models: list[tuple[float, float, Torque, str]] = []
     if torques.gravity_gradient is not None:
         gradient = GravityGradient(_position_source(torques.gravity_gradient, scenario))
-        models.append((-math.inf, math.inf, gradient))
+        models.append((-math.inf, math.inf, gradient, "torques.gravity_gradient"))
     for placed in scenario.burns:
         burn = placed.burn
         model = ConstantTorque(burn.torque, placed.start_s, placed.stop_s, burn.frame)
-        models.append((placed.start_s, placed.stop_s, model))
+        models.append(
+            (placed.start_s, placed.stop_s, model, f"torques.burns[{placed.index}].torque")
+        )
     return models
 
 

@@ -66,9 +66,12 @@ def propagate(
     cover the whole run, the estimate is predicted, and the motion is propagated at a
     longer step for the checks that read it (:attr:`Trajectory.approximate`).
 
-    Raises :class:`InputError` naming the state (``initial_state`` or ``events[i]``)
-    whose motion the solver refuses, or that turns too fast for TT seconds (floats)
-    to follow over the span, or ``torques.accuracy`` when the run cannot meet it.
+    Raises :class:`InputError` whose ``key`` names what holds the bad value: the
+    state (``initial_state.angular_velocity``, ``events[i].impulse``) whose motion the
+    solver refuses, or that turns too fast for TT seconds (floats) to follow over the
+    span; a burn (``torques.burns[i].torque``) that spins the body up that fast, or so
+    fast that no step meets the accuracy; ``torques.accuracy`` when the run cannot
+    meet it otherwise; the orbit the gravity gradient needs.
     """
     models = scenario_torque_models(scenario) if scenario.torques.any else []
     if not models:
@@ -126,14 +129,13 @@ class Trajectory:
     def __init__(
         self,
         scenario: Scenario,
-        run: list[tuple[Segment, str]],
+        run: list[Segment],
         steps: RunSteps | None = None,
         approximate_step_s: float | None = None,
         given_steps: list[float | None] | None = None,
     ) -> None:
         self.scenario = scenario
-        self.segments = [segment for segment, _ in run]
-        self._named = run
+        self.segments = list(run)
         # How the torqued segments' step was set, and the run's estimate (None: no torques).
         self.steps = steps
         # Set when `attitude check` propagated at a longer step than the run's.
@@ -263,7 +265,7 @@ class Trajectory:
             return steps
         models = scenario_torque_models(self.scenario)
         step = steps.step_s if self._given_steps is None else self._given_steps
-        found, _ = measure(self.scenario, models, step, fine=self._named)
+        found, _ = measure(self.scenario, models, step, fine=self.segments)
         steps = replace(
             steps,
             measurement=found,
