@@ -62,7 +62,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from attitude.pointing.extrema import Extremum, Problem, least_in_brackets
-from attitude.pointing.intervals import Interval, _assemble, _refine
+from attitude.pointing.intervals import Interval, _assemble, _refine, append_across, join
 from attitude.pointing.shared_surroundings import SharedSurroundings
 from attitude.pointing.spec import PointingSpec
 from attitude.pointing.surroundings import unit_angle
@@ -83,7 +83,10 @@ _OVERSHOOT = 0.1
 _LONGEST_STEP_S = 3600.0
 # A window holds at most this many nodes (bounded memory).
 WINDOW_NODES = 65_536
-# vector_motion samples ω this many times over a period (or over the segment).
+# vector_motion samples ω this many times a turn of the body over a period (or over
+# the segment), and from ... to ... times in all.
+_SAMPLES_PER_TURN = 256
+_MOTION_SAMPLES_LEAST = 1024
 _MOTION_SAMPLES = 16_384
 # A cell is cut at the cubic's extremum or root, kept within this fraction of its ends.
 _CUT = 0.1
@@ -185,12 +188,14 @@ def vector_motion(
     period = solver.period
     periodic = math.isfinite(period) and period < end_s - start_s
     window = period if periodic else max(end_s - start_s, 0.0)
-    samples = _MOTION_SAMPLES
+    # A few hundred samples a turn of the body, within [1024, 16384].
+    turns = window * fastest / (2.0 * math.pi)
+    samples = int(min(max(_SAMPLES_PER_TURN * turns, _MOTION_SAMPLES_LEAST), _MOTION_SAMPLES))
     t = start_s + window * np.arange(samples + 1.0) / samples
     ω = solver.angular_velocity(t)
     tensor = solver.inertia_tensor
     m = ω @ tensor.T
-    α = np.linalg.solve(tensor, np.cross(m, ω).T).T
+    α = np.cross(m, ω) @ np.linalg.inv(tensor).T
     spacing = window / samples
     gap = 0.5 * spacing
     jerk = G * (fastest * fastest + spin_accel) / least + 2.0 * spin_accel * fastest
@@ -261,49 +266,75 @@ def free_plan(
     )
 
 
+@dataclass(frozen=True)
+class FreePiece:
+    """A torque-free segment's part of the searched span, [start_s, end_s], with its
+    solver and :class:`FreePlan`."""
+
+    solver: EulerSolver
+    plan: FreePlan
+    start_s: float
+    end_s: float
+
+
 # --------------------------------------------------------------------- evaluation
 
 
 @dataclass
 class _Values:
-    """At some times: for each vector (rows) and target, the cosine f, its rate df and
-    the angle (Kahan's formula); the limb's angular radius and rate (on an orbit); each
-    target's angle σ to the momentum's direction (empty at rest)."""
+    """At some times: for each vector (rows) and target, the cosine ``f``, its rate
+    ``df`` and bend ``ddf`` (f'') and, when asked, the angle (Kahan's formula); the
+    limb's angular radius and rate (on an orbit); each target's angle σ to the
+    momentum's direction of the point's piece (NaN at rest)."""
 
     f: dict[str, NDArray[np.float64]]
     df: dict[str, NDArray[np.float64]]
+    ddf: dict[str, NDArray[np.float64]]
     angle: dict[str, NDArray[np.float64]]
+    sigma: dict[str, NDArray[np.float64]]
     limb: NDArray[np.float64] | None
     limb_rate: NDArray[np.float64] | None
-    sigma: dict[str, NDArray[np.float64]] = field(default_factory=dict)
-    ddf: dict[str, NDArray[np.float64]] = field(default_factory=dict)  # f
 
 
 class _Evaluator:
-    """The cosines, their rates and the angles of every body vector at any times of one
-    segment: the exact attitude and ω of the solver, the interpolated surroundings."""
+    """The cosines of every body vector with the targets, their rates and bends, at any
+    times of the pieces: the exact attitude and ω of each piece's solver, the
+    interpolated surroundings; one call for points of any pieces."""
 
-    def __init__(self, solver: EulerSolver, spec: PointingSpec, shared: SharedSurroundings):
-        self.solver = solver
+    def __init__(self, pieces: list[FreePiece], spec: PointingSpec, shared: SharedSurroundings):
+        self.pieces = pieces
         self.shared = shared
         self.vectors = np.array([v.vector for v in spec.body_vectors], dtype=np.float64)
         self.targets = [t for t in TARGETS if t != "nadir" or spec.orbit is not None]
-        momentum = np.asarray(solver.inertial_angular_momentum, dtype=np.float64)
-        size = float(np.linalg.norm(momentum))
-        self.axis = momentum / size if size > 0.0 and math.isfinite(size) else None
+        self.tensors = [np.asarray(p.solver.inertia_tensor, dtype=np.float64) for p in pieces]
+        self.inverses = [np.linalg.inv(t) for t in self.tensors]
+        axes, momenta = [], []
+        for piece in pieces:
+            momentum = np.asarray(piece.solver.inertial_angular_momentum, dtype=np.float64)
+            size = float(np.linalg.norm(momentum))
+            momenta.append(momentum)
+            axes.append(momentum / size if size > 0.0 and math.isfinite(size) else np.full(3, np.nan))
+        self.axes = np.array(axes).reshape(-1, 3)
+        self.momenta = np.array(momenta).reshape(-1, 3)
         self.calls = 0
         self.points = 0
-        self.tensor = np.asarray(solver.inertia_tensor, dtype=np.float64)
-        self.inverse = np.linalg.inv(self.tensor)
 
-    def __call__(self, τ: NDArray[np.float64], angles: bool = False) -> _Values:
-        """The values at τ; the angles (Kahan's formula) only with ``angles``."""
+    def __call__(self, τ, piece, angles: bool | set = False) -> _Values:
+        """The values at times τ of pieces ``piece`` (indices); the angles with
+        ``angles`` (True: to every target; a set: to those)."""
         τ = np.asarray(τ, dtype=np.float64)
+        piece = np.asarray(piece, dtype=np.intp)
         self.calls += 1
         self.points += τ.size
-        q = self.solver.attitude_quaternion(τ)  # scalar first, body → inertial
-        ω = self.solver.angular_velocity(τ)
-        w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+        n = τ.size
+        q = np.empty((n, 4))
+        if n and np.all(piece == piece[0]):
+            groups = [(int(piece[0]), slice(None))]
+        else:
+            groups = [(int(k), piece == k) for k in np.unique(piece)]
+        for k, mine in groups:
+            q[mine] = self.pieces[k].solver.attitude_quaternion(τ[mine])
+        w, x, y, z = q[:, 0].copy(), q[:, 1].copy(), q[:, 2].copy(), q[:, 3].copy()
         # The rotation matrix, row by row (R v for many v without a (n, 3, 3) product).
         xx, yy, zz = x * x, y * y, z * z
         xy, xz, yz, wx, wy, wz = x * y, x * z, y * z, w * x, w * y, w * z
@@ -316,16 +347,36 @@ class _Evaluator:
         def rotate(v0, v1, v2):
             return [r[0] * v0 + r[1] * v1 + r[2] * v2 for r in rows]
 
-        ω_in = rotate(ω[:, 0], ω[:, 1], ω[:, 2])
-        # α = I⁻¹((Iω) × ω), Euler's equations in the body, then inertial.
-        m = ω @ self.tensor.T
-        α = np.cross(m, ω) @ self.inverse.T
-        α_in = rotate(α[:, 0], α[:, 1], α[:, 2])
-        sky = self.shared.targets(τ)
+        # The body momentum m = Qᵀ H (H the segment's inertial momentum, constant: the
+        # solver's Q maps m onto it by construction), ω = I⁻¹ m and α = I⁻¹(m × ω)
+        # (Euler's equations without torque): no second pass of the solver over τ.
+        ω_in = [np.empty(n) for _ in range(3)]
+        α_in = [np.empty(n) for _ in range(3)]
+        for k, mine in groups:
+            h = self.momenta[k]
+            inverse = self.inverses[k]
+            r = [[c[mine] for c in row] for row in rows]
+            m = [r[0][i] * h[0] + r[1][i] * h[1] + r[2][i] * h[2] for i in range(3)]
+            ω = [inverse[i, 0] * m[0] + inverse[i, 1] * m[1] + inverse[i, 2] * m[2] for i in range(3)]
+            mω = (m[1] * ω[2] - m[2] * ω[1], m[2] * ω[0] - m[0] * ω[2], m[0] * ω[1] - m[1] * ω[0])
+            α = [inverse[i, 0] * mω[0] + inverse[i, 1] * mω[1] + inverse[i, 2] * mω[2] for i in range(3)]
+            for i in range(3):
+                # Inertial: ω_in = R ω.
+                ω_in[i][mine] = r[i][0] * ω[0] + r[i][1] * ω[1] + r[i][2] * ω[2]
+                α_in[i][mine] = r[i][0] * α[0] + r[i][1] * α[1] + r[i][2] * α[2]
+        sky = self.shared.targets(τ, accelerations=True)
         f: dict[str, list] = {t: [] for t in self.targets}
         df: dict[str, list] = {t: [] for t in self.targets}
-        angle: dict[str, list] = {t: [] for t in self.targets}
         ddf: dict[str, list] = {t: [] for t in self.targets}
+        angle: dict[str, list] = {t: [] for t in self.targets}
+        columns = {}
+        for target in self.targets:
+            s = getattr(sky, target)
+            sr = getattr(sky, f"{target}_rate")
+            sa = getattr(sky, f"{target}_accel")
+            columns[target] = tuple(
+                tuple(np.ascontiguousarray(v[:, i]) for i in range(3)) for v in (s, sr, sa)
+            )
         for b in self.vectors:
             d = rotate(b[0], b[1], b[2])
             rate = (
@@ -333,46 +384,55 @@ class _Evaluator:
                 ω_in[2] * d[0] - ω_in[0] * d[2],
                 ω_in[0] * d[1] - ω_in[1] * d[0],
             )
-            # d̈ = α × d + ω × ḋ: a cosine bends by s·d̈ + 2 ṡ·ḋ (and s̈·d, left out:
-            # below 1e-5 of the rest but for a body near rest, where f'' serves only
-            # the incidence's integral and the extrema's Newton steps, not a bound).
+            # d̈ = α × d + ω × ḋ: a cosine bends by s·d̈ + 2 ṡ·ḋ + s̈·d (f'' serves the
+            # incidence's integral and the extrema's Newton steps, never a bound).
             bend = (
                 α_in[1] * d[2] - α_in[2] * d[1] + ω_in[1] * rate[2] - ω_in[2] * rate[1],
                 α_in[2] * d[0] - α_in[0] * d[2] + ω_in[2] * rate[0] - ω_in[0] * rate[2],
                 α_in[0] * d[1] - α_in[1] * d[0] + ω_in[0] * rate[1] - ω_in[1] * rate[0],
             )
             for target in self.targets:
-                s = getattr(sky, target)
-                s_rate = getattr(sky, f"{target}_rate")
-                ddf[target].append(
-                    (bend[0] * s[:, 0] + bend[1] * s[:, 1] + bend[2] * s[:, 2])
-                    + 2.0 * (rate[0] * s_rate[:, 0] + rate[1] * s_rate[:, 1] + rate[2] * s_rate[:, 2])
-                )
-                f[target].append(d[0] * s[:, 0] + d[1] * s[:, 1] + d[2] * s[:, 2])
+                (s0, s1, s2), (r0, r1, r2), (a0, a1, a2) = columns[target]
+                f[target].append(d[0] * s0 + d[1] * s1 + d[2] * s2)
                 df[target].append(
-                    (d[0] * s_rate[:, 0] + d[1] * s_rate[:, 1] + d[2] * s_rate[:, 2])
-                    + (rate[0] * s[:, 0] + rate[1] * s[:, 1] + rate[2] * s[:, 2])
+                    (d[0] * r0 + d[1] * r1 + d[2] * r2) + (rate[0] * s0 + rate[1] * s1 + rate[2] * s2)
                 )
-                if angles:
-                    angle[target].append(unit_angle(np.stack(d, axis=1), s))
+                ddf[target].append(
+                    (bend[0] * s0 + bend[1] * s1 + bend[2] * s2)
+                    + 2.0 * (rate[0] * r0 + rate[1] * r1 + rate[2] * r2)
+                    + (d[0] * a0 + d[1] * a1 + d[2] * a2)
+                )
+                if angles is True or (angles and target in angles):
+                    angle[target].append(_unit_angle_columns(d, columns[target][0]))
+        # σ by arccos: ~1e-12 rad near 0 and π at σ = 1e-4, far below the margin the
+        # envelope adds (_ENVELOPE_MARGIN).
+        axis = self.axes[piece]
         sigma = {}
-        if self.axis is not None:
-            # arccos: near 0 and π it keeps ~1e-12 rad at σ = 1e-4, far below the
-            # margin the envelope adds (_ENVELOPE_MARGIN).
-            h0, h1, h2 = self.axis
-            for target in self.targets:
-                s = getattr(sky, target)
-                along = s[:, 0] * h0 + s[:, 1] * h1 + s[:, 2] * h2
-                sigma[target] = np.arccos(np.clip(along, -1.0, 1.0))
+        for target in self.targets:
+            s0, s1, s2 = columns[target][0]
+            along = s0 * axis[:, 0] + s1 * axis[:, 1] + s2 * axis[:, 2]
+            sigma[target] = np.arccos(np.clip(along, -1.0, 1.0))
+
+        def stacked(values: dict[str, list]) -> dict[str, NDArray[np.float64]]:
+            return {t: np.array(v).reshape(len(self.vectors), -1) for t, v in values.items()}
+
         return _Values(
-            {t: np.array(v) for t, v in f.items()},
-            {t: np.array(v) for t, v in df.items()},
-            {t: np.array(v) for t, v in angle.items()} if angles else {},
+            stacked(f),
+            stacked(df),
+            stacked(ddf),
+            stacked({t: v for t, v in angle.items() if v}),
+            sigma,
             sky.limb,
             sky.limb_rate,
-            sigma,
-            {t: np.array(v) for t, v in ddf.items()},
         )
+
+
+def _unit_angle_columns(u, v) -> NDArray[np.float64]:
+    """The angle between unit vectors given by columns, 2 atan2(|u − v|, |u + v|)
+    (Kahan's formula, as :func:`attitude.pointing.surroundings.unit_angle`)."""
+    d0, d1, d2 = u[0] - v[0], u[1] - v[1], u[2] - v[2]
+    s0, s1, s2 = u[0] + v[0], u[1] + v[1], u[2] + v[2]
+    return 2.0 * np.arctan2(np.sqrt(d0 * d0 + d1 * d1 + d2 * d2), np.sqrt(s0 * s0 + s1 * s1 + s2 * s2))
 
 
 # ------------------------------------------------------------------ bounds in a cell
@@ -409,8 +469,25 @@ def _cubic(g0, d0, g1, d1, h):
     return g0, a1, a2, a3
 
 
-def _cubic_at(c, s):
-    return c[0] + s * (c[1] + s * (c[2] + s * c[3]))
+def _quintic(y0, p0, q0, y1, p1, q1):
+    """Power coefficients in s ∈ [0, 1] of the quintic with the ends' values y, first
+    derivatives p and second derivatives q (in s: h f', h² f'')."""
+    dy = y1 - y0
+    return (
+        y0,
+        p0,
+        0.5 * q0,
+        10.0 * dy - 6.0 * p0 - 4.0 * p1 - 1.5 * q0 + 0.5 * q1,
+        -15.0 * dy + 8.0 * p0 + 7.0 * p1 + 1.5 * q0 - q1,
+        6.0 * dy - 3.0 * p0 - 3.0 * p1 - 0.5 * q0 + 0.5 * q1,
+    )
+
+
+def _polynomial_at(c, s):
+    value = c[-1]
+    for coefficient in reversed(c[:-1]):
+        value = value * s + coefficient
+    return value
 
 
 def _cubic_peak(c, highest: NDArray[np.bool_]):
@@ -425,7 +502,7 @@ def _cubic_peak(c, highest: NDArray[np.bool_]):
     sign = np.where(highest, 1.0, -1.0)
     for r in (r1, r2):
         ok = np.isfinite(r) & (r > 0.0) & (r < 1.0)
-        value = np.where(ok, sign * _cubic_at(c, np.where(ok, r, 0.5)), -np.inf)
+        value = np.where(ok, sign * _polynomial_at(c, np.where(ok, r, 0.5)), -np.inf)
         better = value > score
         best = np.where(better, r, best)
         score = np.where(better, value, score)
@@ -439,32 +516,38 @@ def _cubic_root(c, g0, g1):
         s = np.clip(np.where(np.isfinite(s), s, 0.5), 0.0, 1.0)
         for _ in range(4):
             slope = c[1] + s * (2.0 * c[2] + 3.0 * s * c[3])
-            step = _cubic_at(c, s) / slope
+            step = _polynomial_at(c, s) / slope
             s = np.clip(np.where(np.isfinite(step), s - step, s), 0.0, 1.0)
     return s
 
 
-def _envelope(plan: FreePlan, name: str, target: str, σ_a, σ_b, t_a, t_b):
+def _envelope(pieces: list[FreePiece], piece, name: str, target: str, σ_a, σ_b, t_a, t_b):
     """Bounds (low, high) on the angle between body vector ``name``'s direction and
-    ``target`` over each window [t_a, t_b], from the spherical triangle of the two and
-    the momentum's direction Ĥ: |σ − β| ≤ angle ≤ min(σ + β, 2π − σ − β), with σ the
-    target's angle to Ĥ (σ_a, σ_b at the ends, drifting at most at the target's rate)
-    and β the vector's angle to the momentum, over the window from its periodic table
-    (:class:`VectorMotion`).  (0, π) where there is no momentum."""
-    tilt = plan.motion[name].tilt if name in plan.motion else None
-    if tilt is None:
-        return np.zeros(np.shape(t_a)), np.full(np.shape(t_a), math.pi)
-    low, high = tilt.over(t_a, t_b)
-    β_low = np.arccos(np.clip(high, -1.0, 1.0))
-    β_high = np.arccos(np.clip(low, -1.0, 1.0))
-    drift = plan.sky.get(f"{target}_1", math.inf) * 0.5 * (t_b - t_a)
-    σ_low = np.minimum(σ_a, σ_b) - drift
-    σ_high = np.maximum(σ_a, σ_b) + drift
-    lower = np.maximum(np.maximum(σ_low - β_high, β_low - σ_high), 0.0)
-    upper = np.minimum(np.minimum(σ_high + β_high, 2.0 * math.pi - σ_low - β_low), math.pi)
-    lower = np.where(np.isfinite(lower), lower - _ENVELOPE_MARGIN, 0.0)
-    upper = np.where(np.isfinite(upper), upper + _ENVELOPE_MARGIN, math.pi)
-    return lower, upper
+    ``target`` over each window [t_a, t_b] of a piece (``piece``: indices), from the
+    spherical triangle of the two and the momentum's direction Ĥ: |σ − β| ≤ angle ≤
+    min(σ + β, 2π − σ − β), with σ the target's angle to Ĥ (σ_a, σ_b at the ends,
+    drifting at most at the target's rate) and β the vector's angle to the momentum,
+    over the window from the piece's periodic table (:class:`VectorMotion`).  (0, π)
+    where there is no momentum."""
+    low = np.zeros(np.shape(t_a))
+    high = np.full(np.shape(t_a), math.pi)
+    for k in np.unique(piece).tolist():
+        plan = pieces[k].plan
+        tilt = plan.motion[name].tilt if name in plan.motion else None
+        if tilt is None:
+            continue
+        mine = piece == k
+        c_low, c_high = tilt.over(t_a[mine], t_b[mine])
+        β_low = np.arccos(np.clip(c_high, -1.0, 1.0))
+        β_high = np.arccos(np.clip(c_low, -1.0, 1.0))
+        drift = plan.sky.get(f"{target}_1", math.inf) * 0.5 * (t_b[mine] - t_a[mine])
+        σ_low = np.minimum(σ_a[mine], σ_b[mine]) - drift
+        σ_high = np.maximum(σ_a[mine], σ_b[mine]) + drift
+        lower = np.maximum(np.maximum(σ_low - β_high, β_low - σ_high), 0.0)
+        upper = np.minimum(np.minimum(σ_high + β_high, 2.0 * math.pi - σ_low - β_low), math.pi)
+        low[mine] = np.where(np.isfinite(lower), np.maximum(lower - _ENVELOPE_MARGIN, 0.0), 0.0)
+        high[mine] = np.where(np.isfinite(upper), upper + _ENVELOPE_MARGIN, math.pi)
+    return low, high
 
 
 # ---------------------------------------------------------------------- the tracks
@@ -497,7 +580,10 @@ def conditions_of(spec: PointingSpec) -> list[_Condition]:
         if v.earth_limb_exclusion_angle_rad is not None and spec.orbit is not None:
             out.append(
                 _Condition(
-                    f"{v.name}.earth_limb_exclusion", j, "nadir", "limb",
+                    f"{v.name}.earth_limb_exclusion",
+                    j,
+                    "nadir",
+                    "limb",
                     v.earth_limb_exclusion_angle_rad,
                 )
             )
@@ -506,48 +592,37 @@ def conditions_of(spec: PointingSpec) -> list[_Condition]:
 
 def _condition_values(values: _Values, conditions: list[_Condition]):
     """Each condition's function g, its rate, its target's angle σ to the momentum's
-    direction (NaN at rest) and g'' (NaN for the limb's) at the values' times: (K, n)
-    each."""
+    direction and g'' (NaN for the limb's) at the values' times: (K, n) each."""
     g, dg, σ, ddg = [], [], [], []
     for c in conditions:
         f = values.f[c.target][c.vector]
         df = values.df[c.target][c.vector]
-        σ.append(values.sigma.get(c.target, np.full(f.shape, np.nan)))
-        cosine = c.kind == "cos" and c.target in values.ddf
-        ddg.append(values.ddf[c.target][c.vector] if cosine else np.full(f.shape, np.nan))
+        σ.append(values.sigma[c.target])
         if c.kind == "cos":
             g.append(f - c.c)
             dg.append(df)
+            ddg.append(values.ddf[c.target][c.vector])
         else:
             assert values.limb is not None and values.limb_rate is not None
             edge = c.c + values.limb
             clipped = np.clip(edge, 0.0, math.pi)
             g.append(f - np.cos(clipped))
             dg.append(df + np.where(clipped == edge, np.sin(clipped), 0.0) * values.limb_rate)
+            ddg.append(np.full(f.shape, np.nan))
     shape = (len(conditions), -1)
     return tuple(np.array(x).reshape(shape) for x in (g, dg, σ, ddg))
 
 
-@dataclass
-class FreeResult:
-    """What :func:`search_free` found over its span: each condition's intervals (by the
-    names of :mod:`attitude.pointing.search`), the extrema (the best of ``incumbents``
-    and of the span, by problem name), the integral of the incidence of each vector,
-    whether each vector saw no Sun at some time (``dark``), and the evaluations made."""
-
-    intervals: dict[str, list[Interval]]
-    extrema: dict[str, Extremum]
-    incidence_integral: dict[str, float]
-    dark: dict[str, bool]
-    evaluations: int = 0
+_CELL_FIELDS = ("k", "p", "a", "b", "ga", "gb", "da", "db", "sa", "sb", "ea", "eb")
 
 
 @dataclass
 class _Cells:
-    """Cells of the conditions (flat): condition index, ends, values and rates there,
-    the target's angle to the momentum's direction and g'' there."""
+    """Cells of the conditions (flat): condition index, piece, ends, values and rates
+    there, the target's angle to the momentum's direction and g'' there."""
 
     k: NDArray[np.intp]
+    p: NDArray[np.intp]
     a: NDArray[np.float64]
     b: NDArray[np.float64]
     ga: NDArray[np.float64]
@@ -567,15 +642,13 @@ class _Cells:
         return _Cells(*(np.concatenate([getattr(p, n) for p in parts]) for n in _CELL_FIELDS))
 
 
-_CELL_FIELDS = ("k", "a", "b", "ga", "gb", "da", "db", "sa", "sb", "ea", "eb")
-
-
 def _settle(cells: _Cells, M: NDArray[np.float64], envelope):
     """Each cell's status: 0 settled without a crossing, 1 one crossing, 2 not proved.
-    ``envelope(cells)``: bounds on each cell's angle to its threshold's target and that
-    threshold as an angle (NaN where the envelope does not apply)."""
+    ``M`` (conditions, pieces): the bounds on |g''|; ``envelope(cells)``: bounds on
+    each cell's angle to its condition's target and the threshold as an angle (NaN
+    where the envelope does not apply)."""
     h = cells.b - cells.a
-    bend = M[cells.k]
+    bend = M[cells.k, cells.p]
     low, high = _bounds(cells.ga, cells.da, cells.gb, cells.db, h, bend)
     in_a, in_b = cells.ga > 0.0, cells.gb > 0.0
     settled = (~in_a & ~in_b & (high <= 0.0)) | (in_a & in_b & (low > 0.0))
@@ -606,19 +679,11 @@ def _cut(cells: _Cells) -> NDArray[np.float64]:
     return cells.a + np.clip(s, _CUT, 1.0 - _CUT) * h
 
 
-def _partition(
-    evaluate, conditions: list[_Condition], τ: NDArray[np.float64], values, M, envelope
-) -> tuple[_Cells, NDArray[np.int8], int]:
-    """Every condition's cells over the nodes τ (``values``: g, g', σ, g'' there), cut
-    until each is settled (module notes): the final cells, their status (0 or 1) and
-    the evaluations made."""
-    K, n = values[0].shape
-    k = np.repeat(np.arange(K), n - 1)
-    ends = [x for v in values for x in (v[:, :-1].ravel(), v[:, 1:].ravel())]
-    cells = _Cells(k, np.tile(τ[:-1], K), np.tile(τ[1:], K), *ends)
+def _partition(evaluate, conditions, cells: _Cells, M, envelope) -> tuple[_Cells, NDArray[np.int8]]:
+    """Every condition's ``cells``, cut until each is settled (module notes): the final
+    cells and their status (0 or 1)."""
     done: list[_Cells] = []
     statuses: list[NDArray[np.int8]] = []
-    evaluations = 0
     while cells.k.size:
         status = _settle(cells, M, envelope)
         final = status < 2
@@ -628,40 +693,20 @@ def _partition(
         if not cells.k.size:
             break
         cut = _cut(cells)
-        times, inverse = np.unique(cut, return_inverse=True)
-        at_cut = _condition_values(evaluate(times), conditions)
-        evaluations += times.size
+        keys = np.stack([cut, cells.p.astype(np.float64)])
+        unique, inverse = np.unique(keys, axis=1, return_inverse=True)
+        inverse = inverse.ravel()
+        at_cut = _condition_values(evaluate(unique[0], unique[1].astype(np.intp)), conditions)
         g, dg, σ, ddg = (x[cells.k, inverse] for x in at_cut)
         left = _Cells(
-            cells.k, cells.a, cut, cells.ga, g, cells.da, dg, cells.sa, σ, cells.ea, ddg
+            cells.k, cells.p, cells.a, cut, cells.ga, g, cells.da, dg, cells.sa, σ, cells.ea, ddg
         )
         right = _Cells(
-            cells.k, cut, cells.b, g, cells.gb, dg, cells.db, σ, cells.sb, ddg, cells.eb
+            cells.k, cells.p, cut, cells.b, g, cells.gb, dg, cells.db, σ, cells.sb, ddg, cells.eb
         )
         cells = _Cells.join([left, right])
     final_cells = _Cells.join(done) if done else cells
-    return final_cells, np.concatenate(statuses) if statuses else np.empty(0, np.int8), evaluations
-
-
-def _quintic(y0, p0, q0, y1, p1, q1):
-    """Power coefficients in s ∈ [0, 1] of the quintic with the ends' values y, first
-    derivatives p and second derivatives q (in s: h f', h² f'')."""
-    dy = y1 - y0
-    return (
-        y0,
-        p0,
-        0.5 * q0,
-        10.0 * dy - 6.0 * p0 - 4.0 * p1 - 1.5 * q0 + 0.5 * q1,
-        -15.0 * dy + 8.0 * p0 + 7.0 * p1 + 1.5 * q0 - q1,
-        6.0 * dy - 3.0 * p0 - 3.0 * p1 - 0.5 * q0 + 0.5 * q1,
-    )
-
-
-def _polynomial_at(c, s):
-    value = c[-1]
-    for coefficient in reversed(c[:-1]):
-        value = value * s + coefficient
-    return value
+    return final_cells, np.concatenate(statuses) if statuses else np.empty(0, np.int8)
 
 
 # ------------------------------------------------------------------ the search
@@ -669,16 +714,53 @@ def _polynomial_at(c, s):
 
 _GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(4)
 _QUANTITIES = ("sun_angle", "moon_angle", "cos_incidence", "nadir_angle", "earth_limb_angle")
-# The quantities whose extrema are those of one cosine (the incidence's, outside the
-# shadow), refined by Newton's method: at most this many steps, done below this (s).
-_TARGET_OF = {"sun_angle": "sun", "moon_angle": "moon", "nadir_angle": "nadir", "cos_incidence": "sun"}
+# Extrema found by Newton's method on a cosine's slope: the quantity's target (the
+# incidence's outside the shadow, the limb's with the limb's own rate); at most this
+# many steps, done below this step (s).
+_TARGET_OF = {
+    "sun_angle": "sun",
+    "moon_angle": "moon",
+    "nadir_angle": "nadir",
+    "cos_incidence": "sun",
+    "earth_limb_angle": "nadir",
+}
 _NEWTON_STEPS = 6
 _NEWTON_DONE_S = 1e-9
+# A piece that ends at an event ends its nodes this long before it (s): the
+# trajectory puts times within SAME_INSTANT_S of an event at the event's state.
+_BEFORE_EVENT_S = 2e-9
+
+
+@dataclass
+class FreeResult:
+    """What :func:`search_free` found over its span: each condition's intervals (by the
+    names of :mod:`attitude.pointing.search`), the extrema (the best of ``incumbents``
+    and of the span, by problem name), the integral of the incidence of each vector,
+    whether each vector saw no Sun at some time (``dark``), and the points evaluated."""
+
+    intervals: dict[str, list[Interval]]
+    extrema: dict[str, Extremum]
+    incidence_integral: dict[str, float]
+    dark: dict[str, bool]
+    evaluations: int = 0
+
+
+def _nodes(pieces: list[FreePiece]) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
+    """The nodes of every piece, in order, and each node's piece: every ``plan.step_s``
+    over [start_s, end_s], the last of a piece followed by an event just before it."""
+    times, owner = [], []
+    for k, piece in enumerate(pieces):
+        count = max(math.ceil((piece.end_s - piece.start_s) / piece.plan.step_s), 1) + 1
+        τ = np.linspace(piece.start_s, piece.end_s, count)
+        if k + 1 < len(pieces):
+            τ[-1] = max(piece.end_s - _BEFORE_EVENT_S, τ[-2] if count > 2 else piece.start_s)
+        times.append(τ)
+        owner.append(np.full(count, k, dtype=np.intp))
+    return np.concatenate(times), np.concatenate(owner)
 
 
 def search_free(
-    plan: FreePlan,
-    solver: EulerSolver,
+    pieces: list[FreePiece],
     spec: PointingSpec,
     shared: SharedSurroundings,
     precision_s: float,
@@ -688,51 +770,61 @@ def search_free(
     incumbents: dict[str, Extremum | None],
     shadow: list[Interval],
     umbra: list[Interval],
-    start_s: float,
-    end_s: float,
 ) -> FreeResult:
-    """Search the free segment of ``plan`` over [start_s, end_s] (within it): every
-    condition's intervals, the extrema of ``problems`` (names ``"<vector>.<quantity>
-    .low"``/``".high"``: the quantity, or its negative, to minimize; each problem's
-    ``lipschitz`` prunes brackets; ``incumbents`` the best known), and each vector's
-    integral of the incidence.  ``shadow`` and ``umbra``: the eclipses over the span
-    (the lit fraction is 1 outside the shadow, 0 in umbra)."""
-    evaluate = _Evaluator(solver, spec, shared)
+    """Search the consecutive torque-free ``pieces`` together: every condition's
+    intervals, the extrema of ``problems`` (names ``"<vector>.<quantity>.low"``/
+    ``".high"``: the quantity, or its negative, to minimize; each problem's
+    ``lipschitz`` prunes golden-section brackets; ``incumbents`` the best known), and
+    each vector's integral of the incidence.  ``shadow``/``umbra``: the eclipses over
+    the span (the lit fraction is 1 outside the shadow, 0 in umbra).  The nodes are
+    searched in windows of at most :data:`WINDOW_NODES`."""
+    evaluate = _Evaluator(pieces, spec, shared)
     conditions = conditions_of(spec)
     names = [v.name for v in spec.body_vectors]
     M = np.array(
         [
-            plan.bend[(names[c.vector], c.target)] + (plan.limb_bend if c.kind == "limb" else 0.0)
+            [
+                p.plan.bend[(names[c.vector], c.target)]
+                + (p.plan.limb_bend if c.kind == "limb" else 0.0)
+                for p in pieces
+            ]
             for c in conditions
         ]
-    )
-    intervals: dict[str, list[Interval]] = {c.name: [] for c in conditions}
+    ).reshape(len(conditions), len(pieces))
+    out: dict[str, list[Interval]] = {c.name: [] for c in conditions}
     best: dict[str, Extremum] = {}
     integral = dict.fromkeys(names, 0.0)
     dark = dict.fromkeys(names, False)
-    shadow_ends = np.array([x for i in shadow for x in (i.start_s, i.end_s)], dtype=np.float64)
-    umbra_ends = np.array([x for i in umbra for x in (i.start_s, i.end_s)], dtype=np.float64)
-    step = plan.step_s
-    count = max(math.ceil((end_s - start_s) / step), 1) + 1
+    ends = np.array(
+        [x for i in [*shadow, *umbra] for x in (i.start_s, i.end_s)], dtype=np.float64
+    )
+    τ_all, owner_all = _nodes(pieces)
     first = 0
-    while first < count - 1:
-        last = min(first + WINDOW_NODES, count - 1)
-        w0 = start_s + (end_s - start_s) * first / (count - 1)
-        w1 = end_s if last == count - 1 else start_s + (end_s - start_s) * last / (count - 1)
-        τ = np.linspace(w0, w1, last - first + 1)
-        inside = np.concatenate([shadow_ends, umbra_ends])
-        inside = inside[(inside > w0) & (inside < w1)]
+    while first < τ_all.size - 1:
+        last = min(first + WINDOW_NODES, τ_all.size - 1)
+        τ, owner = τ_all[first : last + 1], owner_all[first : last + 1]
+        # The eclipses' ends are nodes (the lit fraction has kinks there).
+        inside = ends[(ends > τ[0]) & (ends < τ[-1])]
         if inside.size:
-            τ = np.unique(np.concatenate([τ, inside]))
-        window = _Window(evaluate, spec, shared, plan, conditions, M, τ, shadow, umbra)
-        window.intervals(precision_s, intervals)
-        window.extrema(problems, incumbents, best, tolerance, extremum_precision_s)
+            piece_of = owner[np.clip(np.searchsorted(τ, inside, side="right") - 1, 0, τ.size - 1)]
+            order = np.lexsort((np.concatenate([τ, inside]), np.concatenate([owner, piece_of])))
+            τ = np.concatenate([τ, inside])[order]
+            owner = np.concatenate([owner, piece_of])[order]
+        window = _Window(evaluate, spec, shared, pieces, conditions, M, τ, owner, shadow, umbra)
+        found = window.search(
+            precision_s, problems, incumbents, best, tolerance, extremum_precision_s
+        )
+        for name, pieces_found in found.items():
+            if first == 0:
+                join(out[name], pieces_found, float(τ[0]))
+            else:
+                append_across(out[name], pieces_found, float(τ[0]))
         for name, value in window.incidence().items():
             integral[name] += value
         for name, value in window.dark().items():
             dark[name] = dark[name] or value
         first = last
-    return FreeResult(intervals, best, integral, dark, evaluate.points)
+    return FreeResult(out, best, integral, dark, evaluate.points)
 
 
 def _in_any(τ: NDArray[np.float64], intervals: list[Interval]) -> NDArray[np.bool_]:
@@ -746,21 +838,33 @@ def _in_any(τ: NDArray[np.float64], intervals: list[Interval]) -> NDArray[np.bo
 
 
 class _Window:
-    """One window of nodes of a free segment, searched."""
+    """One window of nodes (τ, each of a piece: ``owner``), searched."""
 
-    def __init__(self, evaluate, spec, shared, plan, conditions, M, τ, shadow, umbra) -> None:
-        self.evaluate, self.spec, self.shared, self.plan = evaluate, spec, shared, plan
-        self.conditions, self.M, self.τ = conditions, M, τ
+    def __init__(self, evaluate, spec, shared, pieces, conditions, M, τ, owner, shadow, umbra):
+        self.evaluate, self.spec, self.shared, self.pieces = evaluate, spec, shared, pieces
+        self.fraction_rate = pieces[0].plan.sky.get("fraction_1", math.inf)
+        self.conditions, self.M, self.τ, self.owner = conditions, M, τ, owner
         self.shadow, self.umbra = shadow, umbra
         self.limb_rate = shared.rate_bounds().get("limb_1", 0.0)
-        self.values = evaluate(τ, angles=True)
+        self.values = evaluate(τ, owner, angles=True)
         at_nodes = _condition_values(self.values, conditions)
         self.g = at_nodes[0]
-        self.cells, self.status, _ = _partition(
-            evaluate, conditions, τ, at_nodes, M, self._condition_envelope
+        # Cells join neighbouring nodes of one piece.
+        self.cell = np.flatnonzero(owner[1:] == owner[:-1])
+        K = len(conditions)
+        i = self.cell
+        k = np.repeat(np.arange(K), i.size)
+        pairs = [x for v in at_nodes for x in (v[:, i].ravel(), v[:, i + 1].ravel())]
+        cells = _Cells(
+            k, np.tile(owner[i], K), np.tile(τ[i], K), np.tile(τ[i + 1], K), *pairs
+        )
+        self.cells, self.status = _partition(
+            evaluate, conditions, cells, M, self._condition_envelope
         )
         # The refined time of each cell's crossing (NaN for a cell without one).
         self.cross = np.full(self.status.size, np.nan)
+        self._cosines: dict = {}
+        self._envelopes: dict = {}
         self.found: dict[str, list[Interval]] = {}
 
     def _condition_envelope(self, cells: _Cells):
@@ -776,52 +880,77 @@ class _Window:
             mine = cells.k == index
             name = self.spec.body_vectors[condition.vector].name
             low[mine], high[mine] = _envelope(
-                self.plan, name, condition.target,
-                cells.sa[mine], cells.sb[mine], cells.a[mine], cells.b[mine],
+                self.pieces,
+                cells.p[mine],
+                name,
+                condition.target,
+                cells.sa[mine],
+                cells.sb[mine],
+                cells.a[mine],
+                cells.b[mine],
             )
             threshold[mine] = math.acos(min(max(condition.c, -1.0), 1.0))
         return low, high, threshold
 
     # ---------------------------------------------------------------- intervals
 
-    def intervals(self, precision_s: float, out: dict[str, list[Interval]]) -> None:
-        """Refine the crossings and append each condition's intervals to ``out``."""
-        from attitude.pointing.intervals import join
-
+    def search(self, precision_s, problems, incumbents, best, tolerance, extremum_precision_s):
+        """Every condition's intervals over the window (returned) and the extrema of
+        ``problems`` (folded into ``best``).  The crossings' estimates and the extrema's
+        first Newton points are evaluated in one call."""
         crossing = self.status == 1
         cells = self.cells.take(crossing)
-        times = self._crossings(cells, precision_s)
-        inside_at_a = cells.ga > 0.0
-        self.cross[crossing] = times
-        w = np.array([self.τ[0], self.τ[-1]])
-        for index, condition in enumerate(self.conditions):
-            mine = np.flatnonzero(cells.k == index)
-            order = mine[np.argsort(times[mine], kind="stable")]
-            pieces = _assemble(
-                w, np.array([self.g[index, 0] > 0.0]), times[order], ~inside_at_a[order]
-            )
-            self.found[condition.name] = pieces
-            join(out[condition.name], pieces, float(self.τ[0]))
-
-    def _crossings(self, cells: _Cells, precision_s: float) -> NDArray[np.float64]:
-        """The crossing in each cell (one, where g' keeps its sign), to ``precision_s``.
-
-        g at the root of the cubic through the ends, x, with its slope d there: on
-        [x − δ, x + δ], δ = 2|g(x)|/|d|, g' stays within M δ of d, so if M δ < |d|/2 the
-        crossing lies there, and within M δ²/|d| of the Newton step x − g(x)/d (Taylor's
-        remainder over a slope at least |d|/2): reported when that is below
-        ``precision_s``/2, one evaluation a crossing.  The others are refined by the
-        probes and bisection of :func:`~attitude.pointing.intervals._refine`."""
-        conditions = self.conditions
         h = cells.b - cells.a
         c = _cubic(cells.ga, cells.da, cells.gb, cells.db, h)
         x = cells.a + _cubic_root(c, cells.ga, cells.gb) * h
+        newton = self._extrema_start(problems, incumbents, best, tolerance)
+        points = np.concatenate([x, newton.x])
+        owners = np.concatenate([cells.p, newton.piece])
+        at = self.evaluate(points, owners, angles=True) if points.size else None
+        times = self._crossings(cells, x, at, precision_s)
+        self.cross[crossing] = times
+        self._extrema_finish(newton, at, x.size, problems, best, tolerance, extremum_precision_s)
+        return self._intervals(cells, times)
+
+    def _intervals(self, cells: _Cells, times: NDArray[np.float64]) -> dict[str, list[Interval]]:
+        """Each condition's intervals over the window from its crossings' ``times`` (a
+        crossing at each event where the condition's value jumps across 0)."""
+        entering = cells.ga <= 0.0
+        # Events inside the window: the pieces' last nodes and the next ones' first.
+        τ, owner = self.τ, self.owner
+        boundary = np.flatnonzero(owner[1:] != owner[:-1])
+        w = np.array([τ[0], τ[-1]])
+        out = {}
+        for index, condition in enumerate(self.conditions):
+            mine = np.flatnonzero(cells.k == index)
+            g = self.g[index]
+            jumps = boundary[(g[boundary] > 0.0) != (g[boundary + 1] > 0.0)]
+            at = np.concatenate([times[mine], τ[jumps + 1]])
+            enters = np.concatenate([entering[mine], g[jumps + 1] > 0.0])
+            order = np.argsort(at, kind="stable")
+            pieces = _assemble(w, np.array([g[0] > 0.0]), at[order], enters[order])
+            self.found[condition.name] = pieces
+            out[condition.name] = pieces
+        return out
+
+    def _crossings(self, cells: _Cells, x, at, precision_s: float) -> NDArray[np.float64]:
+        """The crossing in each cell (one, where g' keeps its sign), to ``precision_s``,
+        from g at the root x of the cubic through the ends (``at``: the values there,
+        its first x.size points).
+
+        With d the slope at x: on [x − δ, x + δ], δ = 2|g(x)|/|d|, g' stays within M δ
+        of d, so if M δ < |d|/2 the crossing lies there, and within M δ²/|d| of the
+        Newton step x − g(x)/d (Taylor's remainder over a slope at least |d|/2):
+        reported when that is below ``precision_s``/2, one evaluation a crossing.  The
+        others are refined by the probes and bisection of
+        :func:`~attitude.pointing.intervals._refine`."""
+        conditions = self.conditions
         if not x.size:
             return x
-        g, dg, _, _ = _condition_values(self.evaluate(x), conditions)
+        g, dg, _, _ = _condition_values(at, conditions)
         column = np.arange(x.size)
         g_x, d_x = g[cells.k, column], dg[cells.k, column]
-        bend = self.M[cells.k]
+        bend = self.M[cells.k, cells.p]
         with np.errstate(divide="ignore", invalid="ignore"):
             δ = 2.0 * np.abs(g_x) / np.abs(d_x)
             newton = x - g_x / d_x
@@ -834,7 +963,7 @@ class _Window:
             sub = cells.take(rest)
 
             def f(τ: NDArray[np.float64], which: NDArray[np.intp]) -> NDArray[np.float64]:
-                values = _condition_values(self.evaluate(τ), conditions)[0]
+                values = _condition_values(self.evaluate(τ, sub.p[which]), conditions)[0]
                 return values[sub.k[which], np.arange(τ.size)]
 
             # The bracket keeps its side of x: the cell's ends, x itself.
@@ -848,10 +977,11 @@ class _Window:
 
     # ------------------------------------------------------------------ extrema
 
-    def _quantities(self, values: _Values, τ: NDArray[np.float64]) -> dict[str, NDArray]:
-        """Each problem's function (to minimize) at τ."""
+    def _quantities(self, values: _Values, τ: NDArray[np.float64], fraction=None) -> dict[str, NDArray]:
+        """Each problem's function (to minimize) at τ (the lit fraction there, if known)."""
         out = {}
-        fraction = self._fraction(τ)
+        if fraction is None:
+            fraction = self._fraction(τ)
         for j, v in enumerate(self.spec.body_vectors):
             for quantity, q in self._vector_quantities(values, j, fraction).items():
                 out[f"{v.name}.{quantity}.low"] = q
@@ -873,76 +1003,138 @@ class _Window:
     def _fraction(self, τ: NDArray[np.float64]) -> NDArray[np.float64]:
         """The lit fraction: 1 outside the shadow, 0 in umbra, the surroundings' else."""
         fraction = np.ones(τ.shape)
-        partial = _in_any(τ, self.shadow) & ~_in_any(τ, self.umbra)
-        fraction[_in_any(τ, self.umbra)] = 0.0
+        if not self.shadow:
+            return fraction
+        in_umbra = _in_any(τ, self.umbra)
+        partial = _in_any(τ, self.shadow) & ~in_umbra
+        fraction[in_umbra] = 0.0
         if np.any(partial):
             fraction[partial] = self.shared.at(τ[partial]).sunlit_fraction
         return fraction
 
+    def _cell_in(self, intervals: list[Interval]) -> NDArray[np.bool_]:
+        """Whether each cell (between nodes) meets one of the intervals."""
+        a, b = self.τ[self.cell], self.τ[self.cell + 1]
+        if not intervals:
+            return np.zeros(a.size, dtype=bool)
+        starts = np.array([i.start_s for i in intervals])
+        ends = np.array([i.end_s for i in intervals])
+        k = np.searchsorted(starts, b, side="left") - 1  # the last interval starting before b
+        return (k >= 0) & (ends[np.maximum(k, 0)] > a)
+
+    def _cosine_bounds(self, target: str):
+        """Bounds (low, high), (vectors, cells), on every vector's cosine with ``target``
+        in each cell between nodes, from the bend bound (computed once a window)."""
+        if target not in self._cosines:
+            values, i = self.values, self.cell
+            h = self.τ[i + 1] - self.τ[i]
+            piece = self.owner[i]
+            bend = np.array(
+                [[p.plan.bend[(v.name, target)] for p in self.pieces] for v in self.spec.body_vectors]
+            )[:, piece]
+            f, df = values.f[target], values.df[target]
+            self._cosines[target] = _bounds(f[:, i], df[:, i], f[:, i + 1], df[:, i + 1], h, bend)
+        return self._cosines[target]
+
+    def _envelope_at(self, j: int, target: str, ask: NDArray[np.intp]):
+        """The envelope's angle bounds (:func:`_envelope`) of vector j with ``target`` in
+        the cells ``ask`` (computed once a cell)."""
+        key = (j, target)
+        if key not in self._envelopes:
+            size = self.cell.size
+            self._envelopes[key] = (np.zeros(size, bool), np.zeros(size), np.full(size, math.pi))
+        known, low, high = self._envelopes[key]
+        missing = ask[~known[ask]]
+        if missing.size:
+            i = self.cell[missing]
+            σ = self.values.sigma[target]
+            low[missing], high[missing] = _envelope(
+                self.pieces,
+                self.owner[i],
+                self.spec.body_vectors[j].name,
+                target,
+                σ[i],
+                σ[i + 1],
+                self.τ[i],
+                self.τ[i + 1],
+            )
+            known[missing] = True
+        return low[ask], high[ask]
+
     def _cell_bounds(self, j: int, quantity: str, interesting=None) -> tuple[NDArray, NDArray]:
         """Bounds on a vector's quantity in each cell between nodes; the envelope tightens
         them where ``interesting(low, high)`` (of the bend bound's) says it matters."""
-        τ, values = self.τ, self.values
-        h = np.diff(τ)
-        target = {"sun_angle": "sun", "moon_angle": "moon", "cos_incidence": "sun"}.get(
-            quantity, "nadir"
-        )
-        name = self.spec.body_vectors[j].name
-        f, df = values.f[target][j], values.df[target][j]
-        bend = self.plan.bend[(name, target)]
-        low, high = _bounds(f[:-1], df[:-1], f[1:], df[1:], h, bend)
+        τ, values, i = self.τ, self.values, self.cell
+        h = τ[i + 1] - τ[i]
+        target = _TARGET_OF[quantity]
+        cos_low, cos_high = self._cosine_bounds(target)
+        low, high = cos_low[j].copy(), cos_high[j].copy()
+
+        def tighten(lo, hi, as_cosine: bool, ask_where):
+            if ask_where is None:
+                return lo, hi
+            ask = np.flatnonzero(ask_where(lo, hi))
+            env_low, env_high = self._envelope_at(j, target, ask)
+            if as_cosine:
+                lo[ask] = np.maximum(lo[ask], np.cos(env_high))
+                hi[ask] = np.minimum(hi[ask], np.cos(env_low))
+            else:
+                lo[ask] = np.maximum(lo[ask], env_low)
+                hi[ask] = np.minimum(hi[ask], env_high)
+            return lo, hi
+
         if quantity == "cos_incidence":
-            σ = values.sigma.get(target)
-            if σ is not None and interesting is not None:
-                ask = np.flatnonzero(interesting(np.maximum(low, 0.0), np.maximum(high, 0.0)))
-                env_low, env_high = _envelope(
-                    self.plan, name, target, σ[:-1][ask], σ[1:][ask], τ[:-1][ask], τ[1:][ask]
-                )
-                low[ask] = np.maximum(low[ask], np.cos(env_high))
-                high[ask] = np.minimum(high[ask], np.cos(env_low))
-            fraction_low = np.where(self._cell_in(self.shadow), 0.0, 1.0)
-            return np.maximum(low, 0.0) * fraction_low, np.maximum(high, 0.0)
+            low, high = tighten(np.maximum(low, 0.0), np.maximum(high, 0.0), True, interesting)
+            low, high = np.maximum(low, 0.0), np.maximum(high, 0.0)
+            if not self.shadow:
+                return low, high
+            # The lit fraction: 1 outside the shadow, 0 in umbra, and in the penumbra
+            # at most the ends' greater plus its rate over half the cell.
+            outside = ~self._cell_in(self.shadow)
+            fraction = self._node_fraction
+            most = np.maximum(fraction[i], fraction[i + 1]) + self.fraction_rate * 0.5 * h
+            return np.where(outside, low, 0.0), np.where(outside, high, high * np.minimum(most, 1.0))
         angle_low = np.arccos(np.clip(high, -1.0, 1.0))
         angle_high = np.arccos(np.clip(low, -1.0, 1.0))
-        σ = values.sigma.get(target)
-        if σ is not None and interesting is not None:
-            # The envelope, for the cells the bend bound leaves in question.
-            ask = np.flatnonzero(interesting(angle_low, angle_high))
-            env_low, env_high = _envelope(
-                self.plan, name, target, σ[:-1][ask], σ[1:][ask], τ[:-1][ask], τ[1:][ask]
-            )
-            angle_low[ask] = np.maximum(angle_low[ask], env_low)
-            angle_high[ask] = np.minimum(angle_high[ask], env_high)
-        if quantity == "earth_limb_angle":
-            assert values.limb is not None
-            drift = self.limb_rate * 0.5 * h
-            limb_low = np.minimum(values.limb[:-1], values.limb[1:]) - drift
-            limb_high = np.maximum(values.limb[:-1], values.limb[1:]) + drift
-            return angle_low - limb_high, angle_high - limb_low
-        return angle_low, angle_high
+        if quantity != "earth_limb_angle":
+            return tighten(angle_low, angle_high, False, interesting)
+        assert values.limb is not None
+        drift = self.limb_rate * 0.5 * h
+        limb_low = np.minimum(values.limb[i], values.limb[i + 1]) - drift
+        limb_high = np.maximum(values.limb[i], values.limb[i + 1]) + drift
+        ask_where = None
+        if interesting is not None:
 
-    def _cell_in(self, intervals: list[Interval]) -> NDArray[np.bool_]:
-        """Whether each cell meets one of the intervals."""
-        τ = self.τ
+            def ask_where(lo, hi):
+                return interesting(lo - limb_high, hi - limb_low)
+
+        angle_low, angle_high = tighten(angle_low, angle_high, False, ask_where)
+        return angle_low - limb_high, angle_high - limb_low
+
+    def _cell_within(self, intervals: list[Interval]) -> NDArray[np.bool_]:
+        """Whether each cell lies wholly within one of the intervals."""
+        a, b = self.τ[self.cell], self.τ[self.cell + 1]
         if not intervals:
-            return np.zeros(τ.size - 1, dtype=bool)
+            return np.zeros(a.size, dtype=bool)
         starts = np.array([i.start_s for i in intervals])
         ends = np.array([i.end_s for i in intervals])
-        k = np.searchsorted(starts, τ[1:], side="left") - 1  # last interval starting before b
-        return (k >= 0) & (ends[np.maximum(k, 0)] > τ[:-1])
+        k = np.searchsorted(starts, a, side="right") - 1
+        return (k >= 0) & (ends[np.maximum(k, 0)] >= b)
 
-    def extrema(self, problems, incumbents, best, tolerance, precision_s) -> None:
-        """The extrema of ``problems`` over the window, folded into ``best``."""
+    def _extrema_start(self, problems, incumbents, best, tolerance) -> _Newton:
+        """The extrema's start: the nodes' values folded into ``best``, the cells whose
+        bounds could beat them (by ``tolerance``), and Newton's first points in them
+        (where the quantity is smooth; the rest go to golden-section search)."""
         τ = self.τ
-        on_nodes = self._quantities(self.values, τ)
+        self._node_fraction = self._fraction(τ)
+        on_nodes = self._quantities(self.values, τ, self._node_fraction)
         self._node_problems = on_nodes
-        for name, problem in problems.items():
-            values = on_nodes[name]
-            i = int(np.argmin(values))
-            found = Extremum(float(τ[i]), float(values[i]))
+        for name in problems:
             known = best.get(name) or incumbents.get(name)
-            best[name] = found if known is None or found.value < known.value else known
-        brackets = {}
+            if known is not None:
+                best[name] = known
+        self._fold(on_nodes, τ, problems, best)
+        candidates: dict[str, NDArray[np.intp]] = {}
         for j, v in enumerate(self.spec.body_vectors):
             for quantity in _QUANTITIES[: 3 if self.values.limb is None else 5]:
                 keys = (f"{v.name}.{quantity}.low", f"{v.name}.{quantity}.high")
@@ -955,119 +1147,56 @@ class _Window:
                     return (lo < lb - tolerance) | (hi > hb + tolerance)
 
                 low, high = self._cell_bounds(j, quantity, interesting)
-                for end, bound in (("low", low), ("high", -high)):
-                    name = f"{v.name}.{quantity}.{end}"
-                    if name not in problems:
-                        continue
-                    candidate = np.flatnonzero(bound < best[name].value - tolerance)
-                    values = on_nodes[name]
-                    brackets[name] = (
-                        τ[candidate],
-                        τ[candidate + 1],
-                        values[candidate],
-                        values[candidate + 1],
-                    )
+                for name, bound in ((keys[0], low), (keys[1], -high)):
+                    if name in problems:
+                        candidates[name] = np.flatnonzero(bound < best[name].value - tolerance)
+        return _Newton.start(self, candidates)
 
-        def evaluate(t: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
-            return self._quantities(self.evaluate(t, angles=True), t)
+    def _extrema_finish(self, newton, at, offset, problems, best, tolerance, precision_s):
+        """Newton's steps from the first points' values (``at``, from ``offset``), then
+        golden-section search for what is left."""
+        τ, on_nodes = self.τ, self._node_problems
+        left = newton.run(self, at, offset, problems, best, tolerance)
 
-        brackets = self._newton(brackets, problems, best, precision_s)
-        found = least_in_brackets(evaluate, brackets, problems, best, tolerance, precision_s)
-        best.update(found)
+        def evaluate(t: NDArray[np.float64], piece: NDArray[np.intp]):
+            return self._quantities(self.evaluate(t, piece, angles=True), t)
 
-    def _newton(self, brackets, problems, best, precision_s: float):
-        """Narrow the brackets of the smooth problems by Newton's method on the cosine's
-        slope: the angles to the Sun, the Moon and nadir (the least angle where the
-        cosine is greatest, the greatest where it is least) and the incidence outside
-        the Earth's shadow (the cosine itself).  From the extremum of the cubic through
-        the cell's ends, each step moves to x − f'(x)/f''(x) (f' and f'' exact), kept
-        within the cell; every point evaluated counts for every problem.  A cell whose
-        step shrinks below a nanosecond, or that reaches an end the slope leaves by, is
-        done; one where f'' has the wrong sign, or still moving after the steps, goes
-        on by golden-section search.  Returns the brackets left for it."""
-        τ, values = self.τ, self.values
-        rows = []  # (name, vector, target, sign: +1 where f is greatest), cell indices
-        left = {}
-        shadow = self._cell_in(self.shadow)
-        for name, (a, _, _, _) in brackets.items():
-            vector, quantity, end = name.rsplit(".", 2)
-            target = _TARGET_OF.get(quantity)
-            if target is None or target not in values.f or not a.size:
-                left[name] = brackets[name]
-                continue
-            j = next(k for k, v in enumerate(self.spec.body_vectors) if v.name == vector)
-            sign = 1.0 if (end == "low") != (quantity == "cos_incidence") else -1.0
-            cells = np.searchsorted(τ, a)
-            smooth = ~shadow[cells] if quantity == "cos_incidence" else np.ones(a.size, bool)
-            rows.append((name, j, target, sign, cells[smooth]))
-            rest = ~smooth
-            left[name] = tuple(x[rest] for x in brackets[name])
-        if not rows:
-            return brackets
-        name_of = np.concatenate([np.full(r[4].size, k) for k, r in enumerate(rows)])
-        cells = np.concatenate([r[4] for r in rows])
-        sign = np.concatenate([np.full(r[4].size, r[3]) for r in rows])
-        a, b = τ[cells], τ[cells + 1]
-        h = b - a
-        f_of = [values.f[r[2]][r[1]] for r in rows]
-        df_of = [values.df[r[2]][r[1]] for r in rows]
-        ga = np.concatenate([f[r[4]] for f, r in zip(f_of, rows)])
-        gb = np.concatenate([f[r[4] + 1] for f, r in zip(f_of, rows)])
-        da = np.concatenate([d[r[4]] for d, r in zip(df_of, rows)])
-        db = np.concatenate([d[r[4] + 1] for d, r in zip(df_of, rows)])
-        c = _cubic(sign * ga, sign * da, sign * gb, sign * db, h)
-        x = a + _cubic_peak(c, np.ones(a.size, dtype=bool)) * h
-        active = np.ones(a.size, dtype=bool)
-        for _ in range(_NEWTON_STEPS):
-            which = np.flatnonzero(active)
-            if not which.size:
-                break
-            times, inverse = np.unique(x[which], return_inverse=True)
-            at = self.evaluate(times, angles=True)
-            self._fold(self._quantities(at, times), times, problems, best)
-            d1 = np.empty(which.size)
-            d2 = np.empty(which.size)
-            for k, r in enumerate(rows):
-                mine = name_of[which] == k
-                d1[mine] = at.df[r[2]][r[1]][inverse[mine]]
-                d2[mine] = at.ddf[r[2]][r[1]][inverse[mine]]
-            d1, d2 = sign[which] * d1, sign[which] * d2
-            with np.errstate(divide="ignore", invalid="ignore"):
-                step = -d1 / d2
-            concave = d2 < 0.0
-            new = np.clip(x[which] + step, a[which], b[which])
-            done = concave & (np.abs(new - x[which]) <= _NEWTON_DONE_S)
-            # At an end, a slope that leaves the cell: the end is the cell's best.
-            done |= ((new == a[which]) & (d1 < 0.0)) | ((new == b[which]) & (d1 > 0.0))
-            x[which] = np.where(concave, new, x[which])
-            active[which[done]] = False
-            active[which[~concave]] = False
-            failed = which[~concave & ~done]
-            for k in np.unique(name_of[failed]).tolist():
-                mine = failed[name_of[failed] == k]
-                name = rows[k][0]
-                t0, t1 = a[mine], b[mine]
-                more = (t0, t1, *self._at_nodes(name, cells[mine]))
-                left[name] = tuple(np.concatenate([u, v]) for u, v in zip(left[name], more))
-        # Still moving after the steps: golden-section search, from their cells.
-        for k in np.unique(name_of[active]).tolist():
-            mine = np.flatnonzero(active & (name_of == k))
-            name = rows[k][0]
-            more = (a[mine], b[mine], *self._at_nodes(name, cells[mine]))
-            left[name] = tuple(np.concatenate([u, v]) for u, v in zip(left[name], more))
-        return left
+        brackets = {}
+        for name, cells in left.items():
+            i = self.cell[cells]
+            values = on_nodes[name]
+            brackets[name] = (τ[i], τ[i + 1], values[i], values[i + 1])
+        if any(b[0].size for b in brackets.values()):
+            found = least_in_brackets(
+                _PiecewiseCall(evaluate, τ, self.owner),
+                brackets,
+                problems,
+                best,
+                tolerance,
+                precision_s,
+            )
+            best.update(found)
 
-    def _at_nodes(self, name: str, cells: NDArray[np.intp]):
-        """A problem's values at the ends of cells between nodes."""
-        values = self._node_problems[name]
-        return values[cells], values[cells + 1]
+    def _fold_at(self, at: _Values, times, offset: int, problems, best) -> None:
+        """Fold the problems' values at the points of ``at`` from ``offset`` on (at
+        ``times``)."""
+        sliced = _Values(
+            {t: v[:, offset:] for t, v in at.f.items()},
+            {t: v[:, offset:] for t, v in at.df.items()},
+            {t: v[:, offset:] for t, v in at.ddf.items()},
+            {t: v[:, offset:] for t, v in at.angle.items()},
+            {t: v[offset:] for t, v in at.sigma.items()},
+            None if at.limb is None else at.limb[offset:],
+            None if at.limb_rate is None else at.limb_rate[offset:],
+        )
+        self._fold(self._quantities(sliced, times), times, problems, best)
 
     def _fold(self, quantities, times, problems, best) -> None:
         """Fold the values of the problems at ``times`` into ``best``."""
         for name in problems:
             values = quantities[name]
             i = int(np.argmin(values))
-            if values[i] < best[name].value:
+            if name not in best or values[i] < best[name].value:
                 best[name] = Extremum(float(times[i]), float(values[i]))
 
     # ---------------------------------------------------------------- incidence
@@ -1092,24 +1221,29 @@ class _Window:
             b[rows] = np.where(entering, b[rows], cut)
             rows = np.flatnonzero(keep)
             h = cells.b[rows] - cells.a[rows]
-            # The quintic through the ends' values, slopes and bends (the cubic where a
-            # bend is missing): exact for it, 4 Gauss–Legendre points on the lit part.
-            ea, eb = cells.ea[rows], cells.eb[rows]
-            bent = np.isfinite(ea) & np.isfinite(eb)
-            q0 = np.where(bent, ea, 0.0) * h * h
-            q1 = np.where(bent, eb, 0.0) * h * h
-            c = _quintic(cells.ga[rows], h * cells.da[rows], q0, cells.gb[rows], h * cells.db[rows], q1)
-            c3 = _cubic(cells.ga[rows], cells.da[rows], cells.gb[rows], cells.db[rows], h)
+            # The quintic through the ends' values, slopes and bends: exact for it, 4
+            # Gauss–Legendre points on the lit part.
+            c = _quintic(
+                cells.ga[rows],
+                h * cells.da[rows],
+                h * h * cells.ea[rows],
+                cells.gb[rows],
+                h * cells.db[rows],
+                h * h * cells.eb[rows],
+            )
             lo, hi = a[rows], b[rows]
             x = 0.5 * (hi + lo)[:, None] + 0.5 * (hi - lo)[:, None] * _GAUSS_X[None, :]
             s = (x - cells.a[rows][:, None]) / h[:, None]
-            five = _polynomial_at(tuple(ci[:, None] for ci in c), s)
-            three = _cubic_at(tuple(ci[:, None] for ci in c3), s)
-            f = np.maximum(np.where(bent[:, None], five, three), 0.0)
-            meets = _in_any(0.5 * (lo + hi), self.shadow) | _in_any(lo, self.shadow) | _in_any(hi, self.shadow)
+            f = np.maximum(_polynomial_at(tuple(ci[:, None] for ci in c), s), 0.0)
             weight = np.ones_like(f)
-            if np.any(meets):
-                weight[meets] = self._fraction(x[meets].ravel()).reshape(-1, _GAUSS_X.size)
+            if self.shadow:
+                meets = (
+                    _in_any(0.5 * (lo + hi), self.shadow)
+                    | _in_any(lo, self.shadow)
+                    | _in_any(hi, self.shadow)
+                )
+                if np.any(meets):
+                    weight[meets] = self._fraction(x[meets].ravel()).reshape(-1, _GAUSS_X.size)
             out[name] = float(np.sum((f * weight) @ _GAUSS_W * 0.5 * (hi - lo)))
         return out
 
@@ -1125,3 +1259,150 @@ class _Window:
                 lit = len(pieces) == 1 and pieces[0].starts_before and pieces[0].ends_after
                 out[name] = in_umbra or not lit
         return out
+
+
+class _PiecewiseCall:
+    """``evaluate(t, piece)`` as golden-section search calls it, ``evaluate(t)``: each
+    point on the piece whose nodes surround it (no cell spans two pieces)."""
+
+    def __init__(self, evaluate, τ: NDArray[np.float64], owner: NDArray[np.intp]) -> None:
+        self.evaluate, self.τ, self.owner = evaluate, τ, owner
+
+    def __call__(self, t: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
+        k = np.clip(np.searchsorted(self.τ, t, side="right") - 1, 0, self.τ.size - 1)
+        return self.evaluate(t, self.owner[k])
+
+
+class _Newton:
+    """Newton's method on the slope of a cosine, for the candidate cells of the smooth
+    extremum problems: the angles to the Sun, the Moon and nadir (the least angle where
+    the cosine is greatest, the greatest where it is least), the incidence outside the
+    Earth's shadow (the cosine itself) and the limb angle (nadir's cosine, its slope
+    shifted by the limb's rate: d/dt (α − ρ) = 0 ⇔ f' + ρ̇ sin α = 0).  From the
+    extremum of the cubic through the cell's ends, each step moves to x − s/f'' (s that
+    slope, f'' the exact bend), kept within the cell; every point evaluated counts for
+    every problem.  A cell is done when its next step could improve its quantity by
+    less than a tenth of the tolerance (½|f''| step², over sin α for an angle), when it
+    sits at an end that the slope leaves by, or where the function is convex at the
+    cubic's peak: the cell then holds no peak, and its best is the end the slope climbs
+    to (a node, counted).  One still moving after :data:`_NEWTON_STEPS` is left to
+    golden-section search, as are the incidence's cells in the shadow."""
+
+    def __init__(self) -> None:
+        self.rows: list = []
+        self.left: dict[str, NDArray[np.intp]] = {}
+        self.x = np.empty(0)
+        self.piece = np.empty(0, dtype=np.intp)
+
+    @classmethod
+    def start(cls, window: _Window, candidates: dict[str, NDArray[np.intp]]) -> _Newton:
+        """The rows (problem, vector, target, sign, kind, cells) and the first points."""
+        self = cls()
+        values, τ = window.values, window.τ
+        index = {v.name: j for j, v in enumerate(window.spec.body_vectors)}
+        shadow = window._cell_in(window.shadow)
+        for name, cells in candidates.items():
+            vector, quantity, end = name.rsplit(".", 2)
+            target = _TARGET_OF[quantity]
+            if quantity == "cos_incidence":
+                smooth = ~shadow[cells]
+            else:
+                smooth = np.ones(cells.size, dtype=bool)
+            if not np.any(smooth) or target not in values.f:
+                self.left[name] = cells
+                continue
+            self.left[name] = cells[~smooth]
+            # +1 where the quantity is extreme where the cosine is greatest.
+            sign = 1.0 if (end == "low") != (quantity == "cos_incidence") else -1.0
+            kind = {"earth_limb_angle": "limb", "cos_incidence": "cosine"}.get(quantity, "angle")
+            self.rows.append((name, index[vector], target, sign, kind, cells[smooth]))
+        if not self.rows:
+            return self
+        self.which_row = np.concatenate([np.full(r[5].size, k) for k, r in enumerate(self.rows)])
+        self.cells = np.concatenate([r[5] for r in self.rows])
+        self.sign = np.concatenate([np.full(r[5].size, r[3]) for r in self.rows])
+        i = window.cell[self.cells]
+        self.a, self.b, self.piece = τ[i], τ[i + 1], window.owner[i]
+        h = self.b - self.a
+        ga, gb, da, db = (np.empty(self.cells.size) for _ in range(4))
+        for k, r in enumerate(self.rows):
+            mine = self.which_row == k
+            f, df = values.f[r[2]][r[1]], values.df[r[2]][r[1]]
+            j = i[mine]
+            ga[mine], gb[mine], da[mine], db[mine] = f[j], f[j + 1], df[j], df[j + 1]
+        s = self.sign
+        c = _cubic(s * ga, s * da, s * gb, s * db, h)
+        self.x = self.a + _cubic_peak(c, np.ones(self.a.size, dtype=bool)) * h
+        return self
+
+    def _fold(self, window: _Window, at: _Values, times, which, points, best) -> None:
+        """Fold each row's quantity at its own points (``which``: the rows' cells being
+        stepped, ``points``: their indices into ``at``) into ``best``."""
+        for k in np.unique(self.which_row[which]).tolist():
+            name, j, target, _, kind, _ = self.rows[k]
+            there = points[self.which_row[which] == k]
+            if kind == "cosine":
+                q = np.maximum(at.f[target][j][there], 0.0)  # outside the shadow: lit
+            else:
+                q = at.angle[target][j][there]
+                if kind == "limb":
+                    assert at.limb is not None
+                    q = q - at.limb[there]
+            if name.endswith(".high"):
+                q = -q
+            i = int(np.argmin(q))
+            if q[i] < best[name].value:
+                best[name] = Extremum(float(times[there][i]), float(q[i]))
+
+    def run(self, window: _Window, at, offset: int, problems, best, tolerance):
+        """The steps, the first from ``at`` (the values at ``self.x``, from
+        ``offset``); returns the cells left to golden-section search, per problem."""
+        if not self.rows:
+            return self.left
+        active = np.ones(self.x.size, dtype=bool)
+        for count in range(_NEWTON_STEPS):
+            which = np.flatnonzero(active)
+            if not which.size:
+                break
+            if count == 0:
+                window._fold_at(at, self.x, offset, problems, best)
+                points = offset + which
+            else:
+                keys = np.stack([self.x[which], self.piece[which].astype(np.float64)])
+                unique, inverse = np.unique(keys, axis=1, return_inverse=True)
+                targets = {self.rows[k][2] for k in np.unique(self.which_row[which]).tolist()}
+                at = window.evaluate(unique[0], unique[1].astype(np.intp), angles=targets)
+                points = inverse.ravel()
+                self._fold(window, at, unique[0], which, points, best)
+            slope, bend, size = (np.empty(which.size) for _ in range(3))
+            for k, r in enumerate(self.rows):
+                mine = self.which_row[which] == k
+                there = points[mine]
+                slope[mine] = at.df[r[2]][r[1]][there]
+                bend[mine] = at.ddf[r[2]][r[1]][there]
+                size[mine] = 1.0 if r[4] == "cosine" else np.sin(at.angle[r[2]][r[1]][there])
+                if r[4] == "limb":  # the slope of α − ρ, times −sin α
+                    assert at.limb_rate is not None
+                    slope[mine] += at.limb_rate[there] * size[mine]
+            slope, bend = self.sign[which] * slope, self.sign[which] * bend
+            with np.errstate(divide="ignore", invalid="ignore"):
+                step = -slope / bend
+                gain = 0.5 * np.abs(bend) * step * step / np.maximum(size, 1e-300)
+            concave = bend < 0.0
+            x = self.x[which]
+            a, b = self.a[which], self.b[which]
+            new = np.clip(x + step, a, b)
+            done = concave & ((np.abs(new - x) <= _NEWTON_DONE_S) | (gain < 0.1 * tolerance))
+            # At an end, a slope that leaves the cell: the end is the cell's best.
+            done |= ((x == a) & (slope < 0.0)) | ((x == b) & (slope > 0.0))
+            # Convex where the cubic put its peak: the cell holds no peak of its own,
+            # its best is the end the slope climbs to (a node, already counted).
+            flat = ~concave & ~done
+            done |= flat
+            self.x[which] = np.where(concave, new, np.where(slope > 0.0, b, a))
+            active[which[done]] = False
+        failed = active
+        for k, r in enumerate(self.rows):
+            more = self.cells[(self.which_row == k) & failed]
+            self.left[r[0]] = np.concatenate([self.left.get(r[0], more[:0]), more])
+        return self.left

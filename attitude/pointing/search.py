@@ -63,7 +63,7 @@ from attitude.environment.orbit import Orbit
 from attitude.environment.timescales import SECONDS_PER_DAY
 from attitude.pointing.eclipse import SUN_RADIUS_M
 from attitude.pointing.extrema import Extremum, Problem, least_of_each
-from attitude.pointing.free_search import FreePlan, free_plan, search_free
+from attitude.pointing.free_search import FreePiece, FreePlan, free_plan, search_free
 from attitude.pointing.intervals import (
     Interval,
     append_across,
@@ -206,12 +206,16 @@ def _body_rate(trajectory: Trajectory, start_s: float, stop_s: float) -> float:
 
 
 def _vector_rates(
-    trajectory: Trajectory, spec: PointingSpec, start_s: float, stop_s: float
+    trajectory: Trajectory,
+    spec: PointingSpec,
+    start_s: float,
+    stop_s: float,
+    segments: list | None = None,
 ) -> dict[str, float]:
     """For each body vector b, a bound on its inertial rate |ω × b| over [start_s,
-    stop_s], rad/s: the pointing's extrema are pruned with it (a vector near the spin
-    axis turns far slower than the body, and :func:`_body_rate` would keep every
-    bracket of its Sun angle).
+    stop_s] on ``segments`` (those meeting the span by default), rad/s: the pointing's
+    extrema are pruned with it (a vector near the spin axis turns far slower than the
+    body, and :func:`_body_rate` would keep every bracket of its Sun angle).
 
     Per segment, ω(t) (body axes) is sampled :data:`_RATE_SAMPLES` times (fewer when
     many segments share :data:`_RATE_SAMPLES_IN_ALL`) over one body period of its
@@ -225,11 +229,8 @@ def _vector_rates(
     """
     vectors = [(v.name, v.vector) for v in spec.body_vectors]
     rates = dict.fromkeys((name for name, _ in vectors), 0.0)
-    segments = [
-        segment
-        for segment in trajectory.segments
-        if segment.end_s >= start_s and segment.start_s <= stop_s
-    ]
+    if segments is None:
+        segments = [segment for _, segment in _in_span(trajectory, start_s, stop_s)]
     if not vectors or not segments:
         return rates
     # Thousands of events share the samples (the bound stays rigorous, only looser).
@@ -316,6 +317,13 @@ def search_grid(
     if spec.orbit is not None:
         count += math.ceil((stop_s - start_s) / _ORBIT_STEP_S) + 1
         steps.append(_ORBIT_STEP_S)
+    # Each vector's rate bound: the free plans' own, the sampled one elsewhere.
+    others = [segment for k, segment in segments if plans[k] is None]
+    rates = _vector_rates(trajectory, spec, start_s, stop_s, others)
+    for plan in plans:
+        if plan is not None:
+            for name, motion in plan.motion.items():
+                rates[name] = max(rates[name], motion.rate)
     return SearchGrid(
         start_s,
         stop_s,
@@ -324,7 +332,7 @@ def search_grid(
         body,
         orbit_rate,
         speed,
-        _vector_rates(trajectory, spec, start_s, stop_s),
+        rates,
         grid_step,
         tuple(plans),
     )
@@ -552,8 +560,8 @@ class _Search:
 
     # --------------------------------------------------------- torque-free segments
 
-    def free(self, plan: FreePlan, solver: EulerSolver, start_s: float, end_s: float) -> None:
-        """Search a torque-free segment over [start_s, end_s] (free_search)."""
+    def free(self, pieces: list[FreePiece]) -> None:
+        """Search consecutive torque-free segments together (free_search)."""
         problems, incumbents = {}, {}
         for name, quantity in self.wanted:
             rate = self._rate(name, quantity)
@@ -565,8 +573,7 @@ class _Search:
                 None if high is None else Extremum(high.time_s, -high.value)
             )
         result = search_free(
-            plan,
-            solver,
+            pieces,
             self.spec,
             self.shared,
             self.precision,
@@ -576,10 +583,9 @@ class _Search:
             incumbents,
             self.orbit.get("shadow", []),
             self.orbit.get("umbra", []),
-            start_s,
-            end_s,
         )
         self.evaluations += result.evaluations
+        start_s = pieces[0].start_s
         self._add(result.intervals, start_s)
         for name, quantity in self.wanted:
             low = result.extrema[f"{name}.{quantity}.low"]
@@ -689,8 +695,6 @@ class _Search:
     def _exact_values(self) -> None:
         """Each extremum's value computed at its time as a sample there gives it (the
         exact surroundings), so that the values reported are the samples' values."""
-        from attitude.pointing.sampling import pointing_samples
-
         found = [
             (which, key, extremum)
             for which in (self.lows, self.highs)
@@ -700,19 +704,17 @@ class _Search:
         if not found:
             return
         times = np.array([extremum.time_s for _, _, extremum in found])
-        samples = pointing_samples(self.trajectory, self.spec, times)
-        by_name = {item.vector.name: item for item in samples.vectors}
-        attributes = {
-            "sun_angle": "sun_angle_rad",
-            "moon_angle": "moon_angle_rad",
-            "nadir_angle": "nadir_angle_rad",
-            "earth_limb_angle": "earth_limb_angle_rad",
-            "cos_incidence": "cos_incidence",
+        # As pointing_samples computes them: the exact surroundings (the shared ones'
+        # exact path: the same ephemeris nodes), the trajectory's attitude.
+        env = self.shared.exact(times)
+        attitude = self.trajectory.attitude(times)
+        angles = {
+            v.name: vector_angles(attitude.apply(v.vector), env) for v in self.spec.body_vectors
         }
         for k, (which, (name, quantity), extremum) in enumerate(found):
             if quantity == "cos_incidence" and extremum.value == 0.0:
                 continue  # the dark's 0, placed from the intervals
-            value = getattr(by_name[name], attributes[quantity])[k]
+            value = angles[name][quantity][k]
             which[(name, quantity)] = Extremum(extremum.time_s, float(value))
 
     def result(self) -> PointingAnalysis:
@@ -818,15 +820,21 @@ def pointing_analysis(
     search = _Search(trajectory, spec, grid, shared)
     search.orbit_only()
     if spec.body_vectors:
+        run: list[FreePiece] = []  # consecutive torque-free segments, searched together
         for k, segment in _in_span(trajectory, grid.start_s, grid.stop_s):
             a, b = max(segment.start_s, grid.start_s), min(segment.end_s, grid.stop_s)
-            if b < a or (b == a and k > 0 and a > grid.start_s):
-                continue
+            if b <= a and not (a == b == grid.start_s == grid.stop_s):
+                continue  # an event at the span's end, or two at one epoch
             plan = grid.plans[k] if k < len(grid.plans) else None
             if plan is not None and isinstance(segment.solver, EulerSolver):
-                search.free(plan, segment.solver, a, b)
-            else:
-                search.gridded(a, b)
+                run.append(FreePiece(segment.solver, plan, a, b))
+                continue
+            if run:
+                search.free(run)
+                run = []
+            search.gridded(a, b)
+        if run:
+            search.free(run)
     return search.result()
 
 

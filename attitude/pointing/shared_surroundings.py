@@ -66,6 +66,7 @@ from numpy.typing import NDArray
 from attitude.environment.earth import EARTH_EQUATORIAL_RADIUS_M
 from attitude.environment.orbit import Orbit
 from attitude.environment.timescales import SECONDS_PER_DAY
+from attitude.pointing.eclipse import SUN_RADIUS_M
 from attitude.pointing.spec import PointingSpec, for_scenario
 from attitude.pointing.surroundings import (
     SunMoonEarth,
@@ -81,6 +82,7 @@ __all__ = [
     "SharedSurroundings",
     "Targets",
     "clear_cache",
+    "exact_surroundings",
     "shared_surroundings",
 ]
 
@@ -105,14 +107,17 @@ _CENTRE_FIELDS = ("sun", "moon")
 _TARGET_FIELDS = ("sun", "moon", "r")
 
 CACHE_SIZE = 4
+# The Sun's least angular radius from near the Earth (at aphelion, 1.53e11 m).
+_SUN_LEAST_RADIUS_RAD = SUN_RADIUS_M / 1.53e11
 
 
 @dataclass(frozen=True)
 class Targets:
     """The directions a search compares body vectors with, and their time derivatives,
     at some times: unit vectors (n, 3) to the Sun and the Moon (apparent, from the
-    spacecraft) and, on an orbit, to nadir, with ``*_rate`` their derivatives (1/s),
-    and the limb's angular radius ``limb`` (rad) with its rate ``limb_rate``."""
+    spacecraft) and, on an orbit, to nadir, with ``*_rate`` their derivatives (1/s)
+    and, when asked, ``*_accel`` their second derivatives (1/s²); the limb's angular
+    radius ``limb`` (rad) with its rate ``limb_rate``."""
 
     sun: NDArray[np.float64]
     sun_rate: NDArray[np.float64]
@@ -122,6 +127,9 @@ class Targets:
     nadir_rate: NDArray[np.float64] | None = None
     limb: NDArray[np.float64] | None = None
     limb_rate: NDArray[np.float64] | None = None
+    sun_accel: NDArray[np.float64] | None = None
+    moon_accel: NDArray[np.float64] | None = None
+    nadir_accel: NDArray[np.float64] | None = None
 
 
 def _to_power() -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
@@ -189,6 +197,11 @@ class SharedSurroundings:
         self._target_names = [n for n in self._fields if n in _TARGET_FIELDS]
         self._target_values = np.ascontiguousarray(np.moveaxis(coefficients[:, :, columns], 1, 0))
         self._target_rates = np.ascontiguousarray(np.moveaxis(self._derivative[:, :, columns], 1, 0))
+        k2 = np.arange(1, max(degree, 1), dtype=np.float64)
+        second = self._derivative[:, 1:, :] * (k2[None, :, None] * (2.0 / widths)[:, None, None])
+        if second.shape[1] == 0:
+            second = np.zeros((second.shape[0], 1, second.shape[2]))
+        self._target_accels = np.ascontiguousarray(np.moveaxis(second[:, :, columns], 1, 0))
 
     # ------------------------------------------------------------------ building
 
@@ -397,34 +410,60 @@ class SharedSurroundings:
         fields["moon"] = _unit(fields["moon"])
         return assemble(self.spec, fields)
 
-    def _target_fields(self, seconds: NDArray[np.float64]):
-        """The Sun, the Moon and the position (on an orbit) and their rates at ``seconds``."""
+    def _target_fields(self, seconds: NDArray[np.float64], accelerations: bool = False):
+        """The Sun, the Moon and the position (on an orbit), their rates and, with
+        ``accelerations``, their second derivatives (else None) at ``seconds``."""
         seconds = np.asarray(seconds, dtype=np.float64).ravel()
         index, t = self._locate(seconds)
         values = _horner_rows(self._target_values, index, t)
         rates = _horner_rows(self._target_rates, index, t)
+        accels = _horner_rows(self._target_accels, index, t) if accelerations else None
         exact = self._exact_pieces[index]
         if np.any(exact):
             fields, field_rates = self.fields(seconds[exact], derivative=True)
             assert field_rates is not None
             values[exact] = np.concatenate([fields[n] for n in self._target_names], axis=1)
             rates[exact] = np.concatenate([field_rates[n] for n in self._target_names], axis=1)
-        out = {n: values[:, 3 * k : 3 * k + 3] for k, n in enumerate(self._target_names)}
-        out_rates = {n: rates[:, 3 * k : 3 * k + 3] for k, n in enumerate(self._target_names)}
-        return out, out_rates
+            if accels is not None:
+                accels[exact] = 0.0  # exact pieces: not used for bounds (rate_bounds is inf)
 
-    def targets(self, seconds: NDArray[np.float64]) -> Targets:
+        def split(x):
+            return {n: x[:, 3 * k : 3 * k + 3] for k, n in enumerate(self._target_names)}
+
+        return split(values), split(rates), None if accels is None else split(accels)
+
+    def exact(self, seconds: NDArray[np.float64]) -> Surroundings:
+        """The exact surroundings at TT ``seconds`` (no interpolation: what
+        :func:`attitude.pointing.sampling.pointing_samples` computes there, on the same
+        ephemeris nodes), for values that must be a sample's."""
+        return self._exact.at(np.asarray(seconds, dtype=np.float64))
+
+    def targets(self, seconds: NDArray[np.float64], accelerations: bool = False) -> Targets:
         """The search's :class:`Targets` at TT ``seconds``: unit directions and their
-        rates, nadir from the position, the limb's angular radius and its rate."""
-        fields, rates = self._target_fields(seconds)
+        rates, nadir from the position, the limb's angular radius and its rate; with
+        ``accelerations``, the directions' second derivatives too."""
+        fields, rates, accels = self._target_fields(seconds, accelerations)
         # The Sun's and the Moon's interpolated directions are unit vectors within
         # the stated bound: used as they are.
         sun, sun_rate = fields["sun"], rates["sun"]
         moon, moon_rate = fields["moon"], rates["moon"]
+        extra = {}
+        if accels is not None:
+            extra = {"sun_accel": accels["sun"], "moon_accel": accels["moon"]}
         if "r" not in fields:
-            return Targets(sun, sun_rate, moon, moon_rate)
+            return Targets(sun, sun_rate, moon, moon_rate, **extra)
         r, r_rate = fields["r"], rates["r"]
         up, up_rate = _unit_and_rate(r, r_rate)
+        if accels is not None:
+            # ü = (r̈ − 2 ρ̇ u̇ − ρ̈ u)/ρ for u = r/ρ, ρ = |r|: ρ̇ = u·ṙ, ρ̈ = (|ṙ|² +
+            # r·r̈)/ρ − ρ̇²/ρ.
+            distance = norm(r)
+            r_accel = accels["r"]
+            ρ_rate = np.einsum("ij,ij->i", up, r_rate)
+            ρ_accel = (np.einsum("ij,ij->i", r_rate, r_rate) + np.einsum("ij,ij->i", r, r_accel)) / distance
+            ρ_accel -= ρ_rate * ρ_rate / distance
+            up_accel = (r_accel - 2.0 * ρ_rate[:, None] * up_rate - ρ_accel[:, None] * up) / distance[:, None]
+            extra["nadir_accel"] = -up_accel
         distance = norm(r)
         radius = EARTH_EQUATORIAL_RADIUS_M + self.limb_height_m
         ratio = np.minimum(1.0, radius / distance)
@@ -433,7 +472,7 @@ class SharedSurroundings:
         radial = np.einsum("ij,ij->i", up, r_rate)
         with np.errstate(divide="ignore", invalid="ignore"):
             limb_rate = np.where(ratio < 1.0, -np.tan(limb) * radial / distance, 0.0)
-        return Targets(sun, sun_rate, moon, moon_rate, -up, -up_rate, limb, limb_rate)
+        return Targets(sun, sun_rate, moon, moon_rate, -up, -up_rate, limb, limb_rate, **extra)
 
     def rate_bounds(self) -> dict[str, float]:
         """Bounds over the span on |ṡ| (``<target>_1``) and |s̈| (``<target>_2``) of each
@@ -455,6 +494,10 @@ class SharedSurroundings:
             r1, r2 = b["r_1"], b["r_2"]
             out["nadir_1"] = r1 / least
             out["nadir_2"] = 2.0 * r2 / least + 5.0 * (r1 / least) ** 2
+            # The lit fraction changes at most at (2/π a) per radian of the discs'
+            # relative motion (a: the Sun's least angular radius near the Earth), the
+            # discs moving at most at nadir's rate plus the Sun's.
+            out["fraction_1"] = 2.0 * (out["nadir_1"] + out["sun_1"]) / (math.pi * _SUN_LEAST_RADIUS_RAD)
             radius = EARTH_EQUATORIAL_RADIUS_M + self.limb_height_m
             if least > radius:
                 tan = radius / math.sqrt(least * least - radius * radius)
@@ -560,6 +603,22 @@ def shared_surroundings(
         while len(_CACHE) > CACHE_SIZE:
             _CACHE.popitem(last=False)
     return built
+
+
+def exact_surroundings(
+    trajectory: Trajectory, spec: PointingSpec, start_s: float, stop_s: float
+) -> SunMoonEarth:
+    """The exact surroundings of ``spec`` (resolved for the scenario) over [start_s,
+    stop_s]: those a cached :class:`SharedSurroundings` covering the span holds (its
+    ephemeris sampled once: the same values, the nodes being aligned on J2000), else
+    new ones (nothing is built for the cache)."""
+    jd = scenario_jd(trajectory)
+    key = (jd, _orbit_key(spec.orbit), float(spec.earth_limb_atmosphere_height_m))
+    with _CACHE_LOCK:
+        found = _CACHE.get(key)
+    if found is not None and found.covers(start_s, stop_s):
+        return found._exact
+    return SunMoonEarth(trajectory, spec, start_s, stop_s)
 
 
 def clear_cache() -> None:
