@@ -84,9 +84,9 @@ _LONGEST_STEP_S = 3600.0
 # A window holds at most this many nodes (bounded memory).
 WINDOW_NODES = 65_536
 # vector_motion samples ω this many times a turn of the body over a period (or over
-# the segment), and from ... to ... times in all.
-_SAMPLES_PER_TURN = 256
-_MOTION_SAMPLES_LEAST = 1024
+# the segment), and at least and at most these many times in all.
+_SAMPLES_PER_TURN = 512
+_MOTION_SAMPLES_LEAST = 2048
 _MOTION_SAMPLES = 16_384
 # A cell is cut at the cubic's extremum or root, kept within this fraction of its ends.
 _CUT = 0.1
@@ -171,12 +171,14 @@ def vector_motion(
 ) -> dict[str, VectorMotion]:
     """:class:`VectorMotion` of each (name, body vector) over [start_s, end_s].
 
-    ω(t) is sampled :data:`_MOTION_SAMPLES` times over one period of the body's motion
-    (in which it takes all its values) or over the segment if that is shorter; α =
-    I⁻¹(m × ω) (Euler's equations) at the same samples.  Between samples Δ apart, each
-    quantity changes by at most its rate bound times Δ/2: |d/dt (ω × b)| ≤ |α| ≤ A and
-    |d/dt (α × b + ω × (ω × b))| ≤ |α̇| + 2AΩ with |α̇| = |I⁻¹((m × ω) × ω + m × α)| ≤
-    G(Ω² + A)/I_min.  Each result is also capped by its analytic bound (module notes).
+    ω(t) is sampled (512 times a turn of the body, 2048 to 16384 times in all) over
+    one period of the body's motion (in which it takes all its values) or over the
+    segment if that is shorter; α =
+    I⁻¹(m × ω) (Euler's equations) at the same samples.  Within Δ/2 of a sample, |ω × b|
+    is bounded by its Taylor expansion to second order there (α̇ = I⁻¹((m × ω) × ω + m ×
+    α) exact at the sample) plus the third-order remainder, and |α × b + ω × (ω × b)| by
+    its expansion to first order plus the second-order remainder.  Each result is also
+    capped by its analytic bound (module notes).
     """
     moments = np.sort(np.asarray(solver.moments_of_inertia, dtype=np.float64))
     G = float(solver.angular_momentum_norm)
@@ -188,7 +190,7 @@ def vector_motion(
     period = solver.period
     periodic = math.isfinite(period) and period < end_s - start_s
     window = period if periodic else max(end_s - start_s, 0.0)
-    # A few hundred samples a turn of the body, within [1024, 16384].
+    # Hundreds of samples a turn of the body, within [2048, 16384].
     turns = window * fastest / (2.0 * math.pi)
     samples = int(min(max(_SAMPLES_PER_TURN * turns, _MOTION_SAMPLES_LEAST), _MOTION_SAMPLES))
     t = start_s + window * np.arange(samples + 1.0) / samples
@@ -198,15 +200,37 @@ def vector_motion(
     α = np.cross(m, ω) @ np.linalg.inv(tensor).T
     spacing = window / samples
     gap = 0.5 * spacing
-    jerk = G * (fastest * fastest + spin_accel) / least + 2.0 * spin_accel * fastest
     m_hat = m / np.linalg.norm(m, axis=1)[:, None]
     drift = np.cross(m_hat, ω)  # dm̂/dt in the body (ṁ = m × ω)
+    # ω̈ = α̇ = I⁻¹((m × ω) × ω + m × α) at the samples, and a bound on the third
+    # derivative: each component of Euler's equations is a product of two others with
+    # a coefficient at most Λ = (I3 − I1)/I1 (principal axes), and every component is
+    # at most Ω, so by Leibniz's rule each component of ω⁽ᵏ⁾ is at most k! Λᵏ Ω^(k+1),
+    # and |ω⁽³⁾| ≤ √3 · 6 Λ³ Ω⁴.
+    inverse = np.linalg.inv(tensor)
+    α_rate = (np.cross(np.cross(m, ω), ω) + np.cross(m, α)) @ inverse.T
+    Λ = (float(moments[2]) - least) / least
+    third = math.sqrt(3.0) * 6.0 * Λ**3 * fastest**4
     out = {}
     for name, b in vectors:
         ωb = np.cross(ω, b)
         bend = np.cross(α, b) + np.cross(ω, ωb)
-        rate = min(float(np.max(np.linalg.norm(ωb, axis=1))) + spin_accel * gap, fastest)
-        bent = float(np.max(np.linalg.norm(bend, axis=1))) + jerk * gap
+        # |ω × b| within Δ/2 of a sample: Taylor's expansion to second order there,
+        # and the third-order remainder.
+        taylor = (
+            np.linalg.norm(ωb, axis=1)
+            + np.linalg.norm(np.cross(α, b), axis=1) * gap
+            + 0.5 * np.linalg.norm(np.cross(α_rate, b), axis=1) * gap * gap
+        )
+        rate = min(float(np.max(taylor)) + third * gap**3 / 6.0, fastest)
+        # |d̈| = |α × b + ω × (ω × b)| within Δ/2 of a sample: its value and exact rate
+        # there (α̇ × b + α × (ω × b) + ω × (α × b)), and the second-order remainder,
+        # |ω⃛| + 2|ω̈||ω| + 2|ω̇|² ≤ (6√3 Λ³ + 4√3 Λ² + 6 Λ²) Ω⁴ by the same majorant.
+        bend_rate = np.cross(α_rate, b) + np.cross(α, ωb) + np.cross(ω, np.cross(α, b))
+        second = (6.0 * math.sqrt(3.0) * Λ**3 + (4.0 * math.sqrt(3.0) + 6.0) * Λ**2) * fastest**4
+        bent = float(
+            np.max(np.linalg.norm(bend, axis=1) + np.linalg.norm(bend_rate, axis=1) * gap)
+        ) + 0.5 * second * gap * gap
         tilt = m_hat @ b
         # |d/dt (b·m̂)| = |b·(m̂ × ω)|, whose own rate is at most Ω² + A.
         tilt_rate = float(np.max(np.abs(drift @ b))) + (fastest * fastest + spin_accel) * gap
@@ -269,12 +293,14 @@ def free_plan(
 @dataclass(frozen=True)
 class FreePiece:
     """A torque-free segment's part of the searched span, [start_s, end_s], with its
-    solver and :class:`FreePlan`."""
+    solver and :class:`FreePlan`; ``event_at_end``: an event ends it (and the next
+    segment's state holds from end_s on)."""
 
     solver: EulerSolver
     plan: FreePlan
     start_s: float
     end_s: float
+    event_at_end: bool = False
 
 
 # --------------------------------------------------------------------- evaluation
@@ -747,12 +773,13 @@ class FreeResult:
 
 def _nodes(pieces: list[FreePiece]) -> tuple[NDArray[np.float64], NDArray[np.intp]]:
     """The nodes of every piece, in order, and each node's piece: every ``plan.step_s``
-    over [start_s, end_s], the last of a piece followed by an event just before it."""
+    over [start_s, end_s], the last of a piece that an event ends just before it (the
+    trajectory gives the event's state from SAME_INSTANT_S before it on)."""
     times, owner = [], []
-    for k, piece in enumerate(pieces):
+    for piece in pieces:
         count = max(math.ceil((piece.end_s - piece.start_s) / piece.plan.step_s), 1) + 1
         τ = np.linspace(piece.start_s, piece.end_s, count)
-        if k + 1 < len(pieces):
+        if piece.event_at_end:
             τ[-1] = max(piece.end_s - _BEFORE_EVENT_S, τ[-2] if count > 2 else piece.start_s)
         times.append(τ)
         owner.append(np.full(count, k, dtype=np.intp))
@@ -811,8 +838,10 @@ def search_free(
             τ = np.concatenate([τ, inside])[order]
             owner = np.concatenate([owner, piece_of])[order]
         window = _Window(evaluate, spec, shared, pieces, conditions, M, τ, owner, shadow, umbra)
+        # The last window's intervals reach the pieces' end (its node may be before it).
+        end_s = pieces[-1].end_s if last == τ_all.size - 1 else None
         found = window.search(
-            precision_s, problems, incumbents, best, tolerance, extremum_precision_s
+            precision_s, problems, incumbents, best, tolerance, extremum_precision_s, end_s
         )
         for name, pieces_found in found.items():
             if first == 0:
@@ -894,10 +923,13 @@ class _Window:
 
     # ---------------------------------------------------------------- intervals
 
-    def search(self, precision_s, problems, incumbents, best, tolerance, extremum_precision_s):
-        """Every condition's intervals over the window (returned) and the extrema of
-        ``problems`` (folded into ``best``).  The crossings' estimates and the extrema's
-        first Newton points are evaluated in one call."""
+    def search(
+        self, precision_s, problems, incumbents, best, tolerance, extremum_precision_s, end_s=None
+    ):
+        """Every condition's intervals over the window (returned; to ``end_s`` if given,
+        else to its last node) and the extrema of ``problems`` (folded into ``best``).
+        The crossings' estimates and the extrema's first Newton points are evaluated in
+        one call."""
         crossing = self.status == 1
         cells = self.cells.take(crossing)
         h = cells.b - cells.a
@@ -910,16 +942,16 @@ class _Window:
         times = self._crossings(cells, x, at, precision_s)
         self.cross[crossing] = times
         self._extrema_finish(newton, at, x.size, problems, best, tolerance, extremum_precision_s)
-        return self._intervals(cells, times)
+        return self._intervals(cells, times, self.τ[-1] if end_s is None else end_s)
 
-    def _intervals(self, cells: _Cells, times: NDArray[np.float64]) -> dict[str, list[Interval]]:
+    def _intervals(self, cells: _Cells, times, end_s: float) -> dict[str, list[Interval]]:
         """Each condition's intervals over the window from its crossings' ``times`` (a
         crossing at each event where the condition's value jumps across 0)."""
         entering = cells.ga <= 0.0
         # Events inside the window: the pieces' last nodes and the next ones' first.
         τ, owner = self.τ, self.owner
         boundary = np.flatnonzero(owner[1:] != owner[:-1])
-        w = np.array([τ[0], τ[-1]])
+        w = np.array([τ[0], end_s])
         out = {}
         for index, condition in enumerate(self.conditions):
             mine = np.flatnonzero(cells.k == index)
@@ -1377,6 +1409,8 @@ class _Newton:
             slope, bend, size = (np.empty(which.size) for _ in range(3))
             for k, r in enumerate(self.rows):
                 mine = self.which_row[which] == k
+                if not np.any(mine):
+                    continue
                 there = points[mine]
                 slope[mine] = at.df[r[2]][r[1]][there]
                 bend[mine] = at.ddf[r[2]][r[1]][there]

@@ -612,7 +612,8 @@ class _Search:
 
     def gridded(self, start_s: float, end_s: float) -> None:
         """Search [start_s, end_s] (a segment under torques or a law) on the grid."""
-        τ_all = _grid_points(start_s, end_s, self.grid.grid_step_s)
+        step = self.grid.grid_step_s if self.grid.grid_step_s > 0.0 else self.grid.step_s
+        τ_all = _grid_points(start_s, end_s, step)
         first = 0
         while first < τ_all.size - 1:
             last = min(first + CHUNK_POINTS, τ_all.size - 1)
@@ -827,7 +828,7 @@ def pointing_analysis(
                 continue  # an event at the span's end, or two at one epoch
             plan = grid.plans[k] if k < len(grid.plans) else None
             if plan is not None and isinstance(segment.solver, EulerSolver):
-                run.append(FreePiece(segment.solver, plan, a, b))
+                run.append(FreePiece(segment.solver, plan, a, b, b < grid.stop_s))
                 continue
             if run:
                 search.free(run)
