@@ -115,7 +115,15 @@ def orekit_setup(trajectory, sun_table: np.ndarray):
     frame = FramesFactory.getGCRF()
     # Where the spacecraft is does not matter: the target is placed from it.
     orbit = KeplerianOrbit(
-        7.0e6, 0.001, 0.5, 0.0, 0.0, 0.0, PositionAngleType.MEAN, frame, date,
+        7.0e6,
+        0.001,
+        0.5,
+        0.0,
+        0.0,
+        0.0,
+        PositionAngleType.MEAN,
+        frame,
+        date,
         Constants.EIGEN5C_EARTH_MU,
     )
     inertia = Inertia(
@@ -166,7 +174,11 @@ def compare(ours: list, theirs: list, tolerance_s: float = 2e-3) -> dict:
             worst = max(worst, abs(ours_a[k, 0] - a), abs(ours_a[k, 1] - b))
         else:
             missing.append((a, b))
-    extra = [(float(a), float(b), float(b - a)) for (a, b), m in zip(ours_a, matched) if not m]
+    extra = [
+        (float(a), float(b), float(b - a))
+        for (a, b), m in zip(ours_a, matched, strict=True)
+        if not m
+    ]
     return {
         "orekit_intervals": len(theirs),
         "our_intervals": len(ours),
@@ -230,7 +242,9 @@ def main() -> dict:
     report["orekit_g_evaluations"] = calls
     report["orekit_us_per_g"] = 1e6 * float(np.median(their_cpu)) / calls
     report["ratio_orekit_over_ours_median"] = float(np.median(their_cpu) / np.median(our_cpu))
-    report["ratio_orekit_over_ours_per_round"] = [t / o for o, t in zip(our_cpu, their_cpu)]
+    report["ratio_orekit_over_ours_per_round"] = [
+        t / o for o, t in zip(our_cpu, their_cpu, strict=True)
+    ]
     report["uptime_at_end"] = _uptime()
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "pointing_search_vs_orekit.json").write_text(json.dumps(report, indent=2) + "\n")

@@ -165,7 +165,9 @@ def test_a_grazing_pass_of_a_few_milliseconds_against_dense_sampling():
     reference = []
     for k in minima:
         t = coarse.seconds[k]
-        τ, holds, changes = dense_intervals(trajectory, spec, "v", "sun_exclusion", t - 0.02, t + 0.02, 2e-5)
+        τ, holds, _ = dense_intervals(
+            trajectory, spec, "v", "sun_exclusion", t - 0.02, t + 0.02, 2e-5
+        )
         if holds.any():
             reference.append((τ[holds][0], τ[holds][-1]))
     assert len(found) == len(reference)
@@ -181,7 +183,9 @@ def test_a_vector_on_the_spin_axis_against_dense_sampling():
     # The vector along the spin axis stays where it is: only the Sun moves (1e-7 rad/s).
     # The cone is set to the Sun's angle at mid-span: the Sun enters it once.
     probe, _ = _spin(3600.0, [0.0, 0.0, 1.0])
-    middle = pointing_samples(probe, PointingSpec([BodyVector("v", [0.0, 0.0, 1.0])]), [1800.0, 1800.0])
+    middle = pointing_samples(
+        probe, PointingSpec([BodyVector("v", [0.0, 0.0, 1.0])]), [1800.0, 1800.0]
+    )
     half_angle = float(middle.vectors[0].sun_angle_rad[0])
     trajectory, spec = _spin(3600.0, [0.0, 0.0, 1.0], sun_exclusion_half_angle_rad=half_angle)
     structural, gridded = both(trajectory, spec)
@@ -194,8 +198,13 @@ def test_a_vector_on_the_spin_axis_against_dense_sampling():
 
 def test_a_body_at_rest_on_an_orbit_against_dense_sampling():
     craft = Spacecraft("rest", [10.0, 20.0, 30.0])
-    state = InitialState(Rotation.from_euler("zyx", [10.0, 20.0, 30.0], degrees=True), angular_velocity=[0.0, 0.0, 0.0])
-    scenario = Scenario("rest", craft, "2027-06-21T00:00:00", state, duration=6000.0, step=10.0, orbit=TLE)
+    state = InitialState(
+        Rotation.from_euler("zyx", [10.0, 20.0, 30.0], degrees=True),
+        angular_velocity=[0.0, 0.0, 0.0],
+    )
+    scenario = Scenario(
+        "rest", craft, "2027-06-21T00:00:00", state, duration=6000.0, step=10.0, orbit=TLE
+    )
     vector = BodyVector(
         "v", [0.0, 0.0, 1.0], earth_limb_exclusion_angle_rad=math.radians(10.0), kind="star_tracker"
     )
@@ -203,9 +212,14 @@ def test_a_body_at_rest_on_an_orbit_against_dense_sampling():
     trajectory = propagate(scenario)
     structural, gridded = both(trajectory, spec)
     assert_same(structural, gridded)
-    τ, holds, changes = dense_intervals(trajectory, spec, "v", "earth_limb_exclusion", 0.0, 6000.0, 0.05)
+    _, _, changes = dense_intervals(
+        trajectory, spec, "v", "earth_limb_exclusion", 0.0, 6000.0, 0.05
+    )
     found = structural.vectors[0].earth_limb_exclusion
-    ends = sorted([i.start_s for i in found if not i.starts_before] + [i.end_s for i in found if not i.ends_after])
+    ends = sorted(
+        [i.start_s for i in found if not i.starts_before]
+        + [i.end_s for i in found if not i.ends_after]
+    )
     assert len(ends) == changes.size
     assert np.max(np.abs(np.array(ends) - changes)) <= 0.05
 
@@ -213,7 +227,9 @@ def test_a_body_at_rest_on_an_orbit_against_dense_sampling():
 def test_an_attitude_reset_against_the_grid_search():
     # At 30 s the attitude is reset: the vector's angles jump; intervals end or start
     # at the event, flagged as neither before nor after the span.
-    reset = AttitudeReset(30.0, Rotation.from_euler("x", 90.0, degrees=True), angular_velocity=[0.3, 0.0, 1.0])
+    reset = AttitudeReset(
+        30.0, Rotation.from_euler("x", 90.0, degrees=True), angular_velocity=[0.3, 0.0, 1.0]
+    )
     trajectory, spec = _spin(
         60.0,
         [1.0, 0.0, 0.0],
@@ -242,7 +258,9 @@ def test_mean_incidence_against_dense_sampling():
     # The attitude reset case: the structural search integrates max(cos, 0) on the
     # quintic through each cell's ends, cut at the refined crossings; a trapezoid on
     # 600 001 samples of each segment is the reference.
-    reset = AttitudeReset(30.0, Rotation.from_euler("x", 90.0, degrees=True), angular_velocity=[0.3, 0.0, 1.0])
+    reset = AttitudeReset(
+        30.0, Rotation.from_euler("x", 90.0, degrees=True), angular_velocity=[0.3, 0.0, 1.0]
+    )
     trajectory, spec = _spin(60.0, [1.0, 0.0, 0.0], events=[reset])
     analysis = pointing_analysis(trajectory, spec)
     total = 0.0
@@ -251,4 +269,3 @@ def test_mean_incidence_against_dense_sampling():
         samples = pointing_samples(trajectory, spec, τ)
         total += np.trapezoid(samples.vectors[0].cos_incidence, τ)
     assert abs(analysis.vectors[0].mean_cos_incidence - total / 60.0) <= 1e-5
-

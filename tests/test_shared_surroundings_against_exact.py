@@ -88,7 +88,9 @@ def test_rates_against_central_differences_and_their_bounds(spinner):
     for name in ("sun", "moon", "nadir"):
         rate = getattr(here, f"{name}_rate")
         difference = (getattr(ahead, name) - getattr(behind, name)) / (2.0 * h)
-        assert np.max(np.linalg.norm(rate - difference, axis=1)) <= 1e-9 * (1.0 + bounds[f"{name}_1"])
+        assert np.max(np.linalg.norm(rate - difference, axis=1)) <= 1e-9 * (
+            1.0 + bounds[f"{name}_1"]
+        )
         accel = getattr(here, f"{name}_accel")
         difference = (getattr(ahead, f"{name}_rate") - getattr(behind, f"{name}_rate")) / (2.0 * h)
         assert np.max(np.linalg.norm(accel - difference, axis=1)) <= 1e-9

@@ -216,9 +216,7 @@ def least_in_brackets(
     narrowing: dict[str, _Brackets] = {}
     for name, (a, b, fa, fb) in brackets.items():
         if a.size:
-            narrowing[name] = _Brackets(
-                a, b, fa, fb, b - _GOLDEN * (b - a), a + _GOLDEN * (b - a)
-            )
+            narrowing[name] = _Brackets(a, b, fa, fb, b - _GOLDEN * (b - a), a + _GOLDEN * (b - a))
     return _narrow(evaluate, narrowing, out, problems, tolerance, precision_s)
 
 

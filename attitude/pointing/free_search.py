@@ -65,7 +65,6 @@ from attitude.pointing.extrema import Extremum, Problem, least_in_brackets
 from attitude.pointing.intervals import Interval, _assemble, _refine, append_across, join
 from attitude.pointing.shared_surroundings import SharedSurroundings
 from attitude.pointing.spec import PointingSpec
-from attitude.pointing.surroundings import unit_angle
 from attitude.solver.euler_solver import EulerSolver
 
 __all__ = [
@@ -167,7 +166,10 @@ class VectorMotion:
 
 
 def vector_motion(
-    solver: EulerSolver, vectors: list[tuple[str, NDArray[np.float64]]], start_s: float, end_s: float
+    solver: EulerSolver,
+    vectors: list[tuple[str, NDArray[np.float64]]],
+    start_s: float,
+    end_s: float,
 ) -> dict[str, VectorMotion]:
     """:class:`VectorMotion` of each (name, body vector) over [start_s, end_s].
 
@@ -228,9 +230,10 @@ def vector_motion(
         # |ω⃛| + 2|ω̈||ω| + 2|ω̇|² ≤ (6√3 Λ³ + 4√3 Λ² + 6 Λ²) Ω⁴ by the same majorant.
         bend_rate = np.cross(α_rate, b) + np.cross(α, ωb) + np.cross(ω, np.cross(α, b))
         second = (6.0 * math.sqrt(3.0) * Λ**3 + (4.0 * math.sqrt(3.0) + 6.0) * Λ**2) * fastest**4
-        bent = float(
-            np.max(np.linalg.norm(bend, axis=1) + np.linalg.norm(bend_rate, axis=1) * gap)
-        ) + 0.5 * second * gap * gap
+        bent = (
+            float(np.max(np.linalg.norm(bend, axis=1) + np.linalg.norm(bend_rate, axis=1) * gap))
+            + 0.5 * second * gap * gap
+        )
         tilt = m_hat @ b
         # |d/dt (b·m̂)| = |b·(m̂ × ω)|, whose own rate is at most Ω² + A.
         tilt_rate = float(np.max(np.abs(drift @ b))) + (fastest * fastest + spin_accel) * gap
@@ -276,7 +279,9 @@ def free_plan(
     for name, _ in vectors:
         for target in targets:
             bend[(name, target)] = (
-                sky[f"{target}_2"] + 2.0 * sky[f"{target}_1"] * motion[name].rate + motion[name].bend
+                sky[f"{target}_2"]
+                + 2.0 * sky[f"{target}_1"] * motion[name].rate
+                + motion[name].bend
             )
     limb_bend = sky.get("limb_2", 0.0) + sky.get("limb_1", 0.0) ** 2
     values = [*bend.values(), limb_bend]
@@ -339,7 +344,9 @@ class _Evaluator:
             momentum = np.asarray(piece.solver.inertial_angular_momentum, dtype=np.float64)
             size = float(np.linalg.norm(momentum))
             momenta.append(momentum)
-            axes.append(momentum / size if size > 0.0 and math.isfinite(size) else np.full(3, np.nan))
+            axes.append(
+                momentum / size if size > 0.0 and math.isfinite(size) else np.full(3, np.nan)
+            )
         self.axes = np.array(axes).reshape(-1, 3)
         self.momenta = np.array(momenta).reshape(-1, 3)
         self.calls = 0
@@ -383,9 +390,14 @@ class _Evaluator:
             inverse = self.inverses[k]
             r = [[c[mine] for c in row] for row in rows]
             m = [r[0][i] * h[0] + r[1][i] * h[1] + r[2][i] * h[2] for i in range(3)]
-            ω = [inverse[i, 0] * m[0] + inverse[i, 1] * m[1] + inverse[i, 2] * m[2] for i in range(3)]
+            ω = [
+                inverse[i, 0] * m[0] + inverse[i, 1] * m[1] + inverse[i, 2] * m[2] for i in range(3)
+            ]
             mω = (m[1] * ω[2] - m[2] * ω[1], m[2] * ω[0] - m[0] * ω[2], m[0] * ω[1] - m[1] * ω[0])
-            α = [inverse[i, 0] * mω[0] + inverse[i, 1] * mω[1] + inverse[i, 2] * mω[2] for i in range(3)]
+            α = [
+                inverse[i, 0] * mω[0] + inverse[i, 1] * mω[1] + inverse[i, 2] * mω[2]
+                for i in range(3)
+            ]
             for i in range(3):
                 # Inertial: ω_in = R ω.
                 ω_in[i][mine] = r[i][0] * ω[0] + r[i][1] * ω[1] + r[i][2] * ω[2]
@@ -421,7 +433,8 @@ class _Evaluator:
                 (s0, s1, s2), (r0, r1, r2), (a0, a1, a2) = columns[target]
                 f[target].append(d[0] * s0 + d[1] * s1 + d[2] * s2)
                 df[target].append(
-                    (d[0] * r0 + d[1] * r1 + d[2] * r2) + (rate[0] * s0 + rate[1] * s1 + rate[2] * s2)
+                    (d[0] * r0 + d[1] * r1 + d[2] * r2)
+                    + (rate[0] * s0 + rate[1] * s1 + rate[2] * s2)
                 )
                 ddf[target].append(
                     (bend[0] * s0 + bend[1] * s1 + bend[2] * s2)
@@ -458,7 +471,9 @@ def _unit_angle_columns(u, v) -> NDArray[np.float64]:
     (Kahan's formula, as :func:`attitude.pointing.surroundings.unit_angle`)."""
     d0, d1, d2 = u[0] - v[0], u[1] - v[1], u[2] - v[2]
     s0, s1, s2 = u[0] + v[0], u[1] + v[1], u[2] + v[2]
-    return 2.0 * np.arctan2(np.sqrt(d0 * d0 + d1 * d1 + d2 * d2), np.sqrt(s0 * s0 + s1 * s1 + s2 * s2))
+    return 2.0 * np.arctan2(
+        np.sqrt(d0 * d0 + d1 * d1 + d2 * d2), np.sqrt(s0 * s0 + s1 * s1 + s2 * s2)
+    )
 
 
 # ------------------------------------------------------------------ bounds in a cell
@@ -776,7 +791,7 @@ def _nodes(pieces: list[FreePiece]) -> tuple[NDArray[np.float64], NDArray[np.int
     over [start_s, end_s], the last of a piece that an event ends just before it (the
     trajectory gives the event's state from SAME_INSTANT_S before it on)."""
     times, owner = [], []
-    for piece in pieces:
+    for k, piece in enumerate(pieces):
         count = max(math.ceil((piece.end_s - piece.start_s) / piece.plan.step_s), 1) + 1
         τ = np.linspace(piece.start_s, piece.end_s, count)
         if piece.event_at_end:
@@ -822,9 +837,7 @@ def search_free(
     best: dict[str, Extremum] = {}
     integral = dict.fromkeys(names, 0.0)
     dark = dict.fromkeys(names, False)
-    ends = np.array(
-        [x for i in [*shadow, *umbra] for x in (i.start_s, i.end_s)], dtype=np.float64
-    )
+    ends = np.array([x for i in [*shadow, *umbra] for x in (i.start_s, i.end_s)], dtype=np.float64)
     τ_all, owner_all = _nodes(pieces)
     first = 0
     while first < τ_all.size - 1:
@@ -884,9 +897,7 @@ class _Window:
         i = self.cell
         k = np.repeat(np.arange(K), i.size)
         pairs = [x for v in at_nodes for x in (v[:, i].ravel(), v[:, i + 1].ravel())]
-        cells = _Cells(
-            k, np.tile(owner[i], K), np.tile(τ[i], K), np.tile(τ[i + 1], K), *pairs
-        )
+        cells = _Cells(k, np.tile(owner[i], K), np.tile(τ[i], K), np.tile(τ[i + 1], K), *pairs)
         self.cells, self.status = _partition(
             evaluate, conditions, cells, M, self._condition_envelope
         )
@@ -1009,7 +1020,9 @@ class _Window:
 
     # ------------------------------------------------------------------ extrema
 
-    def _quantities(self, values: _Values, τ: NDArray[np.float64], fraction=None) -> dict[str, NDArray]:
+    def _quantities(
+        self, values: _Values, τ: NDArray[np.float64], fraction=None
+    ) -> dict[str, NDArray]:
         """Each problem's function (to minimize) at τ (the lit fraction there, if known)."""
         out = {}
         if fraction is None:
@@ -1062,7 +1075,10 @@ class _Window:
             h = self.τ[i + 1] - self.τ[i]
             piece = self.owner[i]
             bend = np.array(
-                [[p.plan.bend[(v.name, target)] for p in self.pieces] for v in self.spec.body_vectors]
+                [
+                    [p.plan.bend[(v.name, target)] for p in self.pieces]
+                    for v in self.spec.body_vectors
+                ]
             )[:, piece]
             f, df = values.f[target], values.df[target]
             self._cosines[target] = _bounds(f[:, i], df[:, i], f[:, i + 1], df[:, i + 1], h, bend)
@@ -1125,7 +1141,9 @@ class _Window:
             outside = ~self._cell_in(self.shadow)
             fraction = self._node_fraction
             most = np.maximum(fraction[i], fraction[i + 1]) + self.fraction_rate * 0.5 * h
-            return np.where(outside, low, 0.0), np.where(outside, high, high * np.minimum(most, 1.0))
+            return np.where(outside, low, 0.0), np.where(
+                outside, high, high * np.minimum(most, 1.0)
+            )
         angle_low = np.arccos(np.clip(high, -1.0, 1.0))
         angle_high = np.arccos(np.clip(low, -1.0, 1.0))
         if quantity != "earth_limb_angle":
@@ -1193,7 +1211,7 @@ class _Window:
         def evaluate(t: NDArray[np.float64], piece: NDArray[np.intp]):
             return self._quantities(self.evaluate(t, piece, angles=True), t)
 
-        brackets = {}
+        brackets: dict[str, tuple[NDArray[np.float64], ...]] = {}
         for name, cells in left.items():
             i = self.cell[cells]
             values = on_nodes[name]
@@ -1325,6 +1343,12 @@ class _Newton:
         self.left: dict[str, NDArray[np.intp]] = {}
         self.x = np.empty(0)
         self.piece = np.empty(0, dtype=np.intp)
+        # Per cell stepped: its row, cell index, sign, ends.
+        self.which_row = np.empty(0, dtype=np.intp)
+        self.cells = np.empty(0, dtype=np.intp)
+        self.sign = np.empty(0)
+        self.a = np.empty(0)
+        self.b = np.empty(0)
 
     @classmethod
     def start(cls, window: _Window, candidates: dict[str, NDArray[np.intp]]) -> _Newton:
@@ -1364,7 +1388,7 @@ class _Newton:
             ga[mine], gb[mine], da[mine], db[mine] = f[j], f[j + 1], df[j], df[j + 1]
         s = self.sign
         c = _cubic(s * ga, s * da, s * gb, s * db, h)
-        self.x = self.a + _cubic_peak(c, np.ones(self.a.size, dtype=bool)) * h
+        self.x = self.a + _cubic_peak(c, np.ones(self.a.size, dtype=np.bool_)) * h
         return self
 
     def _fold(self, window: _Window, at: _Values, times, which, points, best) -> None:

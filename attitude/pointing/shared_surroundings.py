@@ -52,6 +52,7 @@ span (a study of failure times) can also build one and pass it to
 from __future__ import annotations
 
 import hashlib
+import itertools
 import math
 import pickle
 import threading
@@ -135,8 +136,8 @@ class Targets:
 def _to_power() -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]:
     """The Chebyshev points of the first kind on [−1, 1], the matrix from values there
     to Chebyshev coefficients, and the matrix from those to power coefficients."""
-    nodes = chebyshev.chebpts1(_DEGREE + 1)
-    to_chebyshev = np.linalg.inv(chebyshev.chebvander(nodes, _DEGREE))
+    nodes = np.asarray(chebyshev.chebpts1(_DEGREE + 1), dtype=np.float64)
+    to_chebyshev = np.asarray(np.linalg.inv(chebyshev.chebvander(nodes, _DEGREE)), np.float64)
     to_power = np.zeros((_DEGREE + 1, _DEGREE + 1))
     for k in range(_DEGREE + 1):
         to_power[: k + 1, k] = chebyshev.cheb2poly(np.eye(_DEGREE + 1)[k])
@@ -186,7 +187,9 @@ class SharedSurroundings:
         degree = coefficients.shape[1] - 1
         # The derivative's power coefficients (per second) of every piece.
         k = np.arange(1, degree + 1, dtype=np.float64)
-        self._derivative = coefficients[:, 1:, :] * (k[None, :, None] * (2.0 / widths)[:, None, None])
+        self._derivative = coefficients[:, 1:, :] * (
+            k[None, :, None] * (2.0 / widths)[:, None, None]
+        )
         self._slices = self._field_slices()
         self._rates = self._rate_bounds(widths)
         # What targets() needs (the Sun, the Moon, the position), degree first: each
@@ -196,7 +199,9 @@ class SharedSurroundings:
         )
         self._target_names = [n for n in self._fields if n in _TARGET_FIELDS]
         self._target_values = np.ascontiguousarray(np.moveaxis(coefficients[:, :, columns], 1, 0))
-        self._target_rates = np.ascontiguousarray(np.moveaxis(self._derivative[:, :, columns], 1, 0))
+        self._target_rates = np.ascontiguousarray(
+            np.moveaxis(self._derivative[:, :, columns], 1, 0)
+        )
         k2 = np.arange(1, max(degree, 1), dtype=np.float64)
         second = self._derivative[:, 1:, :] * (k2[None, :, None] * (2.0 / widths)[:, None, None])
         if second.shape[1] == 0:
@@ -230,7 +235,7 @@ class SharedSurroundings:
 
     def _fit(self, edges: NDArray[np.float64]):
         """Fit every piece, halving the ones that fail the check (module notes)."""
-        pieces = [(float(a), float(b), 0) for a, b in zip(edges[:-1], edges[1:], strict=True)]
+        pieces = [(float(a), float(b), 0) for a, b in itertools.pairwise(edges)]
         done: list[tuple[float, float, NDArray[np.float64] | None]] = []
         while pieces:
             lower = np.array([p[0] for p in pieces])
@@ -460,9 +465,13 @@ class SharedSurroundings:
             distance = norm(r)
             r_accel = accels["r"]
             ρ_rate = np.einsum("ij,ij->i", up, r_rate)
-            ρ_accel = (np.einsum("ij,ij->i", r_rate, r_rate) + np.einsum("ij,ij->i", r, r_accel)) / distance
+            ρ_accel = (
+                np.einsum("ij,ij->i", r_rate, r_rate) + np.einsum("ij,ij->i", r, r_accel)
+            ) / distance
             ρ_accel -= ρ_rate * ρ_rate / distance
-            up_accel = (r_accel - 2.0 * ρ_rate[:, None] * up_rate - ρ_accel[:, None] * up) / distance[:, None]
+            up_accel = (
+                r_accel - 2.0 * ρ_rate[:, None] * up_rate - ρ_accel[:, None] * up
+            ) / distance[:, None]
             extra["nadir_accel"] = -up_accel
         distance = norm(r)
         radius = EARTH_EQUATORIAL_RADIUS_M + self.limb_height_m
@@ -497,7 +506,9 @@ class SharedSurroundings:
             # The lit fraction changes at most at (2/π a) per radian of the discs'
             # relative motion (a: the Sun's least angular radius near the Earth), the
             # discs moving at most at nadir's rate plus the Sun's.
-            out["fraction_1"] = 2.0 * (out["nadir_1"] + out["sun_1"]) / (math.pi * _SUN_LEAST_RADIUS_RAD)
+            out["fraction_1"] = (
+                2.0 * (out["nadir_1"] + out["sun_1"]) / (math.pi * _SUN_LEAST_RADIUS_RAD)
+            )
             radius = EARTH_EQUATORIAL_RADIUS_M + self.limb_height_m
             if least > radius:
                 tan = radius / math.sqrt(least * least - radius * radius)
@@ -562,6 +573,12 @@ _CACHE: OrderedDict[tuple, SharedSurroundings] = OrderedDict()
 _CACHE_LOCK = threading.Lock()
 
 
+def _as_orbit(orbit: Orbit | tuple[str, str] | None) -> Orbit | None:
+    """A spec's orbit (a PointingSpec makes an Orbit of two TLE lines when it is built)."""
+    assert orbit is None or isinstance(orbit, Orbit)
+    return orbit
+
+
 def _orbit_key(orbit: Orbit | None) -> str:
     """The orbit's content, as a digest: two orbits read from the same lines or file
     share it (a Monte Carlo sample's, read again from its document)."""
@@ -588,15 +605,14 @@ def shared_surroundings(
     start_s = scenario.start_s if start_s is None else float(start_s)
     stop_s = scenario.stop_s if stop_s is None else float(stop_s)
     jd = scenario_jd(trajectory)
-    key = (jd, _orbit_key(spec.orbit), float(spec.earth_limb_atmosphere_height_m))
+    orbit = _as_orbit(spec.orbit)
+    key = (jd, _orbit_key(orbit), float(spec.earth_limb_atmosphere_height_m))
     with _CACHE_LOCK:
         found = _CACHE.get(key)
         if found is not None and found.covers(start_s, stop_s):
             _CACHE.move_to_end(key)
             return found
-    built = SharedSurroundings(
-        jd, spec.orbit, spec.earth_limb_atmosphere_height_m, start_s, stop_s
-    )
+    built = SharedSurroundings(jd, orbit, spec.earth_limb_atmosphere_height_m, start_s, stop_s)
     with _CACHE_LOCK:
         _CACHE[key] = built
         _CACHE.move_to_end(key)
@@ -613,7 +629,7 @@ def exact_surroundings(
     ephemeris sampled once: the same values, the nodes being aligned on J2000), else
     new ones (nothing is built for the cache)."""
     jd = scenario_jd(trajectory)
-    key = (jd, _orbit_key(spec.orbit), float(spec.earth_limb_atmosphere_height_m))
+    key = (jd, _orbit_key(_as_orbit(spec.orbit)), float(spec.earth_limb_atmosphere_height_m))
     with _CACHE_LOCK:
         found = _CACHE.get(key)
     if found is not None and found.covers(start_s, stop_s):
