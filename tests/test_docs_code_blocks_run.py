@@ -6,8 +6,8 @@
   written into the clone).  It imports the package only as ``from attitude import``
   or ``import attitude``: the public API is what ``attitude`` exports.
 - A ``toml`` block parses.
-- A ``sh`` block's ``attitude check`` and ``attitude run`` lines run to exit 0 (the
-  others install, build or benchmark: CI's own steps, or ``benchmarks/``).
+- A ``sh`` block's ``attitude check``, ``attitude run`` and ``attitude fit`` lines run to
+  exit 0 (the others install, build or benchmark: CI's own steps, or ``benchmarks/``).
 """
 
 import os
@@ -25,9 +25,7 @@ PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 _BLOCK = re.compile(r"^```(\w*)\n(.*?)^```", re.S | re.M)
 _DEEP_IMPORT = re.compile(r"^\s*(?:from|import)\s+attitude\.\w", re.M)
 # Blocks that still name a module path, each with what makes it public.
-_NOT_YET_PUBLIC = {
-    "docs/solver.md:60": "the free-flow map becomes public with the batched solver interface",
-}
+_NOT_YET_PUBLIC: dict[str, str] = {}
 _PLACEHOLDER = re.compile(r"^[A-Z][A-Z_]*(\.toml)?$")  # FILE, DIR, SCENARIO.toml: a template
 
 
@@ -110,7 +108,8 @@ def _commands() -> list[tuple[str, list[str]]]:
             for part in text.split("#", 1)[0].split("&&"):
                 words = shlex.split(part)
                 template = any(_PLACEHOLDER.match(word) for word in words)
-                if words[:2] in (["attitude", "check"], ["attitude", "run"]) and not template:
+                commands = (["attitude", "check"], ["attitude", "run"], ["attitude", "fit"])
+                if words[:2] in commands and not template:
                     found.append((f"{_name(page)}:{line + 1 + offset}", words))
     return found
 
