@@ -85,7 +85,7 @@ WINDOW_NODES = 65_536
 # vector_motion samples ω this many times a turn of the body over a period (or over
 # the segment), and at least and at most these many times in all.
 _SAMPLES_PER_TURN = 512
-_MOTION_SAMPLES_LEAST = 2048
+_MOTION_SAMPLES_LEAST = 256
 _MOTION_SAMPLES = 16_384
 # A cell is cut at the cubic's extremum or root, kept within this fraction of its ends.
 _CUT = 0.1
@@ -104,26 +104,32 @@ class _PeriodicRange:
 
     def __init__(self, values, start_s: float, spacing: float, periodic: bool, slack: float):
         self.start_s, self.spacing, self.periodic, self.slack = start_s, spacing, periodic, slack
-        self.n = values.size
-        lows, highs = [values], [values]
+        self.n = n = values.size
+        levels = max(int(n).bit_length(), 1)
+        # Row k: the min (max) of samples i .. i + 2^k − 1 (padded past the end).
+        self.lows = np.empty((levels, n))
+        self.highs = np.empty((levels, n))
+        self.lows[0], self.highs[0] = values, values
         width = 1
-        while 2 * width <= self.n:
-            lows.append(np.minimum(lows[-1][:-width], lows[-1][width:]))
-            highs.append(np.maximum(highs[-1][:-width], highs[-1][width:]))
+        for k in range(1, levels):
+            self.lows[k, : n - width] = np.minimum(
+                self.lows[k - 1, : n - width], self.lows[k - 1, width:]
+            )
+            self.highs[k, : n - width] = np.maximum(
+                self.highs[k - 1, : n - width], self.highs[k - 1, width:]
+            )
+            self.lows[k, n - width :] = self.lows[k - 1, n - width :]
+            self.highs[k, n - width :] = self.highs[k - 1, n - width :]
             width *= 2
-        self.lows, self.highs = lows, highs
         self.whole = (float(values.min()) - slack, float(values.max()) + slack)
 
     def _query(self, i, j):
-        """min and max of samples i..j (inclusive, 0 ≤ i ≤ j < n), vectorized."""
+        """min and max of samples i..j (inclusive, 0 ≤ i ≤ j < n), vectorized: the two
+        windows of the largest power of two that cover it."""
         level = np.floor(np.log2(np.maximum(j - i + 1, 1))).astype(np.intp)
-        low = np.empty(i.shape)
-        high = np.empty(i.shape)
-        for k in np.unique(level).tolist():
-            mine = level == k
-            a, b = i[mine], j[mine] - (1 << k) + 1
-            low[mine] = np.minimum(self.lows[k][a], self.lows[k][b])
-            high[mine] = np.maximum(self.highs[k][a], self.highs[k][b])
+        b = j - (np.left_shift(1, level)) + 1
+        low = np.minimum(self.lows[level, i], self.lows[level, b])
+        high = np.maximum(self.highs[level, i], self.highs[level, b])
         return low, high
 
     def over(self, t0: NDArray[np.float64], t1: NDArray[np.float64]):
@@ -156,13 +162,38 @@ class _PeriodicRange:
 @dataclass(frozen=True)
 class VectorMotion:
     """How a body vector b moves over a segment: ``rate`` ≥ |ḋ| = |ω × b| and ``bend`` ≥
-    |d̈| = |α × b + ω × (ω × b)| of its inertial direction d = Q b, and ``tilt``, b·m̂
-    (the cosine of its angle β to the momentum, body axes, periodic in the motion)
-    over any window: the envelope of the module notes (None at rest)."""
+    |d̈| = |α × b + ω × (ω × b)| of its inertial direction d = Q b, and b·m̂ (the cosine
+    of its angle β to the momentum, body axes, periodic in the motion) at samples
+    ``tilt_start_s + k tilt_spacing_s``, each within ``tilt_slack`` of it between its
+    neighbours: the envelope of the module notes (None at rest), whose range table
+    :meth:`tilt` builds when a search needs it (:meth:`release` drops it: a run with
+    thousands of segments keeps only the samples)."""
 
     rate: float
     bend: float
-    tilt: _PeriodicRange | None = field(default=None, compare=False)
+    tilt_values: NDArray[np.float64] | None = field(default=None, compare=False, repr=False)
+    tilt_start_s: float = 0.0
+    tilt_spacing_s: float = 0.0
+    tilt_periodic: bool = False
+    tilt_slack: float = 0.0
+    _table: dict = field(default_factory=dict, compare=False, repr=False)
+
+    def tilt(self) -> _PeriodicRange | None:
+        """The range table of b·m̂ over any window (None at rest)."""
+        if self.tilt_values is None:
+            return None
+        if "table" not in self._table:
+            self._table["table"] = _PeriodicRange(
+                self.tilt_values,
+                self.tilt_start_s,
+                self.tilt_spacing_s,
+                self.tilt_periodic,
+                self.tilt_slack,
+            )
+        return self._table["table"]
+
+    def release(self) -> None:
+        self._table.clear()
 
 
 def vector_motion(
@@ -173,7 +204,7 @@ def vector_motion(
 ) -> dict[str, VectorMotion]:
     """:class:`VectorMotion` of each (name, body vector) over [start_s, end_s].
 
-    ω(t) is sampled (512 times a turn of the body, 2048 to 16384 times in all) over
+    ω(t) is sampled (512 times a turn of the body, 256 to 16384 times in all) over
     one period of the body's motion (in which it takes all its values) or over the
     segment if that is shorter; α =
     I⁻¹(m × ω) (Euler's equations) at the same samples.  Within Δ/2 of a sample, |ω × b|
@@ -192,57 +223,83 @@ def vector_motion(
     period = solver.period
     periodic = math.isfinite(period) and period < end_s - start_s
     window = period if periodic else max(end_s - start_s, 0.0)
-    # Hundreds of samples a turn of the body, within [2048, 16384].
+    # Hundreds of samples a turn of the body, within [256, 16384].
     turns = window * fastest / (2.0 * math.pi)
     samples = int(min(max(_SAMPLES_PER_TURN * turns, _MOTION_SAMPLES_LEAST), _MOTION_SAMPLES))
     t = start_s + window * np.arange(samples + 1.0) / samples
-    ω = solver.angular_velocity(t)
-    tensor = solver.inertia_tensor
-    m = ω @ tensor.T
-    α = np.cross(m, ω) @ np.linalg.inv(tensor).T
+    tensor = np.asarray(solver.inertia_tensor, dtype=np.float64)
+    inverse = np.asarray(np.linalg.inv(tensor), dtype=np.float64)
+    # Columns (x, y, z) of the samples: ω, m = Iω, α = I⁻¹(m × ω), and ω̈ = α̇ =
+    # I⁻¹((m × ω) × ω + m × α).
+    ω = _columns(solver.angular_velocity(t))
+    m = _apply(tensor, ω)
+    mω = _cross(m, ω)
+    α = _apply(inverse, mω)
+    α_rate = _apply(inverse, _add(_cross(mω, ω), _cross(m, α)))
     spacing = window / samples
     gap = 0.5 * spacing
-    m_hat = m / np.linalg.norm(m, axis=1)[:, None]
-    drift = np.cross(m_hat, ω)  # dm̂/dt in the body (ṁ = m × ω)
-    # ω̈ = α̇ = I⁻¹((m × ω) × ω + m × α) at the samples, and a bound on the third
-    # derivative: each component of Euler's equations is a product of two others with
-    # a coefficient at most Λ = (I3 − I1)/I1 (principal axes), and every component is
-    # at most Ω, so by Leibniz's rule each component of ω⁽ᵏ⁾ is at most k! Λᵏ Ω^(k+1),
-    # and |ω⁽³⁾| ≤ √3 · 6 Λ³ Ω⁴.
-    inverse = np.linalg.inv(tensor)
-    α_rate = (np.cross(np.cross(m, ω), ω) + np.cross(m, α)) @ inverse.T
+    size = _norm(m)
+    m_hat = (m[0] / size, m[1] / size, m[2] / size)
+    drift = _cross(m_hat, ω)  # dm̂/dt in the body (ṁ = m × ω)
+    # A bound on the third derivative of ω: each component of Euler's equations is a
+    # product of two others with a coefficient at most Λ = (I3 − I1)/I1 (principal
+    # axes), and every component is at most Ω, so by Leibniz's rule each component of
+    # ω⁽ᵏ⁾ is at most k! Λᵏ Ω^(k+1), and |ω⁽³⁾| ≤ √3 · 6 Λ³ Ω⁴.
     Λ = (float(moments[2]) - least) / least
     third = math.sqrt(3.0) * 6.0 * Λ**3 * fastest**4
+    # |ω⃛| + 2|ω̈||ω| + 2|ω̇|² ≤ (6√3 Λ³ + 4√3 Λ² + 6 Λ²) Ω⁴ by the same majorant.
+    second = (6.0 * math.sqrt(3.0) * Λ**3 + (4.0 * math.sqrt(3.0) + 6.0) * Λ**2) * fastest**4
     out = {}
     for name, b in vectors:
-        ωb = np.cross(ω, b)
-        bend = np.cross(α, b) + np.cross(ω, ωb)
+        ωb = _cross_vector(ω, b)
+        αb = _cross_vector(α, b)
         # |ω × b| within Δ/2 of a sample: Taylor's expansion to second order there,
         # and the third-order remainder.
-        taylor = (
-            np.linalg.norm(ωb, axis=1)
-            + np.linalg.norm(np.cross(α, b), axis=1) * gap
-            + 0.5 * np.linalg.norm(np.cross(α_rate, b), axis=1) * gap * gap
-        )
+        taylor = _norm(ωb) + _norm(αb) * gap + 0.5 * _norm(_cross_vector(α_rate, b)) * gap * gap
         rate = min(float(np.max(taylor)) + third * gap**3 / 6.0, fastest)
         # |d̈| = |α × b + ω × (ω × b)| within Δ/2 of a sample: its value and exact rate
-        # there (α̇ × b + α × (ω × b) + ω × (α × b)), and the second-order remainder,
-        # |ω⃛| + 2|ω̈||ω| + 2|ω̇|² ≤ (6√3 Λ³ + 4√3 Λ² + 6 Λ²) Ω⁴ by the same majorant.
-        bend_rate = np.cross(α_rate, b) + np.cross(α, ωb) + np.cross(ω, np.cross(α, b))
-        second = (6.0 * math.sqrt(3.0) * Λ**3 + (4.0 * math.sqrt(3.0) + 6.0) * Λ**2) * fastest**4
-        bent = (
-            float(np.max(np.linalg.norm(bend, axis=1) + np.linalg.norm(bend_rate, axis=1) * gap))
-            + 0.5 * second * gap * gap
-        )
-        tilt = m_hat @ b
+        # there (α̇ × b + α × (ω × b) + ω × (α × b)), and the second-order remainder.
+        bend = _add(αb, _cross(ω, ωb))
+        bend_rate = _add(_add(_cross_vector(α_rate, b), _cross(α, ωb)), _cross(ω, αb))
+        bent = float(np.max(_norm(bend) + _norm(bend_rate) * gap)) + 0.5 * second * gap * gap
+        tilt = m_hat[0] * b[0] + m_hat[1] * b[1] + m_hat[2] * b[2]
         # |d/dt (b·m̂)| = |b·(m̂ × ω)|, whose own rate is at most Ω² + A.
-        tilt_rate = float(np.max(np.abs(drift @ b))) + (fastest * fastest + spin_accel) * gap
-        table = None
+        tilt_rate = drift[0] * b[0] + drift[1] * b[1] + drift[2] * b[2]
+        slack = (float(np.max(np.abs(tilt_rate))) + (fastest * fastest + spin_accel) * gap) * gap
+        values = None
         if window > 0.0:
             values = tilt[:-1] if periodic else tilt
-            table = _PeriodicRange(values, start_s, spacing, periodic, tilt_rate * gap)
-        out[name] = VectorMotion(rate, min(bent, spin_accel + fastest * rate), table)
+        out[name] = VectorMotion(
+            rate, min(bent, spin_accel + fastest * rate), values, start_s, spacing, periodic, slack
+        )
     return out
+
+
+def _columns(v: NDArray[np.float64]):
+    """The columns of (n, 3) vectors, contiguous."""
+    return tuple(np.ascontiguousarray(v[:, k]) for k in range(3))
+
+
+def _apply(matrix: NDArray[np.float64], v):
+    """matrix · v for columns v."""
+    return tuple(matrix[i, 0] * v[0] + matrix[i, 1] * v[1] + matrix[i, 2] * v[2] for i in range(3))
+
+
+def _cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _cross_vector(a, b: NDArray[np.float64]):
+    """a × b for columns a and one vector b."""
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _add(a, b):
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+def _norm(a):
+    return np.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
 
 
 @dataclass(frozen=True)
@@ -574,7 +631,7 @@ def _envelope(pieces: list[FreePiece], piece, name: str, target: str, σ_a, σ_b
     high = np.full(np.shape(t_a), math.pi)
     for k in np.unique(piece).tolist():
         plan = pieces[k].plan
-        tilt = plan.motion[name].tilt if name in plan.motion else None
+        tilt = plan.motion[name].tilt() if name in plan.motion else None
         if tilt is None:
             continue
         mine = piece == k
@@ -865,6 +922,9 @@ def search_free(
             integral[name] += value
         for name, value in window.dark().items():
             dark[name] = dark[name] or value
+        for k in range(int(owner[0]), int(owner[-1]) + (1 if last == τ_all.size - 1 else 0)):
+            for motion in pieces[k].plan.motion.values():
+                motion.release()  # the pieces behind: their tables are not needed again
         first = last
     return FreeResult(out, best, integral, dark, evaluate.points)
 

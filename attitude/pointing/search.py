@@ -611,9 +611,15 @@ class _Search:
     # ------------------------------------------------------------- the grid search
 
     def gridded(self, start_s: float, end_s: float) -> None:
-        """Search [start_s, end_s] (a segment under torques or a law) on the grid."""
+        """Search [start_s, end_s] (consecutive segments under torques or laws) on the
+        grid, with the events' epochs within it as points (the trajectory gives each
+        point its segment: the later one at an event)."""
         step = self.grid.grid_step_s if self.grid.grid_step_s > 0.0 else self.grid.step_s
         τ_all = _grid_points(start_s, end_s, step)
+        events = np.array([t for t, _ in self.trajectory.scenario.events], dtype=np.float64)
+        inside = events[(events > start_s) & (events < end_s)]
+        if inside.size:
+            τ_all = np.unique(np.concatenate([τ_all, inside]))
         first = 0
         while first < τ_all.size - 1:
             last = min(first + CHUNK_POINTS, τ_all.size - 1)
@@ -821,21 +827,29 @@ def pointing_analysis(
     search = _Search(trajectory, spec, grid, shared)
     search.orbit_only()
     if spec.body_vectors:
-        run: list[FreePiece] = []  # consecutive torque-free segments, searched together
+        # Consecutive torque-free segments are searched together, and so are
+        # consecutive other ones, on the grid.
+        run: list[FreePiece] = []
+        gridded: list[float] = []  # the start and end of the segments to grid
         for k, segment in _in_span(trajectory, grid.start_s, grid.stop_s):
             a, b = max(segment.start_s, grid.start_s), min(segment.end_s, grid.stop_s)
             if b <= a and not (a == b == grid.start_s == grid.stop_s):
                 continue  # an event at the span's end, or two at one epoch
             plan = grid.plans[k] if k < len(grid.plans) else None
             if plan is not None and isinstance(segment.solver, EulerSolver):
+                if gridded:
+                    search.gridded(gridded[0], gridded[-1])
+                    gridded = []
                 run.append(FreePiece(segment.solver, plan, a, b, b < grid.stop_s))
                 continue
             if run:
                 search.free(run)
                 run = []
-            search.gridded(a, b)
+            gridded = [gridded[0] if gridded else a, b]
         if run:
             search.free(run)
+        if gridded:
+            search.gridded(gridded[0], gridded[-1])
     return search.result()
 
 
