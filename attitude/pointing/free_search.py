@@ -81,7 +81,7 @@ __all__ = [
 _OVERSHOOT = 0.1
 _LONGEST_STEP_S = 3600.0
 # A window holds at most this many nodes (bounded memory).
-WINDOW_NODES = 65_536
+WINDOW_NODES = 16_384
 # vector_motion samples ω this many times a turn of the body over a period (or over
 # the segment), and at least and at most these many times in all.
 _SAMPLES_PER_TURN = 512
