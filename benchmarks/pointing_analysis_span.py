@@ -63,9 +63,7 @@ def main() -> list[dict]:
             results.append(json.loads(run.stdout.strip().splitlines()[-1]))
     base = results[0]
     for item in results:
-        item["cpu_per_day_ratio"] = (item["cpu_s"] / item["days"]) / (
-            base["cpu_s"] / base["days"]
-        )
+        item["cpu_per_day_ratio"] = (item["cpu_s"] / item["days"]) / (base["cpu_s"] / base["days"])
         item["peak_ratio"] = item["peak_mb"] / base["peak_mb"]
         print(
             f"{item['days']:5g} days: {item['grid_points']:>9} grid points, "

@@ -16,8 +16,9 @@ over one day from 2027-03-20T12:00 UTC, the Sun near +x, at the Earth's centre, 
   placed 1 au from the spacecraft, so that both searches look for the same Sun and the
   comparison is about the search (``FieldOfViewRun.java``, compiled by javac).
 
-CPU time (``time.process_time``: the JVM runs in this process), each side warmed up,
-the pair alternated three times; the machine's load beside the figures.  Every Orekit
+CPU time (``time.process_time``), each side in its own process (the JVM's threads,
+its compiler and collector, count for Orekit, not for us), each warmed up, the pair
+alternated three times; the machine's load beside the figures.  Every Orekit
 interval must be among ours (ends within 2 ms); those we find that Orekit does not are
 listed with their lengths (shorter than its max-check, they can fall between its
 samples).  Run with the bench venv (orekit-jpype, a JDK):
@@ -190,9 +191,53 @@ def compare(ours: list, theirs: list, tolerance_s: float = 2e-3) -> dict:
     }
 
 
-def main() -> dict:
+def _ours(connection) -> None:
+    """Our side, in its own process: on each message, one timed search."""
     from attitude.pointing.search import pointing_analysis
-    from attitude.pointing.shared_surroundings import clear_cache, shared_surroundings
+    from attitude.pointing.shared_surroundings import shared_surroundings
+
+    trajectory, spec = case()
+    begin = time.process_time()
+    shared_surroundings(trajectory, spec)
+    built = time.process_time() - begin
+    pointing_analysis(trajectory, spec)  # warm: imports, the solver's table
+    connection.send({"surroundings_build_cpu_s": built})
+    while connection.recv():
+        begin = time.process_time()
+        analysis = pointing_analysis(trajectory, spec)
+        cpu = time.process_time() - begin
+        cone = analysis.vectors[0]
+        connection.send(
+            {
+                "cpu_s": cpu,
+                "intervals": [(i.start_s, i.end_s) for i in cone.sun_exclusion],
+                "inside_at_start": bool(cone.sun_exclusion and cone.sun_exclusion[0].starts_before),
+            }
+        )
+
+
+def _theirs(connection, sun_table: np.ndarray) -> None:
+    """Orekit's side, in its own process (the JVM): on each message, one timed search."""
+    trajectory, _ = case()
+    start_jvm()
+    run, (orbit, provider), target, fov = orekit_setup(trajectory, sun_table)
+
+    def once():
+        return np.array(run.run(orbit, provider, target, fov, MAX_CHECK_S, THRESHOLD_S, SPAN_S))
+
+    once()  # warm: the JIT
+    connection.send({})
+    while connection.recv():
+        begin = time.process_time()
+        out = once()
+        cpu = time.process_time() - begin
+        connection.send({"cpu_s": cpu, "events": out[:-1].reshape(-1, 2), "g": int(out[-1])})
+
+
+def main() -> dict:
+    import multiprocessing
+
+    from attitude.pointing.shared_surroundings import shared_surroundings
 
     report: dict = {
         "machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores",
@@ -202,45 +247,38 @@ def main() -> dict:
         "uptime_at_start": _uptime(),
     }
     trajectory, spec = case()
-    clear_cache()
-    begin = time.process_time()
-    shared = shared_surroundings(trajectory, spec)
-    report["our_surroundings_build_cpu_s"] = time.process_time() - begin
     times = np.arange(0.0, SPAN_S + 2 * SUN_TABLE_STEP_S, SUN_TABLE_STEP_S)
-    sun = shared.targets(times).sun
+    sun = shared_surroundings(trajectory, spec).targets(times).sun
     sun = sun / np.linalg.norm(sun, axis=1)[:, None]
-
-    start_jvm()
-    run, propagator, target, fov = orekit_setup(trajectory, sun)
-
-    def ours():
-        return pointing_analysis(trajectory, spec)
-
-    def theirs():
-        orbit, provider = propagator
-        return np.array(run.run(orbit, provider, target, fov, MAX_CHECK_S, THRESHOLD_S, SPAN_S))
-
-    ours()  # warm: imports, the solver's table
-    theirs()  # warm: the JIT
+    context = multiprocessing.get_context("spawn")
+    ours_end, ours_child = context.Pipe()
+    theirs_end, theirs_child = context.Pipe()
+    workers = [
+        context.Process(target=_ours, args=(ours_child,)),
+        context.Process(target=_theirs, args=(theirs_child, sun)),
+    ]
+    for worker in workers:
+        worker.start()
+    report["our_surroundings_build_cpu_s"] = ours_end.recv()["surroundings_build_cpu_s"]
+    theirs_end.recv()
     our_cpu, their_cpu = [], []
     for _ in range(ROUNDS):
-        begin = time.process_time()
-        analysis = ours()
-        our_cpu.append(time.process_time() - begin)
-        begin = time.process_time()
-        out = theirs()
-        their_cpu.append(time.process_time() - begin)
-    calls = int(out[-1])
-    events = out[:-1].reshape(-1, 2)
-    cone = analysis.vectors[0]
-    inside = bool(cone.sun_exclusion and cone.sun_exclusion[0].starts_before)
-    theirs_intervals = orekit_intervals(events, SPAN_S, inside)
-    ours_intervals = [(i.start_s, i.end_s) for i in cone.sun_exclusion]
-    report["comparison"] = compare(ours_intervals, theirs_intervals)
+        ours_end.send(True)
+        mine = ours_end.recv()
+        our_cpu.append(mine["cpu_s"])
+        theirs_end.send(True)
+        other = theirs_end.recv()
+        their_cpu.append(other["cpu_s"])
+    for end in (ours_end, theirs_end):
+        end.send(False)
+    for worker in workers:
+        worker.join()
+    theirs_intervals = orekit_intervals(other["events"], SPAN_S, mine["inside_at_start"])
+    report["comparison"] = compare(mine["intervals"], theirs_intervals)
     report["our_cpu_s"] = our_cpu
     report["orekit_cpu_s"] = their_cpu
-    report["orekit_g_evaluations"] = calls
-    report["orekit_us_per_g"] = 1e6 * float(np.median(their_cpu)) / calls
+    report["orekit_g_evaluations"] = other["g"]
+    report["orekit_us_per_g"] = 1e6 * float(np.median(their_cpu)) / other["g"]
     report["ratio_orekit_over_ours_median"] = float(np.median(their_cpu) / np.median(our_cpu))
     report["ratio_orekit_over_ours_per_round"] = [
         t / o for o, t in zip(our_cpu, their_cpu, strict=True)
