@@ -93,6 +93,8 @@ TARGETS = ("sun", "moon", "nadir")
 # The envelope's bounds are widened by this (rad): the rounding of the arc cosines
 # it compares (~1e-12 rad near 0 and π) and of the directions it takes.
 _ENVELOPE_MARGIN = 1e-9
+# The envelope tightens an extremum's candidate cells when there are more than this.
+_ENVELOPE_LEAST = 64
 
 
 class _PeriodicRange:
@@ -409,9 +411,14 @@ class _Evaluator:
         self.calls = 0
         self.points = 0
 
-    def __call__(self, τ, piece, angles: bool | set = False) -> _Values:
-        """The values at times τ of pieces ``piece`` (indices); the angles with
-        ``angles`` (True: to every target; a set: to those)."""
+    def __call__(self, τ, piece, angles=False, targets=None, bends=None) -> _Values:
+        """The values at times τ of pieces ``piece`` (indices): the cosines with
+        ``targets`` (None: every target) and their rates; their bends with ``bends``
+        (None: every one of them); the angles with ``angles`` (True: every one; a set:
+        those).  Each is asked only where it is used: the cost is per target."""
+        wanted = self.targets if targets is None else [t for t in self.targets if t in targets]
+        bent = set(wanted) if bends is None else set(bends) & set(wanted)
+        angled = set(wanted) if angles is True else set(angles or ()) & set(wanted)
         τ = np.asarray(τ, dtype=np.float64)
         piece = np.asarray(piece, dtype=np.intp)
         self.calls += 1
@@ -459,16 +466,16 @@ class _Evaluator:
                 # Inertial: ω_in = R ω.
                 ω_in[i][mine] = r[i][0] * ω[0] + r[i][1] * ω[1] + r[i][2] * ω[2]
                 α_in[i][mine] = r[i][0] * α[0] + r[i][1] * α[1] + r[i][2] * α[2]
-        sky = self.shared.targets(τ, accelerations=True)
-        f: dict[str, list] = {t: [] for t in self.targets}
-        df: dict[str, list] = {t: [] for t in self.targets}
-        ddf: dict[str, list] = {t: [] for t in self.targets}
-        angle: dict[str, list] = {t: [] for t in self.targets}
+        sky = self.shared.targets(τ, accelerations=bool(bent))
+        f: dict[str, list] = {t: [] for t in wanted}
+        df: dict[str, list] = {t: [] for t in wanted}
+        ddf: dict[str, list] = {t: [] for t in wanted if t in bent}
+        angle: dict[str, list] = {t: [] for t in wanted if t in angled}
         columns = {}
-        for target in self.targets:
+        for target in wanted:
             s = getattr(sky, target)
             sr = getattr(sky, f"{target}_rate")
-            sa = getattr(sky, f"{target}_accel")
+            sa = getattr(sky, f"{target}_accel") if target in bent else s
             columns[target] = tuple(
                 tuple(np.ascontiguousarray(v[:, i]) for i in range(3)) for v in (s, sr, sa)
             )
@@ -481,30 +488,32 @@ class _Evaluator:
             )
             # d̈ = α × d + ω × ḋ: a cosine bends by s·d̈ + 2 ṡ·ḋ + s̈·d (f'' serves the
             # incidence's integral and the extrema's Newton steps, never a bound).
-            bend = (
-                α_in[1] * d[2] - α_in[2] * d[1] + ω_in[1] * rate[2] - ω_in[2] * rate[1],
-                α_in[2] * d[0] - α_in[0] * d[2] + ω_in[2] * rate[0] - ω_in[0] * rate[2],
-                α_in[0] * d[1] - α_in[1] * d[0] + ω_in[0] * rate[1] - ω_in[1] * rate[0],
-            )
-            for target in self.targets:
+            if ddf:
+                bend = (
+                    α_in[1] * d[2] - α_in[2] * d[1] + ω_in[1] * rate[2] - ω_in[2] * rate[1],
+                    α_in[2] * d[0] - α_in[0] * d[2] + ω_in[2] * rate[0] - ω_in[0] * rate[2],
+                    α_in[0] * d[1] - α_in[1] * d[0] + ω_in[0] * rate[1] - ω_in[1] * rate[0],
+                )
+            for target in wanted:
                 (s0, s1, s2), (r0, r1, r2), (a0, a1, a2) = columns[target]
                 f[target].append(d[0] * s0 + d[1] * s1 + d[2] * s2)
                 df[target].append(
                     (d[0] * r0 + d[1] * r1 + d[2] * r2)
                     + (rate[0] * s0 + rate[1] * s1 + rate[2] * s2)
                 )
-                ddf[target].append(
-                    (bend[0] * s0 + bend[1] * s1 + bend[2] * s2)
-                    + 2.0 * (rate[0] * r0 + rate[1] * r1 + rate[2] * r2)
-                    + (d[0] * a0 + d[1] * a1 + d[2] * a2)
-                )
-                if angles is True or (angles and target in angles):
+                if target in ddf:
+                    ddf[target].append(
+                        (bend[0] * s0 + bend[1] * s1 + bend[2] * s2)
+                        + 2.0 * (rate[0] * r0 + rate[1] * r1 + rate[2] * r2)
+                        + (d[0] * a0 + d[1] * a1 + d[2] * a2)
+                    )
+                if target in angle:
                     angle[target].append(_unit_angle_columns(d, columns[target][0]))
         # σ by arccos: ~1e-12 rad near 0 and π at σ = 1e-4, far below the margin the
         # envelope adds (_ENVELOPE_MARGIN).
         axis = self.axes[piece]
         sigma = {}
-        for target in self.targets:
+        for target in wanted:
             s0, s1, s2 = columns[target][0]
             along = s0 * axis[:, 0] + s1 * axis[:, 1] + s2 * axis[:, 2]
             sigma[target] = np.arccos(np.clip(along, -1.0, 1.0))
@@ -516,7 +525,7 @@ class _Evaluator:
             stacked(f),
             stacked(df),
             stacked(ddf),
-            stacked({t: v for t, v in angle.items() if v}),
+            stacked(angle),
             sigma,
             sky.limb,
             sky.limb_rate,
@@ -699,7 +708,8 @@ def _condition_values(values: _Values, conditions: list[_Condition]):
         if c.kind == "cos":
             g.append(f - c.c)
             dg.append(df)
-            ddg.append(values.ddf[c.target][c.vector])
+            bends = values.ddf.get(c.target)
+            ddg.append(np.full(f.shape, np.nan) if bends is None else bends[c.vector])
         else:
             assert values.limb is not None and values.limb_rate is not None
             edge = c.c + values.limb
@@ -824,6 +834,10 @@ _TARGET_OF = {
 }
 _NEWTON_STEPS = 6
 _NEWTON_DONE_S = 1e-9
+_ANGLES = ("angle", "limb")
+# The lit fraction's slope and bend by central differences this far apart (s): it
+# changes over the seconds of a penumbra.
+_FRACTION_STEP_S = 1e-2
 # A piece that ends at an event ends its nodes this long before it (s): the
 # trajectory puts times within SAME_INSTANT_S of an event at the event's state.
 _BEFORE_EVENT_S = 2e-9
@@ -948,7 +962,10 @@ class _Window:
         self.conditions, self.M, self.τ, self.owner = conditions, M, τ, owner
         self.shadow, self.umbra = shadow, umbra
         self.limb_rate = shared.rate_bounds().get("limb_1", 0.0)
-        self.values = evaluate(τ, owner, angles=True)
+        # Which targets the conditions look at (the cuts and crossings ask only those),
+        # and the Sun's bend for the incidence's integral.
+        self.condition_targets = {c.target for c in conditions}
+        self.values = evaluate(τ, owner, angles=True, bends={"sun"})
         at_nodes = _condition_values(self.values, conditions)
         self.g = at_nodes[0]
         # Cells join neighbouring nodes of one piece.
@@ -958,8 +975,13 @@ class _Window:
         k = np.repeat(np.arange(K), i.size)
         pairs = [x for v in at_nodes for x in (v[:, i].ravel(), v[:, i + 1].ravel())]
         cells = _Cells(k, np.tile(owner[i], K), np.tile(τ[i], K), np.tile(τ[i + 1], K), *pairs)
+        targets = self.condition_targets
+
+        def at_cuts(t, piece):
+            return evaluate(t, piece, targets=targets, bends={"sun"} & targets)
+
         self.cells, self.status = _partition(
-            evaluate, conditions, cells, M, self._condition_envelope
+            at_cuts, conditions, cells, M, self._condition_envelope
         )
         # The refined time of each cell's crossing (NaN for a cell without one).
         self.cross = np.full(self.status.size, np.nan)
@@ -1009,7 +1031,16 @@ class _Window:
         newton = self._extrema_start(problems, incumbents, best, tolerance)
         points = np.concatenate([x, newton.x])
         owners = np.concatenate([cells.p, newton.piece])
-        at = self.evaluate(points, owners, angles=True) if points.size else None
+        stepped = newton.targets()
+        at = None
+        if points.size:
+            at = self.evaluate(
+                points,
+                owners,
+                angles=stepped,
+                targets=self.condition_targets | stepped,
+                bends=stepped,
+            )
         times = self._crossings(cells, x, at, precision_s)
         self.cross[crossing] = times
         self._extrema_finish(newton, at, x.size, problems, best, tolerance, extremum_precision_s)
@@ -1066,7 +1097,8 @@ class _Window:
             sub = cells.take(rest)
 
             def f(τ: NDArray[np.float64], which: NDArray[np.intp]) -> NDArray[np.float64]:
-                values = _condition_values(self.evaluate(τ, sub.p[which]), conditions)[0]
+                at = self.evaluate(τ, sub.p[which], targets=self.condition_targets, bends=())
+                values = _condition_values(at, conditions)[0]
                 return values[sub.k[which], np.arange(τ.size)]
 
             # The bracket keeps its side of x: the cell's ends, x itself.
@@ -1182,6 +1214,8 @@ class _Window:
             if ask_where is None:
                 return lo, hi
             ask = np.flatnonzero(ask_where(lo, hi))
+            if ask.size <= _ENVELOPE_LEAST:
+                return lo, hi  # a few cells: Newton's steps cost less than the envelope
             env_low, env_high = self._envelope_at(j, target, ask)
             if as_cosine:
                 lo[ask] = np.maximum(lo[ask], np.cos(env_high))
@@ -1287,20 +1321,6 @@ class _Window:
             )
             best.update(found)
 
-    def _fold_at(self, at: _Values, times, offset: int, problems, best) -> None:
-        """Fold the problems' values at the points of ``at`` from ``offset`` on (at
-        ``times``)."""
-        sliced = _Values(
-            {t: v[:, offset:] for t, v in at.f.items()},
-            {t: v[:, offset:] for t, v in at.df.items()},
-            {t: v[:, offset:] for t, v in at.ddf.items()},
-            {t: v[:, offset:] for t, v in at.angle.items()},
-            {t: v[offset:] for t, v in at.sigma.items()},
-            None if at.limb is None else at.limb[offset:],
-            None if at.limb_rate is None else at.limb_rate[offset:],
-        )
-        self._fold(self._quantities(sliced, times), times, problems, best)
-
     def _fold(self, quantities, times, problems, best) -> None:
         """Fold the values of the problems at ``times`` into ``best``."""
         for name in problems:
@@ -1312,50 +1332,66 @@ class _Window:
     # ---------------------------------------------------------------- incidence
 
     def incidence(self) -> dict[str, float]:
-        """Each vector's integral of max(f_sun, 0) × lit fraction over the window."""
-        out = {}
-        for index, condition in enumerate(self.conditions):
-            if not condition.name.endswith(".sun_visible"):
-                continue
-            name = self.spec.body_vectors[condition.vector].name
-            mine = self.cells.k == index
-            cells = self.cells.take(mine)
-            status = self.status[mine]
-            a, b = cells.a.copy(), cells.b.copy()
-            lit_a = cells.ga > 0.0
-            keep = ((status == 0) & lit_a) | (status == 1)
-            rows = np.flatnonzero(status == 1)
-            cut = self.cross[mine][rows]
-            entering = ~lit_a[rows]
-            a[rows] = np.where(entering, cut, a[rows])
-            b[rows] = np.where(entering, b[rows], cut)
-            rows = np.flatnonzero(keep)
-            h = cells.b[rows] - cells.a[rows]
-            # The quintic through the ends' values, slopes and bends: exact for it, 4
-            # Gauss–Legendre points on the lit part.
+        """Each vector's integral of max(f_sun, 0) × lit fraction over the window, on the
+        quintic through each cell's ends (their values, slopes and bends) of the Sun's
+        visibility: in closed form, h (f0 + f1)/2 + h² (f0' − f1')/10 + h³ (f0'' +
+        f1'')/120, on a cell lit throughout and outside the shadow; by 4 Gauss–Legendre
+        points (exact for a quintic) on the lit part of a cell cut by a crossing, or
+        with the lit fraction where the cell meets the shadow."""
+        index_of = {
+            k: c.vector for k, c in enumerate(self.conditions) if c.name.endswith(".sun_visible")
+        }
+        mine = np.isin(self.cells.k, list(index_of))
+        cells = self.cells.take(mine)
+        status = self.status[mine]
+        cross = self.cross[mine]
+        vector = np.array([index_of[k] for k in cells.k.tolist()], dtype=np.intp)
+        lit_a = cells.ga > 0.0
+        keep = ((status == 0) & lit_a) | (status == 1)
+        cells, status, cross, vector = cells.take(keep), status[keep], cross[keep], vector[keep]
+        h = cells.b - cells.a
+        a, b = cells.a.copy(), cells.b.copy()
+        cut = status == 1
+        entering = cells.ga <= 0.0
+        a[cut] = np.where(entering[cut], cross[cut], a[cut])
+        b[cut] = np.where(entering[cut], b[cut], cross[cut])
+        meets = np.zeros(h.size, dtype=bool)
+        if self.shadow:
+            meets = (
+                _in_any(0.5 * (a + b), self.shadow)
+                | _in_any(a, self.shadow)
+                | _in_any(b, self.shadow)
+            )
+        whole = ~cut & ~meets
+        total = np.zeros(h.size)
+        hw = h[whole]
+        total[whole] = (
+            0.5 * hw * (cells.ga[whole] + cells.gb[whole])
+            + hw * hw * (cells.da[whole] - cells.db[whole]) / 10.0
+            + hw**3 * (cells.ea[whole] + cells.eb[whole]) / 120.0
+        )
+        rows = np.flatnonzero(~whole)
+        if rows.size:
+            hr = h[rows]
             c = _quintic(
                 cells.ga[rows],
-                h * cells.da[rows],
-                h * h * cells.ea[rows],
+                hr * cells.da[rows],
+                hr * hr * cells.ea[rows],
                 cells.gb[rows],
-                h * cells.db[rows],
-                h * h * cells.eb[rows],
+                hr * cells.db[rows],
+                hr * hr * cells.eb[rows],
             )
             lo, hi = a[rows], b[rows]
             x = 0.5 * (hi + lo)[:, None] + 0.5 * (hi - lo)[:, None] * _GAUSS_X[None, :]
-            s = (x - cells.a[rows][:, None]) / h[:, None]
+            s = (x - cells.a[rows][:, None]) / hr[:, None]
             f = np.maximum(_polynomial_at(tuple(ci[:, None] for ci in c), s), 0.0)
             weight = np.ones_like(f)
-            if self.shadow:
-                meets = (
-                    _in_any(0.5 * (lo + hi), self.shadow)
-                    | _in_any(lo, self.shadow)
-                    | _in_any(hi, self.shadow)
-                )
-                if np.any(meets):
-                    weight[meets] = self._fraction(x[meets].ravel()).reshape(-1, _GAUSS_X.size)
-            out[name] = float(np.sum((f * weight) @ _GAUSS_W * 0.5 * (hi - lo)))
-        return out
+            shaded = meets[rows]
+            if np.any(shaded):
+                weight[shaded] = self._fraction(x[shaded].ravel()).reshape(-1, _GAUSS_X.size)
+            total[rows] = (f * weight) @ _GAUSS_W * 0.5 * (hi - lo)
+        sums = np.bincount(vector, weights=total, minlength=len(self.spec.body_vectors))
+        return {self.spec.body_vectors[j].name: float(sums[j]) for j in set(index_of.values())}
 
     def dark(self) -> dict[str, bool]:
         """Whether each vector saw no Sun at some time of the window."""
@@ -1392,11 +1428,12 @@ class _Newton:
     extremum of the cubic through the cell's ends, each step moves to x − s/f'' (s that
     slope, f'' the exact bend), kept within the cell; every point evaluated counts for
     every problem.  A cell is done when its next step could improve its quantity by
-    less than a tenth of the tolerance (½|f''| step², over sin α for an angle), when it
+    less than the tolerance (½|f''| step², over sin α for an angle), when it
     sits at an end that the slope leaves by, or where the function is convex at the
     cubic's peak: the cell then holds no peak, and its best is the end the slope climbs
-    to (a node, counted).  One still moving after :data:`_NEWTON_STEPS` is left to
-    golden-section search, as are the incidence's cells in the shadow."""
+    to (a node, counted).  In the shadow the incidence is the cosine times the lit
+    fraction F, whose slope and bend come from F by central differences.  A cell still
+    moving after :data:`_NEWTON_STEPS` is left to golden-section search."""
 
     def __init__(self) -> None:
         self.rows: list = []
@@ -1420,18 +1457,21 @@ class _Newton:
         for name, cells in candidates.items():
             vector, quantity, end = name.rsplit(".", 2)
             target = _TARGET_OF[quantity]
-            if quantity == "cos_incidence":
-                smooth = ~shadow[cells]
-            else:
-                smooth = np.ones(cells.size, dtype=bool)
-            if not np.any(smooth) or target not in values.f:
+            self.left[name] = cells[:0]
+            if target not in values.f:
                 self.left[name] = cells
                 continue
-            self.left[name] = cells[~smooth]
             # +1 where the quantity is extreme where the cosine is greatest.
             sign = 1.0 if (end == "low") != (quantity == "cos_incidence") else -1.0
             kind = {"earth_limb_angle": "limb", "cos_incidence": "cosine"}.get(quantity, "angle")
-            self.rows.append((name, index[vector], target, sign, kind, cells[smooth]))
+            if kind == "cosine":
+                # In the shadow the incidence is the cosine times the lit fraction.
+                shaded = shadow[cells]
+                for part, part_kind in ((cells[~shaded], kind), (cells[shaded], "shaded")):
+                    if part.size:
+                        self.rows.append((name, index[vector], target, sign, part_kind, part))
+                continue
+            self.rows.append((name, index[vector], target, sign, kind, cells))
         if not self.rows:
             return self
         self.which_row = np.concatenate([np.full(r[5].size, k) for k, r in enumerate(self.rows)])
@@ -1459,6 +1499,8 @@ class _Newton:
             there = points[self.which_row[which] == k]
             if kind == "cosine":
                 q = np.maximum(at.f[target][j][there], 0.0)  # outside the shadow: lit
+            elif kind == "shaded":
+                q = np.maximum(at.f[target][j][there], 0.0) * window._fraction(times[there])
             else:
                 q = at.angle[target][j][there]
                 if kind == "limb":
@@ -1469,6 +1511,10 @@ class _Newton:
             i = int(np.argmin(q))
             if q[i] < best[name].value:
                 best[name] = Extremum(float(times[there][i]), float(q[i]))
+
+    def targets(self) -> set[str]:
+        """The targets of the rows (what their steps evaluate)."""
+        return {r[2] for r in self.rows}
 
     def run(self, window: _Window, at, offset: int, problems, best, tolerance):
         """The steps, the first from ``at`` (the values at ``self.x``, from
@@ -1481,15 +1527,21 @@ class _Newton:
             if not which.size:
                 break
             if count == 0:
-                window._fold_at(at, self.x, offset, problems, best)
                 points = offset + which
+                times = np.concatenate([np.full(offset, np.nan), self.x])
             else:
                 keys = np.stack([self.x[which], self.piece[which].astype(np.float64)])
                 unique, inverse = np.unique(keys, axis=1, return_inverse=True)
                 targets = {self.rows[k][2] for k in np.unique(self.which_row[which]).tolist()}
-                at = window.evaluate(unique[0], unique[1].astype(np.intp), angles=targets)
-                points = inverse.ravel()
-                self._fold(window, at, unique[0], which, points, best)
+                at = window.evaluate(
+                    unique[0],
+                    unique[1].astype(np.intp),
+                    angles=targets,
+                    targets=targets,
+                    bends=targets,
+                )
+                points, times = inverse.ravel(), unique[0]
+            self._fold(window, at, times, which, points, best)
             slope, bend, size = (np.empty(which.size) for _ in range(3))
             for k, r in enumerate(self.rows):
                 mine = self.which_row[which] == k
@@ -1498,10 +1550,20 @@ class _Newton:
                 there = points[mine]
                 slope[mine] = at.df[r[2]][r[1]][there]
                 bend[mine] = at.ddf[r[2]][r[1]][there]
-                size[mine] = 1.0 if r[4] == "cosine" else np.sin(at.angle[r[2]][r[1]][there])
+                size[mine] = np.sin(at.angle[r[2]][r[1]][there]) if r[4] in _ANGLES else 1.0
                 if r[4] == "limb":  # the slope of α − ρ, times −sin α
                     assert at.limb_rate is not None
                     slope[mine] += at.limb_rate[there] * size[mine]
+                if r[4] == "shaded":  # (f F)' and (f F)'' with F the lit fraction
+                    f = at.f[r[2]][r[1]][there]
+                    t = times[there]
+                    F = window._fraction(t)
+                    ahead = window._fraction(t + _FRACTION_STEP_S)
+                    behind = window._fraction(t - _FRACTION_STEP_S)
+                    F1 = (ahead - behind) / (2.0 * _FRACTION_STEP_S)
+                    F2 = (ahead - 2.0 * F + behind) / _FRACTION_STEP_S**2
+                    bend[mine] = bend[mine] * F + 2.0 * slope[mine] * F1 + f * F2
+                    slope[mine] = slope[mine] * F + f * F1
             slope, bend = self.sign[which] * slope, self.sign[which] * bend
             with np.errstate(divide="ignore", invalid="ignore"):
                 step = -slope / bend
@@ -1510,7 +1572,7 @@ class _Newton:
             x = self.x[which]
             a, b = self.a[which], self.b[which]
             new = np.clip(x + step, a, b)
-            done = concave & ((np.abs(new - x) <= _NEWTON_DONE_S) | (gain < 0.1 * tolerance))
+            done = concave & ((np.abs(new - x) <= _NEWTON_DONE_S) | (gain < tolerance))
             # At an end, a slope that leaves the cell: the end is the cell's best.
             done |= ((x == a) & (slope < 0.0)) | ((x == b) & (slope > 0.0))
             # Convex where the cubic put its peak: the cell holds no peak of its own,
