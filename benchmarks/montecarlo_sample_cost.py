@@ -14,9 +14,14 @@ venv, e.g. ``git worktree add /work/wt/base98 98b74d4``) runs the same measureme
 its own interpreter; the two alternate, ``--rounds`` times, so that they share the
 machine's load, and each round's ratio is printed beside both costs.
 
-    python -m benchmarks.montecarlo_sample_cost --reference /work/wt/base98
+``--one-day``: the case of ``benchmarks.montecarlo_throughput`` instead (the spinner
+with its thruster pulse over one day at a 10 s output step, dispersed; its file
+written once, read by both trees).
 
-Results: stdout and benchmarks/results/montecarlo_sample_cost.json.
+    python -m benchmarks.montecarlo_sample_cost --reference /work/wt/base98
+    python -m benchmarks.montecarlo_sample_cost --reference /work/wt/base98 --one-day --samples 4
+
+Results: stdout and benchmarks/results/montecarlo_sample_cost.json (``_one_day.json``).
 """
 
 from __future__ import annotations
@@ -26,6 +31,7 @@ import json
 import os
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 HERE = Path(__file__).parent
@@ -87,9 +93,10 @@ print(json.dumps({
 """
 
 
-def _run(python: str, tree: Path, samples: int) -> dict:
+def _run(python: str, tree: Path, samples: int, scenario: Path | None = None) -> dict:
+    path = scenario if scenario is not None else tree / SCENARIO
     result = subprocess.run(
-        [python, "-c", _CHILD, str(tree / SCENARIO), str(samples)],
+        [python, "-c", _CHILD, str(path), str(samples)],
         capture_output=True,
         text=True,
         check=True,
@@ -113,12 +120,24 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--reference", type=Path, required=True, help="the reference tree")
     parser.add_argument("--samples", type=int, default=12)
     parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--one-day", action="store_true", help="the one-day throughput case")
     args = parser.parse_args(argv)
     here = HERE.parent
-    report: dict = {"uptime_at_start": _uptime(), "rounds": []}
+    scenario = None
+    if args.one_day:
+        from benchmarks.montecarlo_throughput import scenario_text
+
+        folder = Path(tempfile.mkdtemp(prefix="montecarlo_sample_cost_"))
+        scenario = folder / "spinner_one_day_dispersions.toml"
+        scenario.write_text(scenario_text(args.samples))
+    report: dict = {
+        "case": "one day" if args.one_day else SCENARIO,
+        "uptime_at_start": _uptime(),
+        "rounds": [],
+    }
     for _ in range(args.rounds):
-        ours = _run(_python(here), here, args.samples)
-        theirs = _run(_python(args.reference), args.reference, args.samples)
+        ours = _run(_python(here), here, args.samples, scenario)
+        theirs = _run(_python(args.reference), args.reference, args.samples, scenario)
         report["rounds"].append(
             {
                 "this_tree": ours["median"],
@@ -132,7 +151,8 @@ def main(argv: list[str] | None = None) -> dict:
         print(json.dumps(report["rounds"][-1]))
     report["uptime_at_end"] = _uptime()
     RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "montecarlo_sample_cost.json").write_text(json.dumps(report, indent=2) + "\n")
+    name = "montecarlo_sample_cost_one_day" if args.one_day else "montecarlo_sample_cost"
+    (RESULTS / f"{name}.json").write_text(json.dumps(report, indent=2) + "\n")
     return report
 
 

@@ -14,7 +14,9 @@ over 20 minutes (``tests/freeze_search_baseline.py``).  Within the precision eac
   trapezoid rule on its grid, across the kinks of max(cos, 0) and of the penumbra
   (the nadir CubeSat's lit fraction was 9e-5 off, where the search now agrees with a
   sampling every 10 ms to 4e-11: test_extrema_against_dense_sampling.py); the eclipses
-  the same.
+  the same;
+- the points a run's limit and the output budget count (64 a turn of the fastest
+  rotation: ``SearchGrid.turn_points``) as many as its grid had: the same spans refused.
 """
 
 from __future__ import annotations
@@ -104,3 +106,15 @@ def test_the_same_intervals_extrema_and_means_as_before(name):
                 assert low.value >= old_low - 1e-8, (item.vector.name, quantity)
                 assert high.value <= old_high + 1e-8, (item.vector.name, quantity)
         assert abs(item.mean_cos_incidence - old["mean_cos_incidence"]) <= 2e-3
+
+
+@pytest.mark.parametrize("name", CASES)
+def test_the_run_limit_counts_the_points_it_counted_before(name):
+    from attitude.pointing.search import search_grid
+
+    before = json.loads((DATA / f"{name}.json").read_text())
+    trajectory, spec = _case(name)
+    grid = search_grid(trajectory, spec)
+    # Its grid spread its points evenly over the span: span / (count - 1) apart.
+    count = round((grid.stop_s - grid.start_s) / before["search_step_s"]) + 1
+    assert grid.turn_points == count

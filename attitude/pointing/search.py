@@ -108,8 +108,9 @@ _MOON_SKY_RATE = 1.1e3 / 3.56e8
 # lit fraction can change is (2/π a) per radian of the discs' relative motion.
 _SUN_LEAST_RADIUS_RAD = SUN_RADIUS_M / 1.53e11
 # The search grid of segments searched on a grid is evaluated this many points at a
-# time (bounded memory), and a run searches at most this many points (nodes of the
-# torque-free search and points of the grid).
+# time (bounded memory), and a run searches a span of at most this many points at 64 a
+# turn of its fastest rotation (SearchGrid.turn_points: the torque-free search needs
+# about a seventh of them).
 CHUNK_POINTS = 65_536
 MAX_SEARCH_POINTS = 100_000_000
 # Extrema: refined to 1 µs, and a bracket that could improve the best by less than
@@ -154,6 +155,15 @@ class SearchGrid:
     vector_rates_rad_s: dict[str, float] = field(default_factory=dict, compare=False)
     grid_step_s: float = 0.0
     plans: tuple[FreePlan | None, ...] = field(default=(), compare=False)
+
+    @property
+    def turn_points(self) -> int:
+        """Points at 64 a turn of the fastest rotation over the span (every
+        ``grid_step_s``): the measure of what a span holds (about two intervals a turn of
+        each vector) that the limit of a run (:data:`MAX_SEARCH_POINTS`) and the output
+        budget (``attitude.outputs.budget``) count, whichever way it is searched."""
+        step = self.grid_step_s if self.grid_step_s > 0.0 else self.step_s
+        return max(math.ceil((self.stop_s - self.start_s) / step) + 1, 2)
 
     @property
     def _geometry_rate(self) -> float:
@@ -389,10 +399,10 @@ def check_pointing(
                 key=orbit.key,
             )
     grid = search_grid(trajectory, spec)
-    if grid.count > MAX_SEARCH_POINTS:
+    if grid.turn_points > MAX_SEARCH_POINTS:
         raise InputError(
-            f"the pointing's search needs {grid.count:.3g} points over the span "
-            f"(every {grid.step_s:.3g} s at the finest, from the motion's rates), more than "
+            f"the pointing's search needs {grid.turn_points:.3g} points over the span "
+            f"(every {grid.grid_step_s:.3g} s: 64 a turn of the fastest rotation), more than "
             f"the {MAX_SEARCH_POINTS:.0e} one run searches: use a shorter span",
             key=scenario.end_key,
         )
