@@ -11,7 +11,7 @@ intervals found), and the time per day should not grow either.
     python -m benchmarks.pointing_analysis_span
 
 Reported as ratios to the 1/4-day run of the same invocation, with the load average.
-(``grid points``: the search's nodes and grid points, ``SearchGrid.count``.)
+(``search points``: the search's nodes and grid points, ``SearchGrid.count``.)
 """
 
 from __future__ import annotations
@@ -44,7 +44,7 @@ wall = time.process_time() - start
 intervals = sum(len(v.sun_visible) + len(v.sun_exclusion) for v in analysis.vectors)
 peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 print(json.dumps({"days": days, "cpu_s": wall, "peak_mb": peak_mb,
-                  "grid_points": analysis.grid.count, "intervals": intervals}))
+                  "search_points": analysis.grid.count, "intervals": intervals}))
 """
 
 
@@ -66,7 +66,7 @@ def main() -> list[dict]:
         item["cpu_per_day_ratio"] = (item["cpu_s"] / item["days"]) / (base["cpu_s"] / base["days"])
         item["peak_ratio"] = item["peak_mb"] / base["peak_mb"]
         print(
-            f"{item['days']:5g} days: {item['grid_points']:>9} grid points, "
+            f"{item['days']:5g} days: {item['search_points']:>9} search points, "
             f"{item['intervals']:>7} intervals, CPU {item['cpu_s']:.3g} s, per day "
             f"×{item['cpu_per_day_ratio']:.2f}, "
             f"peak RSS ×{item['peak_ratio']:.2f} ({item['peak_mb']:.0f} MB)"

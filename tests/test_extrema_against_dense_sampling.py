@@ -2,9 +2,12 @@
 
 The case of the issue: a 3U CubeSat spinning with a 31 s period, written every 10 s.
 The output grid sees a few points per turn, and its least Sun angle on the star
-tracker is off by 0.7°; ``pointing_analysis`` searches the exact motion on its own grid
-(64 points per turn of the fastest rotation) and narrows every bracket by golden-section
-search.  The reference samples every 0.1 s (100× the output step) over the same span.
+tracker is off by 0.7°; ``pointing_analysis`` searches the exact motion on its own
+nodes (attitude.pointing.free_search: bounds from the motion's structure, then Newton's
+method or golden-section search in every cell that could beat the best value), or on a
+grid of 64 points a turn of the fastest rotation (the search of segments under
+torques; the chunks' test runs this case both ways).  The reference samples every
+0.1 s (100× the output step) over the same span.
 
 A sampled extremum is never more extreme than the true one, so the analysis must be at
 least as extreme as every sample.  And within 0.01° of the reference: the extreme sample
