@@ -1,6 +1,6 @@
 """The pointing search against the search before the structural one, frozen.
 
-``tests/data/search_baseline`` holds what ``pointing_analysis`` found at commit 32e953e
+``tests/data/search_baseline`` holds what ``pointing_analysis`` found at commit 395033d
 (every segment on a grid of 64 points a turn, golden-section extrema, the exact
 surroundings at every point) on the examples with a pointing and on the issue's tumbler
 over 20 minutes (``tests/freeze_search_baseline.py``).  Within the precision each states:
