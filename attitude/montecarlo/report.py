@@ -319,6 +319,8 @@ def _plot_histograms(result: MonteCarloResult, names, stats, path: Path) -> str:
     panels = np.atleast_1d(figure.subplots(rows, columns, squeeze=False).ravel())
     for axes, name in zip(panels, names, strict=False):
         values = drawn_spread(ok[name].to_numpy(float), stated_precision(name, result.plan, ok))
+        if values is None:  # not spread: _histogram_columns leaves such a metric out
+            continue
         axes.hist(values, bins=int(np.clip(np.sqrt(values.size), 10, 60)), color="C0", alpha=0.8)
         entry = stats["metrics"][name]
         for p, style in (("1", ":"), ("50", "-"), ("99", ":")):

@@ -144,7 +144,7 @@ def estimate(
     return OutputBudget(samples, search_grid_points, memory, files)
 
 
-def available_memory_bytes() -> int:
+def available_memory_bytes() -> float:
     """The memory available to a new allocation now: ``MemAvailable`` from
     /proc/meminfo (Linux: free memory plus the caches that can be dropped), else the
     free physical pages; unbounded if the system says neither."""
@@ -206,7 +206,7 @@ def check_fits(
         return
     free = free_disk_bytes(out_dir)
     if budget.disk_bytes > DISK_SHARE * free:
-        largest = max(budget.files, key=budget.files.get)
+        largest = max(budget.files, key=budget.files.__getitem__)
         raise ResourceError(
             f"{budget.samples} samples would take about {_size(budget.disk_bytes)} "
             f"({largest} {_size(budget.files[largest])}), and the disk of "

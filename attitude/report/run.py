@@ -406,9 +406,12 @@ def _search_pointing(
 ) -> PointingAnalysis:
     """The pointing's intervals and extrema over the span, on the exact motion; the
     intervals written to intervals.csv."""
+    search = plan.search
+    if search is None:
+        raise ValueError("the plan has no pointing search")
     progress(
-        f"pointing: intervals and extrema on the exact motion ({plan.search.count} "
-        f"search points, every {plan.search.step_s:.3g} s); writing intervals.csv"
+        f"pointing: intervals and extrema on the exact motion ({search.count} "
+        f"search points, every {search.step_s:.3g} s); writing intervals.csv"
     )
     analysis = pointing.analysis()
     write_intervals_csv(
@@ -429,6 +432,8 @@ def _write_aem(
     """attitude.aem over the records the plan chose for its tolerance; the plan with
     the error measured on them."""
     scenario, aem = plan.scenario, plan.aem
+    if aem is None:
+        raise ValueError("the plan writes no attitude.aem")
     progress(
         f"writing attitude.aem (CCSDS AEM 2.0): {aem.records} records, "
         f"{INTERPOLATION_METHOD} to {aem.tolerance_rad:g} rad"
