@@ -1,12 +1,12 @@
 """Attitude under external torques: splitting with the exact free flow (``TorquedSolver``).
 
-The equations of a rigid body under a torque τ(t, R, ω),
+The equations of a rigid body under a torque Γ(t, R, ω),
 
-    dm/dt = m × ω + τ,   dq/dt = ½ q ⊗ (0, ω),   ω = I⁻¹ m   (body axes),
+    dm/dt = m × ω + Γ,   dq/dt = ½ q ⊗ (0, ω),   ω = I⁻¹ m   (body axes),
 
 are split into the free rigid body, whose flow is exact (:mod:`attitude.solver.free_flow`,
 after Celledoni, Fassò, Säfström and Zanna, whose paper's title names this use), and
-the kick dm/dt = τ with the attitude and the clock frozen, exact for any torque that
+the kick dm/dt = Γ with the attitude and the clock frozen, exact for any torque that
 does not depend on ω (see :mod:`attitude.torques.models`).  A composition of the two
 (:mod:`attitude.torques.splitting`) gives a method whose error is proportional to the torque,
 not to the spin, and which is the exact solver when the torque vanishes.  For
@@ -156,16 +156,16 @@ class _Engine:
         ω = (m[0] / I1, m[1] / I2, m[2] / I3)
         total = (0.0, 0.0, 0.0)
         for model, row in zip(self.torques, data, strict=True):
-            τ = model.principal_torque(row, q, ω, self.frame)
-            total = (total[0] + τ[0], total[1] + τ[1], total[2] + τ[2])
+            torque = model.principal_torque(row, q, ω, self.frame)
+            total = (total[0] + torque[0], total[1] + torque[1], total[2] + torque[2])
         return total
 
     def kick(self, data, m, q, w):
         """m after the kick of duration w (s) at frozen attitude and clock."""
         k1 = self.torque(data, m, q)
-        if not self.rk4:  # τ does not depend on m: the kick is exact
+        if not self.rk4:  # Γ does not depend on m: the kick is exact
             return (m[0] + w * k1[0], m[1] + w * k1[1], m[2] + w * k1[2])
-        # Classical Runge–Kutta on dm/dt = τ(t, R, I⁻¹m), R and t frozen.
+        # Classical Runge–Kutta on dm/dt = Γ(t, R, I⁻¹m), R and t frozen.
         h2 = 0.5 * w
         k2 = self.torque(data, tuple(m[i] + h2 * k1[i] for i in range(3)), q)
         k3 = self.torque(data, tuple(m[i] + h2 * k2[i] for i in range(3)), q)

@@ -18,7 +18,7 @@ they need not care which one propagated it:
   for is a bound on the body rate (|ω| ≤ G/I_min, |ω|² ≤ 2T/I_min), so here they are
   the **largest** |m| and T over the segment: the largest at the solver's grid points
   plus twice the largest change between two of them (both change smoothly, by at most
-  |τ| h over a step);
+  |Γ| h over a step);
 - ``error_estimate``: the run's estimated attitude error within the segment (rad),
   errors carried from earlier segments included, set by the trajectory.
 
