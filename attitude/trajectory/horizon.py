@@ -33,9 +33,9 @@ import numpy as np
 
 from attitude.scenario.scenario import Scenario
 from attitude.scenario.torques import ScenarioTorques
-from attitude.torques.models import MU_EARTH_M3_S2
+from attitude.torques.models import MU_EARTH_M3_S2, GravityGradient
 from attitude.torques.solver import angles_between, first_crossing
-from attitude.trajectory.torqued import scenario_torque_models
+from attitude.trajectory.torqued import TorquedMotion, scenario_torque_models
 from attitude.trajectory.trajectory import Trajectory, propagate
 
 __all__ = ["MAX_HORIZON_STEPS", "ValidityHorizon", "validity_horizon"]
@@ -117,6 +117,8 @@ def _step(trajectory: Trajectory, orbit: Any) -> float:
     scenario = trajectory.scenario
     with_orbit = scenario.with_torques(ScenarioTorques(gravity_gradient=orbit))
     gradient = scenario_torque_models(with_orbit)[0][2]
+    if not isinstance(gradient, GravityGradient):
+        raise TypeError(f"the first torque model is the gravity gradient, got {gradient!r}")
     radius = float(np.linalg.norm(gradient.position(np.array([0.0]))[0]))
     candidates.append(2.0 * math.pi * math.sqrt(radius**3 / MU_EARTH_M3_S2) * _ORBIT_FRACTION)
     return min(candidates)
@@ -141,7 +143,7 @@ def validity_horizon(trajectory: Trajectory, orbit: Any) -> ValidityHorizon:
         horizon_threshold=threshold,
     )
     torqued = propagate(_truncated(scenario, searched).with_torques(torques))
-    run_step = max(segment.solver.step for segment in torqued.segments)
+    run_step = max(s.solver.step for s in torqued.segments if isinstance(s.solver, TorquedMotion))
 
     def angle(t):
         return angles_between(torqued.attitude_quaternion(t), trajectory.attitude_quaternion(t))
