@@ -29,7 +29,11 @@ Segments without a period are stated as what they are (``SegmentMotion.motion``)
   body turns over at most once (at u = 0) and nothing repeats;
 - ``"rest"``: G = 0;
 - ``"torqued"``: a segment under torques (``attitude.trajectory.torqued``): no period and
-  no closed form; its energy and momentum are given at its start.
+  no closed form; its energy and momentum are given at its start; ``"gyrostat"``: a body
+  with spinning wheels and no torque, likewise;
+- ``"guided"`` and ``"slew"``: a segment under an attitude law or a slew
+  (``attitude.trajectory.guided``): the attitude is the law's, not a motion of its own;
+  its energy and momentum (I·ω) are given at its start.
 Flips are counted from the closed form without listing them all: at most
 :data:`LISTED_FLIPS` flip times are kept (a day of a fast tumbler has millions).
 """
@@ -44,6 +48,7 @@ from numpy.typing import NDArray
 
 from attitude.base.vectors import basis_across
 from attitude.solver.euler_solver import EulerSolver
+from attitude.trajectory.guided import GuidedMotion
 from attitude.trajectory.torqued import TorquedMotion
 from attitude.trajectory.trajectory import Segment, Trajectory
 
@@ -64,7 +69,8 @@ class SegmentMotion:
     start_s: float
     end_s: float
     formula: str
-    motion: str  # "periodic", "steady spin", "separatrix", "rest" or "torqued"
+    motion: str  # "periodic", "steady spin", "separatrix", "rest", "torqued", "gyrostat",
+    # "guided" or "slew"
     period_s: float  # inf when the motion has no period
     flip_count: int
     flip_times_s: NDArray[np.float64]  # the first LISTED_FLIPS of them
@@ -155,13 +161,14 @@ def _flips(segment: Segment) -> tuple[int, NDArray[np.float64], float | None]:
     return count, listed[:LISTED_FLIPS], half
 
 
-def _torqued_motion(segment: Segment, solver: TorquedMotion) -> SegmentMotion:
-    """A segment under torques: its state at the start; no period, flips or cone."""
+def _torqued_motion(segment: Segment, solver: TorquedMotion | GuidedMotion) -> SegmentMotion:
+    """A segment under torques, with spinning wheels, or under a law or a slew: its state
+    at the start; no period, flips or cone."""
     return SegmentMotion(
         start_s=segment.start_s,
         end_s=segment.end_s,
-        formula="torqued",
-        motion="torqued",
+        formula=solver.formula,
+        motion=solver.formula,
         period_s=math.inf,
         flip_count=0,
         flip_times_s=np.empty(0),
@@ -179,7 +186,7 @@ def _torqued_motion(segment: Segment, solver: TorquedMotion) -> SegmentMotion:
 
 
 def _segment_motion(segment: Segment) -> SegmentMotion:
-    if isinstance(segment.solver, TorquedMotion):
+    if isinstance(segment.solver, TorquedMotion | GuidedMotion):
         return _torqued_motion(segment, segment.solver)
     solver = _free_solver(segment)
     count, flips, flip_period = _flips(segment)

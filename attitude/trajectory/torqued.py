@@ -95,7 +95,9 @@ class _OrbitAtEpoch:
         return repr(self.orbit)
 
 
-def _refuse_a_long_search(state: State, t0: float, span: float, torques) -> None:
+def _refuse_a_long_search(
+    state: State, t0: float, span: float, torques, wheel_momentum: NDArray | None = None
+) -> None:
     """Refuse a step search whose first try alone would take more than MAX_STEPS steps.
 
     The search (``TorquedSolver``) first runs the span at half a quarter turn of the
@@ -105,6 +107,9 @@ def _refuse_a_long_search(state: State, t0: float, span: float, torques) -> None
     """
     I_min = float(np.min(state.inertia.moments))
     rate = math.sqrt(2.0 * state.kinetic_energy / I_min)
+    if wheel_momentum is not None:  # the gyroscopic turn |I⁻¹h| (attitude.torques.gyrostat)
+        gyroscopic = np.linalg.solve(state.inertia.tensor, wheel_momentum)
+        rate = max(rate, float(np.linalg.norm(gyroscopic)))
     impulse = sum(
         float(np.linalg.norm(torque.torque))
         * max(0.0, min(torque.stop, t0 + span) - max(torque.start, t0))
@@ -130,8 +135,10 @@ class TorquedMotion:
     """One segment [t0, end_s] under ``torques`` (models), from ``state`` at ``t0``.
 
     ``settings``: the scenario's :class:`ScenarioTorques` (step or accuracy, order).
-    Times within a nanosecond before ``t0`` (which the trajectory counts as ``t0``) are
-    evaluated at ``t0``.
+    ``wheel_momentum``: wheels spinning at constant speed relative to the body, their
+    momentum h (body axes, N m s): a gyrostat (:mod:`attitude.torques.gyrostat`), whose
+    ``state.angular_momentum`` is the total M = Iω + h.  Times within a nanosecond
+    before ``t0`` (which the trajectory counts as ``t0``) are evaluated at ``t0``.
     """
 
     formula = "torqued"
@@ -144,15 +151,19 @@ class TorquedMotion:
         end_s: float,
         torques: list[Torque],
         settings: ScenarioTorques,
+        wheel_momentum: NDArray[np.float64] | None = None,
     ) -> None:
         self.state = state
+        self.wheel_momentum = wheel_momentum
+        # Spinning wheels alone: the torque-free gyrostat (attitude.torques.gyrostat).
+        self.formula = "gyrostat" if wheel_momentum is not None and not torques else "torqued"
         self.end_s = float(end_s)
         self.torques = tuple(torques)
         self.settings = settings
         span = self.end_s - t0
         options: dict[str, Any] = {"order": settings.order}
         if settings.step is None and span > _SHORTEST_SEARCH_S:
-            _refuse_a_long_search(state, t0, span, self.torques)
+            _refuse_a_long_search(state, t0, span, self.torques, wheel_momentum)
             options.update(tolerance=settings.accuracy_rad, span=span)
         else:
             options["step"] = settings.step if settings.step is not None else max(span, 1.0)
@@ -162,6 +173,7 @@ class TorquedMotion:
             state.attitude,
             t0,
             list(torques),
+            wheel_momentum=wheel_momentum,
             **options,
         )
         self._last: tuple[NDArray, NDArray, NDArray] | None = None
@@ -191,6 +203,8 @@ class TorquedMotion:
 
     def angular_velocity(self, t: ArrayLike) -> NDArray[np.float64]:
         m = self._states(t)[0]
+        if self.wheel_momentum is not None:  # a gyrostat: ω = I⁻¹(M − h)
+            m = m - self.wheel_momentum
         return np.linalg.solve(self.state.inertia.tensor, m[..., None])[..., 0]
 
     def inertial_angular_momentum_at(self, t: ArrayLike) -> NDArray[np.float64]:
@@ -247,6 +261,9 @@ class TorquedMotion:
 
     @property
     def initial_kinetic_energy(self) -> float:
+        if self.wheel_momentum is not None:
+            ω = self.angular_velocity(np.array([self.t0, self.t0]))[0]
+            return 0.5 * float(ω @ self.state.inertia.tensor @ ω)
         return self.state.kinetic_energy
 
     @property
@@ -278,6 +295,7 @@ class TorquedMotion:
             list(self.torques),
             step=2.0 * self.solver.step,
             order=self.settings.order,
+            wheel_momentum=self.wheel_momentum,
         )
         checks = self.t0 + span * np.linspace(1.0 / _CHECKS, 1.0, _CHECKS)
         difference = angles_between(

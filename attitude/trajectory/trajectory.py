@@ -31,6 +31,8 @@ from attitude.scenario.events import Event, State
 from attitude.scenario.scenario import Scenario
 from attitude.solver.euler_solver import EulerSolver
 from attitude.torques.solver import angles_between
+from attitude.trajectory.guided import GuidedMotion
+from attitude.trajectory.modes import ModeTimeline, mode_segments, uses_laws
 from attitude.trajectory.torqued import TorquedMotion, scenario_torque_models
 
 if TYPE_CHECKING:  # astropy loads only when a Time is made
@@ -52,7 +54,7 @@ class Segment:
 
     start_s: float
     end_s: float
-    solver: EulerSolver | TorquedMotion
+    solver: EulerSolver | TorquedMotion | GuidedMotion
     state: State
     event: Event | None = None
     before: State | None = None
@@ -128,6 +130,18 @@ def propagate(scenario: Scenario, steps: list[float | None] | None = None) -> Tr
     whose motion the solver refuses, or that turns too fast for TT seconds (floats)
     to follow over the span.
     """
+    models = scenario_torque_models(scenario) if scenario.torques.any else []
+    if uses_laws(scenario):  # laws, slews and control losses: attitude.trajectory.modes
+        timeline = mode_segments(
+            scenario,
+            steps or [],
+            lambda state, t0, end, where, step: _solver(
+                state, t0, end, where, scenario, models, step
+            ),
+            _check_resolved,
+            models,
+        )
+        return Trajectory(scenario, [Segment(*raw) for raw in timeline.segments], timeline)
     initial = scenario.initial_state
     axes = scenario.spacecraft.principal_axes
     if initial.angular_momentum is not None:
@@ -135,10 +149,10 @@ def propagate(scenario: Scenario, steps: list[float | None] | None = None) -> Tr
     else:  # InitialState holds exactly one of the two (checked when it is made)
         assert initial.angular_velocity is not None
         m0 = axes.tensor @ initial.angular_velocity
+    assert initial.attitude is not None  # without a law, the attitude is given
     state = State(initial.attitude, m0, axes)
     starts: list[tuple[float, State, Event | None, State | None]] = [(0.0, state, None, None)]
     ends = [offset for offset, _ in scenario.events] + [scenario.stop_s]
-    models = scenario_torque_models(scenario) if scenario.torques.any else []
     steps = steps or [None] * len(ends)
     solver = _solver(state, 0.0, ends[0], "initial_state", scenario, models, steps[0])
     _check_resolved(solver, 0.0, ends[0], "initial_state")
@@ -170,9 +184,13 @@ class Trajectory:
     body axes unless the name says inertial.
     """
 
-    def __init__(self, scenario: Scenario, segments: list[Segment]) -> None:
+    def __init__(
+        self, scenario: Scenario, segments: list[Segment], modes: ModeTimeline | None = None
+    ) -> None:
         self.scenario = scenario
         self.segments = segments
+        # With attitude laws: the notes and ground-site passes (attitude.trajectory.modes).
+        self.modes = modes
         # Segment k is in force from _starts[k] on (an event's epoch gets its post-event state).
         self._starts = np.array([segment.start_s for segment in segments]) - _SPAN_TOLERANCE_S
         self._starts[0] = -np.inf
@@ -254,7 +272,7 @@ class Trajectory:
         """Angular momentum in inertial axes, N m s (constant within a torque-free segment)."""
 
         def evaluate(solver, τ):
-            if isinstance(solver, TorquedMotion):
+            if isinstance(solver, TorquedMotion | GuidedMotion):
                 return solver.inertial_angular_momentum_at(τ)
             return np.tile(solver.inertial_angular_momentum, (τ.size, 1))
 
@@ -264,7 +282,7 @@ class Trajectory:
         """Rotational kinetic energy, J (constant within a torque-free segment)."""
 
         def evaluate(solver, τ):
-            if isinstance(solver, TorquedMotion):
+            if isinstance(solver, TorquedMotion | GuidedMotion):
                 return solver.kinetic_energy_at(τ)[:, None]
             return np.full((τ.size, 1), solver.kinetic_energy)
 

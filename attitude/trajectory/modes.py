@@ -1,0 +1,369 @@
+"""The segments of a scenario with attitude laws: guided, slewing, free, torqued.
+
+A scenario that starts under a law (``InitialState(law=...)``) or has mode events
+(:mod:`attitude.scenario.modes`) is propagated here, event by event, into segments of
+four kinds:
+
+- **guided**: the attitude is a law's (:class:`~attitude.trajectory.guided.GuidedMotion`
+  over a :class:`~attitude.laws.align_constrain.BoundLaw`, bound per segment, so that the
+  Sun and the Moon are sampled over that segment only);
+- **slew**: a :class:`~attitude.laws.slews.Slew` from the state at a ``mode_change``
+  or a ``control_resume`` onto the new law, ending before the next event (refused in one
+  line otherwise); then the law, guided, to the next event;
+- **free**: after a ``control_loss``, the exact hand-off
+  (:mod:`attitude.trajectory.handoff`): the exact solver (locked wheels), the splitting
+  with the gyroscopic flow (spinning wheels), or the torqued solver where the
+  scenario's torques act;
+- the scenario's other events act as they do on a free body (an angular impulse, an
+  attitude reset, an inertia change); on a guided body only an inertia change is
+  accepted (the law holds on; its I·ω changes), the others refused in one line.
+
+The scenario's torques act on the free segments only: while a law holds the
+attitude, its controller absorbs them.  Every segment boundary is a non-smooth
+instant of the attitude or its rate (a mode change, a slew's start and end, a control
+loss or resume), and each is a segment of the AEM.
+
+:func:`mode_segments` returns the segments as tuples for
+:mod:`attitude.trajectory.trajectory`, which hands in its own builder of free and
+torqued solvers (so that both paths make them alike).  A ground site a law tracks is
+checked for visibility over its segment: one that never rises above the horizon is a
+note (:attr:`ModeTimeline.notes`), stated by ``check`` and in the summary.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from attitude.base.errors import InputError
+from attitude.environment.timescales import SAME_INSTANT_S
+from attitude.laws.align_constrain import BoundLaw
+from attitude.laws.slews import Slew
+from attitude.laws.visibility import ground_site, visible_intervals
+from attitude.scenario.events import AttitudeReset, InertiaChange, State
+from attitude.scenario.modes import MODE_EVENTS, ControlLoss, ControlResume, ModeChange, Wheels
+from attitude.scenario.scenario import Scenario
+from attitude.solver.inertia import PrincipalAxes
+from attitude.trajectory.guided import GuidedMotion
+from attitude.trajectory.torqued import TorquedMotion
+
+__all__ = ["ModeTimeline", "mode_segments", "uses_laws"]
+
+# (start, end, solver, state, event, before): what trajectory.Segment holds.
+RawSegment = tuple[float, float, Any, State, Any, State | None]
+
+
+def uses_laws(scenario: Scenario) -> bool:
+    """True if the scenario starts under a law or has a mode event."""
+    if getattr(scenario.initial_state, "law", None) is not None:
+        return True
+    return any(event.kind in MODE_EVENTS for _, event in scenario.events)
+
+
+@dataclass
+class ModeTimeline:
+    """The segments of a scenario with laws, and what the run should say about them:
+    ``notes`` (a ground site never visible, the Earth orientation table's coverage)
+    and, per guided segment index, the visibility of the ground site its law tracks."""
+
+    segments: list[RawSegment]
+    notes: list[str] = field(default_factory=list)
+    visibility: dict[int, list[tuple[float, float]]] = field(default_factory=dict)
+
+
+def _orbit(scenario: Scenario) -> Any:
+    """The scenario's orbit (None without one)."""
+    return getattr(scenario, "orbit", None)
+
+
+class _Builder:
+    """Walks the events, keeping the mode (guided or free) and the segments made."""
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        steps: list[float | None],
+        free_solver: Callable[..., Any],
+        check_resolved: Callable[..., None],
+    ) -> None:
+        self.scenario = scenario
+        self.steps = steps
+        self.free_solver = free_solver
+        self.check_resolved = check_resolved
+        self.orbit = _orbit(scenario)
+        self.timeline = ModeTimeline([])
+        self.wheels: Wheels | None = None  # spinning wheels of the free body, or None
+        self.law_key = ""
+
+    # ---- helpers
+
+    def where(self, index: int, offset: float, event: Any) -> str:
+        return f"events[{index}] ({event.kind} at {self.scenario.format_epoch(offset)})"
+
+    def step_for(self) -> float | None:
+        k = len(self.timeline.segments)
+        return self.steps[k] if k < len(self.steps) else None
+
+    def add(self, start: float, end: float, solver: Any, state: State, event, before) -> None:
+        self.timeline.segments.append((start, end, solver, state, event, before))
+
+    def bind(self, law: Any, start: float, end: float, key: str) -> BoundLaw:
+        bound = law.bind(self.scenario.epoch, start, end, self.orbit, key)
+        for note in bound.notes:
+            if note not in self.timeline.notes:
+                self.timeline.notes.append(note)
+        return bound
+
+    def guided(
+        self, profile: BoundLaw | Slew, inertia: PrincipalAxes, start: float, end: float, key: str
+    ) -> GuidedMotion:
+        motion = GuidedMotion(profile, inertia, start, end, key)
+        self.check_resolved(motion, start, end, key)
+        return motion
+
+    def visibility(self, motion: GuidedMotion, index: int) -> None:
+        """The ground site of a target law: its passes over the segment; a note when
+        it never rises above the horizon there."""
+        bound = motion.bound_law
+        try:
+            site = ground_site(bound)
+        except InputError:
+            return
+        a, b = motion.t0, motion.end_s
+        if b - a <= SAME_INSTANT_S:
+            return
+        passes = [
+            (max(p0, a), min(p1, b))
+            for p0, p1 in visible_intervals(bound, 0.0)
+            if p1 > a and p0 < b
+        ]
+        self.timeline.visibility[index] = passes
+        if not passes:
+            fmt = self.scenario.format_epoch
+            self.timeline.notes.append(
+                f"{motion.key}: {site.name} never rises above the horizon between {fmt(a)} and "
+                f"{fmt(b)}: the law points the body through the Earth at it the whole time"
+            )
+
+    # ---- the law's stretches
+
+    def law_stretch(
+        self,
+        law: Any,
+        key: str,
+        inertia: PrincipalAxes,
+        start: float,
+        end: float,
+        event: Any,
+        before: State | None,
+        limits: Any = None,
+        deadline_text: str = "",
+    ) -> State:
+        """The law from ``start`` to ``end``: first a slew within ``limits`` from the
+        state ``before`` (its attitude, and the rate the last segment ended with) when
+        limits are given, then the law itself.  Returns the state at ``end``."""
+        bound = self.bind(law, start, end, key)
+        t = start
+        if limits is not None and before is not None:
+            slew = Slew(
+                start,
+                before.attitude,
+                self.rate_before,
+                bound,
+                limits,
+                end,
+                key=f"{key.rsplit('.', 1)[0]}.slew",
+                deadline_text=deadline_text,
+                format_epoch=self.scenario.format_epoch,
+            )
+            motion = self.guided(slew, inertia, start, slew.end_s, key)
+            self.add(start, slew.end_s, motion, motion.state, event, before)
+            t = slew.end_s
+        if t == start or end - t > SAME_INSTANT_S:
+            motion = self.guided(bound, inertia, t, end, key)
+            # After a slew the law takes over without an event of its own.
+            self.add(t, end, motion, motion.state, event, before if t == start else None)
+            self.visibility(motion, len(self.timeline.segments) - 1)
+        return self.state_at(end)
+
+    def state_at(self, t: float) -> State:
+        """The state at ``t`` of the last segment (the state just before an event)."""
+        solver = self.timeline.segments[-1][2]
+        pair = np.array([t, t])
+        attitude = solver.attitude(pair)[0]
+        momentum = solver.angular_momentum(pair)[0]
+        self.rate_before = solver.angular_velocity(pair)[0]
+        inertia = self.timeline.segments[-1][3].inertia
+        return State(attitude, momentum, inertia)
+
+    # ---- the free stretches
+
+    def free_stretch(
+        self, state: State, start: float, end: float, where: str, event: Any, before: State | None
+    ) -> State:
+        if self.wheels is not None:
+            solver = self.gyrostat(state, start, end, where)
+        else:
+            solver = self.free_solver(state, start, end, where, self.step_for())
+        self.check_resolved(solver, start, end, where)
+        self.add(start, end, solver, state, event, before)
+        return self.state_at(end)
+
+    def gyrostat(self, state: State, start: float, end: float, where: str) -> TorquedMotion:
+        """The free body with spinning wheels from ``state`` (M total): the splitting
+        with the gyroscopic flow, under the scenario's torques acting in [start, end]."""
+        assert self.wheels is not None
+        acting = [m for a, b, m in self.models if a < end and b > start]
+        settings = self.scenario.torques
+        step = self.step_for()
+        if step is not None:
+            import dataclasses
+
+            settings = dataclasses.replace(settings, step=step, accuracy=None)
+        if settings.order == 6:
+            raise InputError(
+                f"torques.order: 6 keeps its order only without a gyroscopic term, and {where} "
+                "leaves the wheels spinning: give order 2 or 4"
+            )
+        try:
+            return TorquedMotion(state, start, end, acting, settings, self.wheels.momentum_vector)
+        except InputError as exc:
+            raise InputError(f"{where}: {exc}") from None
+
+    # ---- the walk
+
+    def build(self, models: list) -> ModeTimeline:
+        scenario = self.scenario
+        self.models = models
+        initial = scenario.initial_state
+        axes = scenario.spacecraft.principal_axes
+        self.inertia0 = axes
+        ends = [offset for offset, _ in scenario.events] + [scenario.stop_s]
+        indices = list(getattr(scenario, "event_indices", range(len(scenario.events))))
+        law = getattr(initial, "law", None)
+        first_end = ends[0]
+        if law is not None:
+            self.law_key = "initial_state.law"
+            state = self.law_stretch(law, self.law_key, axes, 0.0, first_end, None, None)
+            guided = True
+        else:  # InitialState holds an attitude and one rate (checked when it is made)
+            assert initial.attitude is not None
+            if initial.angular_momentum is not None:
+                m0 = initial.angular_momentum
+            else:
+                assert initial.angular_velocity is not None
+                m0 = axes.tensor @ initial.angular_velocity
+            state = self.free_stretch(
+                State(initial.attitude, m0, axes), 0.0, first_end, "initial_state", None, None
+            )
+            guided = False
+        for k, ((offset, event), index) in enumerate(zip(scenario.events, indices, strict=True)):
+            end = ends[k + 1]
+            where = self.where(index, offset, event)
+            following = (
+                f"the next event, events[{indices[k + 1]}]"
+                if k + 1 < len(indices)
+                else "the end of the span"
+            )
+            before = state
+            if guided:
+                state, guided = self.on_guided(event, index, where, before, offset, end, following)
+            else:
+                state, guided = self.on_free(event, index, where, before, offset, end, following)
+        return self.timeline
+
+    def on_guided(self, event, index, where, before, offset, end, following):
+        key = f"events[{index}]"
+        if isinstance(event, ModeChange):
+            self.law_key = f"{key}.law"
+            state = self.law_stretch(
+                event.law,
+                self.law_key,
+                before.inertia,
+                offset,
+                end,
+                event,
+                before,
+                event.slew,
+                following,
+            )
+            return state, True
+        if isinstance(event, InertiaChange):  # the law holds on, with the new I·ω
+            law = self.timeline.segments[-1][2].law
+            state = self.law_stretch(law, self.law_key, event.inertia, offset, end, event, before)
+            return state, True
+        if isinstance(event, ControlLoss):
+            wheels = event.wheels
+            wheels.check_against(before.inertia.tensor, key)
+            rate = self.rate_before
+            momentum = before.inertia.tensor @ rate + wheels.momentum_vector
+            after = State(before.attitude, momentum, before.inertia)
+            self.wheels = wheels if wheels.case == "spinning" else None
+            where_after = f"the state after {where}"
+            return self.free_stretch(after, offset, end, where_after, event, before), False
+        if isinstance(event, ControlResume):
+            raise InputError(
+                f"{where}: control is not lost at that epoch (a law holds the attitude): use "
+                "mode_change to change law"
+            )
+        raise InputError(
+            f"{where}: an {event.kind} needs a free body, and a law holds the attitude at "
+            "that epoch (its controller would absorb it): put a control_loss before it"
+        )
+
+    def on_free(self, event, index, where, before, offset, end, following):
+        key = f"events[{index}]"
+        if isinstance(event, ControlResume):
+            self.wheels = None  # the controller has the wheels again
+            self.law_key = f"{key}.law"
+            state = self.law_stretch(
+                event.law,
+                self.law_key,
+                before.inertia,
+                offset,
+                end,
+                event,
+                before,
+                event.slew,
+                following,
+            )
+            return state, True
+        if isinstance(event, ModeChange | ControlLoss):
+            advice = (
+                "use control_resume to return to a law"
+                if isinstance(event, ModeChange)
+                else "it is already lost"
+            )
+            raise InputError(
+                f"{where}: control is lost at that epoch (since an earlier control_loss): {advice}"
+            )
+        after = event.apply(before)
+        if (
+            self.wheels is not None
+            and isinstance(event, AttitudeReset)
+            and event.angular_velocity is not None
+        ):  # the total momentum of a gyrostat turning at ω is Iω + h
+            momentum = after.angular_momentum + self.wheels.momentum_vector
+            after = State(after.attitude, momentum, after.inertia)
+        state = self.free_stretch(after, offset, end, f"the state after {where}", event, before)
+        return state, False
+
+
+def mode_segments(
+    scenario: Scenario,
+    steps: list[float | None],
+    free_solver: Callable[..., Any],
+    check_resolved: Callable[..., None],
+    models: list,
+) -> ModeTimeline:
+    """The segments of ``scenario`` (which uses laws: :func:`uses_laws`), in time order.
+
+    ``steps``: per segment, the torqued solver's step (None: as the scenario says);
+    ``free_solver(state, t0, end, where, step)``: the free or torqued solver from a
+    state; ``check_resolved(solver, t0, end, where)``: refuses motion too fast for TT
+    seconds; ``models``: the scenario's torques as (start, stop, model).
+    """
+    return _Builder(scenario, steps, free_solver, check_resolved).build(models)
