@@ -181,6 +181,8 @@ def _describe(loaded, plan, out: Path | None = None) -> str:
         f"  spacecraft  {craft.name}, principal moments {craft.principal_moments.tolist()} kg m²",
     ]
     initial = scenario.initial_state
+    if initial.law is not None:
+        lines.append(f"  law         {initial.law.name}: {initial.law.describe()} (at the epoch)")
     if initial.angular_velocity is not None:
         lines.append(
             "  rate        "
@@ -189,7 +191,9 @@ def _describe(loaded, plan, out: Path | None = None) -> str:
     for index, item in enumerate(plan.motion):
         period = "" if math.isinf(item.period_s) else f", body period {item.period_s:.6g} s"
         flips = f", {item.flip_count} flips" if item.flip_count else ""
-        how = "splitting" if item.formula == "torqued" else f"formula {item.formula}"
+        how = "splitting" if item.formula in ("torqued", "gyrostat") else f"formula {item.formula}"
+        if item.formula in ("guided", "slew"):  # a law holds the attitude
+            how = plan.trajectory.segments[index].solver.describe()
         lines.append(
             f"  segment {index}   from {scenario.format_epoch(item.start_s)}: {item.motion} "
             f"({how}{period}{flips})"
@@ -197,6 +201,9 @@ def _describe(loaded, plan, out: Path | None = None) -> str:
     from attitude.report.torques import torques_lines
 
     lines += [f"  {line}" for line in torques_lines(plan)]
+    from attitude.report.guidance import guidance_lines
+
+    lines += [f"  {line}" for line in guidance_lines(plan)]
     lines.append(f"  events      {len(scenario.events)}")
     lines += [
         f"    {scenario.format_epoch(t)} (+{t:.12g} s)  {event.kind}"

@@ -630,7 +630,9 @@ def scenario_from_document(path: Path, document: dict[str, Any]) -> ScenarioFile
     output.allow("start", "stop", "duration", "step", "formats", "aem_tolerance")
     span = _span(output, scale)
     try:
-        scenario = Scenario(name, spacecraft, epoch, state, events, **span, torques=torques)
+        scenario = Scenario(
+            name, spacecraft, epoch, state, events, **span, torques=torques, orbit=pointing.orbit
+        )
     except InputError as exc:
         end = "stop" if span["stop"] is not None else "duration"
         raise ScenarioFileError(f"{path.name}: {_scenario_key(str(exc), end)}") from None

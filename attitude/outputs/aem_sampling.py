@@ -233,9 +233,13 @@ def _test_windows(
 ) -> list[tuple[float, float]]:
     """Spans where the declared reading is tested: one body period (every phase of
     ω(t) occurs in it) or, without a period, the start and the neighbourhood of the
-    first flip."""
+    first flip; and those a segment names itself (a guided segment: its whole stretch
+    and its largest acceleration, attitude.trajectory.guided)."""
     span = max(64.0 * step_s, motion.period_s if math.isfinite(motion.period_s) else 0.0)
     windows = [(start_s, min(end_s, start_s + span))]
+    named = getattr(segment.solver, "aem_test_windows", None)
+    if named is not None:
+        windows += named(start_s, end_s)
     flips = motion.flip_times_s
     flips = flips[(flips >= start_s) & (flips <= end_s)]
     if flips.size:

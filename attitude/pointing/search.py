@@ -141,15 +141,24 @@ class SearchGrid:
         return 2.0 * self.orbit_rate_rad_s / (math.pi * _SUN_LEAST_RADIUS_RAD)
 
 
+def _segment_rate(solver) -> float:
+    """A bound on a segment's body rate, rad/s: its own where it states one (a segment
+    under a law or a slew: ``angular_rate_bound``, attitude.trajectory.guided), else
+    √(2T/I_min), since |ω|² = Σ m_i²/I_i² ≤ (Σ m_i²/I_i)/I_min = 2T/I_min (tighter than
+    G/I_min, which it never exceeds)."""
+    stated = getattr(solver, "angular_rate_bound", None)
+    if stated is not None:
+        return float(stated)
+    return math.sqrt(
+        max(2.0 * solver.kinetic_energy, 0.0) / float(np.min(solver.moments_of_inertia))
+    )
+
+
 def _body_rate(trajectory: Trajectory, start_s: float, stop_s: float) -> float:
     """A bound on the body's rotation rate over [start_s, stop_s], rad/s: the largest
-    over the segments of √(2T/I_min), since |ω|² = Σ m_i²/I_i² ≤ (Σ m_i²/I_i)/I_min =
-    2T/I_min (tighter than G/I_min, which it never exceeds)."""
+    over the segments of :func:`_segment_rate`."""
     rates = [
-        math.sqrt(
-            max(2.0 * segment.solver.kinetic_energy, 0.0)
-            / float(np.min(segment.solver.moments_of_inertia))
-        )
+        _segment_rate(segment.solver)
         for segment in trajectory.segments
         if segment.end_s >= start_s and segment.start_s <= stop_s
     ]
@@ -189,7 +198,7 @@ def _vector_rates(
         a, b = max(segment.start_s, start_s), min(segment.end_s, stop_s)
         solver = segment.solver
         least = float(np.min(solver.moments_of_inertia))
-        highest = math.sqrt(max(2.0 * solver.kinetic_energy, 0.0) / least)
+        highest = _segment_rate(solver)
         window = min(b - a, solver.period) if isinstance(solver, EulerSolver) else math.nan
         if not math.isfinite(window):  # under torques ω need not repeat; no period
             for name, _ in vectors:

@@ -30,6 +30,7 @@ from attitude.pointing.search import SearchGrid, check_pointing
 from attitude.pointing.spec import PointingSpec
 from attitude.report.beside import Beside
 from attitude.scenario.scenario import Scenario
+from attitude.trajectory.guided import GUIDED
 from attitude.trajectory.horizon import ValidityHorizon, validity_horizon
 from attitude.trajectory.motion import SegmentMotion, analyze, undersampling_note
 from attitude.trajectory.trajectory import Trajectory, propagate
@@ -83,6 +84,8 @@ def plan_run(
     check_fits(budget)
     motion = analyze(trajectory)
     notes, search = check_pointing(trajectory, pointing)
+    if trajectory.modes is not None:  # attitude laws: ground sites never seen, EOP coverage
+        notes = [*trajectory.modes.notes, *notes]
     undersampled = undersampling_note(trajectory, motion)
     if undersampled:
         notes.append(undersampled)
@@ -98,6 +101,8 @@ def plan_run(
     # On an orbit, unless the gravity gradient is modelled: a torque-free run, or burns
     # alone, neglects it.
     wanted = pointing.orbit is not None and scenario.torques.gravity_gradient is None
+    # Under a law the controller holds the attitude: only free segments neglect anything.
+    wanted = wanted and any(s.solver.formula not in GUIDED for s in trajectory.segments)
     if wanted and horizon:
         found = validity_horizon(trajectory, pointing.orbit)
     aem = None

@@ -35,6 +35,7 @@ from scipy.spatial.transform import Rotation
 
 from attitude.base.errors import InputError
 from attitude.base.quantities import as_si_scalar, as_vector3
+from attitude.environment.orbit import Orbit, TleOrbit
 from attitude.environment.timescales import (
     SAME_INSTANT_S,
     as_time,
@@ -157,6 +158,10 @@ class Scenario:
         :class:`~attitude.scenario.torques.ScenarioTorques`: gravity gradient, burns,
         and the splitting's step and order (default: none, the exact torque-free
         motion).
+    orbit
+        Where the spacecraft is: an :class:`attitude.environment.orbit.Orbit`
+        (``TleOrbit``, ``KeplerianOrbit``, ``OemOrbit``) or the two lines of a TLE; the
+        gravity gradient and the pointing use it (module notes).  None: no orbit.
     """
 
     def __init__(
@@ -172,6 +177,7 @@ class Scenario:
         start: Any = None,
         step: Any = None,
         torques: ScenarioTorques | None = None,
+        orbit: Orbit | tuple[str, str] | list[str] | None = None,
     ) -> None:
         self.name = str(name)
         if not isinstance(spacecraft, Spacecraft):
@@ -184,7 +190,21 @@ class Scenario:
         self._set_span(stop, duration)
         self._set_output_grid(start, step)
         self._place_events(events)
+        self._set_orbit(orbit)
         self._place_torques(torques)
+
+    def _set_orbit(self, orbit: Any) -> None:
+        """``orbit``: an Orbit, the two lines of a TLE, or None."""
+        if isinstance(orbit, tuple | list):
+            if len(orbit) != 2 or not all(isinstance(line, str) for line in orbit):
+                raise InputError(f"orbit: expected the two lines of a TLE, got {orbit!r}")
+            orbit = TleOrbit(*orbit)
+        if orbit is not None and not isinstance(orbit, Orbit):
+            raise InputError(
+                "orbit: must be an Orbit (TleOrbit, KeplerianOrbit, OemOrbit) or the two "
+                f"lines of a TLE, got {orbit!r}"
+            )
+        self.orbit: Orbit | None = orbit
 
     def _set_epoch(self, epoch: Any) -> None:
         self.epoch = as_time(epoch, name="epoch")

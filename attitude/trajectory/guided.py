@@ -53,7 +53,10 @@ from attitude.laws.slews import Slew
 from attitude.scenario.events import State
 from attitude.solver.inertia import PrincipalAxes
 
-__all__ = ["RATE_SAMPLE_S", "GuidedMotion"]
+__all__ = ["GUIDED", "RATE_SAMPLE_S", "GuidedMotion"]
+
+# The formulas of the segments whose attitude a law (or a slew onto one) holds.
+GUIDED = ("guided", "slew")
 
 # The law's rate is sampled at most this far apart over a segment for its bounds.
 RATE_SAMPLE_S = 10.0

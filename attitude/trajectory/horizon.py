@@ -141,7 +141,8 @@ def validity_horizon(trajectory: Trajectory, orbit: Any) -> ValidityHorizon:
         horizon_threshold=threshold,
     )
     torqued = propagate(_truncated(scenario, searched).with_torques(torques))
-    run_step = max(segment.solver.step for segment in torqued.segments)
+    # (Segments under a law have no step: their attitude is the law's in both runs.)
+    run_step = max(s.solver.step for s in torqued.segments if hasattr(s.solver, "step"))
 
     def angle(t):
         return angles_between(torqued.attitude_quaternion(t), trajectory.attitude_quaternion(t))
@@ -163,4 +164,5 @@ def _truncated(scenario: Scenario, stop_s: float) -> Scenario:
         events,
         duration=stop_s,
         torques=scenario.torques,
+        orbit=getattr(scenario, "orbit", None),
     )
