@@ -350,6 +350,11 @@ class Slew:
     # ---- what the summary states
 
     @property
+    def accelerating_s(self) -> float:
+        """How long the profile accelerates (and brakes), s."""
+        return self._t_a
+
+    @property
     def correction_bound_rad(self) -> float:
         """The most the start-rate correction turns the body off the eigen-axis path."""
         return 4.0 / 27.0 * self.correction_s * self.mismatch_rad_s
@@ -361,8 +366,9 @@ class Slew:
 
     def describe(self) -> str:
         return (
-            f"slew of {math.degrees(self.angle_rad):.6g} deg in {self.duration_s:.6g} s "
-            f"({self.limits.describe()}) onto {self.target.law.describe()}"
+            f"{math.degrees(self.angle_rad):.6g} deg in {self.duration_s:.6g} s, "
+            f"{self.limits.describe()}, onto {self.target.law.name}: "
+            f"{self.target.law.describe()}"
         )
 
     def as_dict(self) -> dict[str, Any]:

@@ -319,10 +319,16 @@ def plan_aem(
         end = min(segment.end_s, stop_s)
         if end - start <= SAME_INSTANT_S:
             continue  # before the output span, or a zero-length stretch between events
-        try:
-            plans.append(_plan_segment(index, segment, item, start, end, tolerance_rad))
-        except InputError as exc:
-            raise InputError(f"{name}: {exc}") from None
+        # Where the segment's own motion is not smooth (a slew's switches: attitude
+        # .trajectory.guided), an AEM segment ends and the next begins.
+        declare = getattr(segment.solver, "breakpoints", None)
+        cuts = [t for t, _ in declare(start, end)] if declare is not None else []
+        cuts = [t for t in cuts if start + SAME_INSTANT_S < t < end - SAME_INSTANT_S]
+        for a, b in zip([start, *cuts], [*cuts, end], strict=True):
+            try:
+                plans.append(_plan_segment(index, segment, item, a, b, tolerance_rad))
+            except InputError as exc:
+                raise InputError(f"{name}: {exc}") from None
     return AemPlan(tolerance_rad, plans)
 
 

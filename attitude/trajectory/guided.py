@@ -298,6 +298,21 @@ class GuidedMotion:
 
     error_estimate = 0.0  # the law's attitude is evaluated, not propagated
 
+    def breakpoints(self, start_s: float, end_s: float) -> list[tuple[float, str]]:
+        """Where the motion inside [start_s, end_s] is not smooth: a slew's switches of
+        acceleration (coast, braking, the end of the start-rate correction), in time
+        order; a law has none."""
+        slew = self.slew
+        if slew is None:
+            return []
+        points = [
+            (slew.start_s + slew.accelerating_s, "slew: coasting begins"),
+            (slew.end_s - slew.accelerating_s, "slew: braking begins"),
+            (slew.start_s + slew.correction_s, "slew: the start-rate correction ends"),
+        ]
+        inside = [(t, what) for t, what in points if start_s < t < end_s]
+        return sorted(inside)
+
     def aem_test_windows(self, start_s: float, end_s: float) -> list[tuple[float, float]]:
         """Where an AEM of this segment is tested: the whole stretch (the records'
         intervals are then drawn across it) and around the largest acceleration."""
