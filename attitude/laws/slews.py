@@ -47,7 +47,7 @@ those formulas bounds the body's rate and acceleration:
 
 where W_B and A_B bound B's |ω_B| and |α_B| over the slew (sampled every
 :data:`LAW_SAMPLE_S` seconds at most, plus the largest change between neighbouring
-samples).  The eigen-axis profile is then given the peak rate w = Ω − W_B − |Δ| and the
+samples; over a window from t₀ grown until it holds the slew).  The eigen-axis profile is then given the peak rate w = Ω − W_B − |Δ| and the
 acceleration a = A − A_B − W_B w − (W_B + w)|Δ| − 4|Δ|/T_c, so that the body's rate and
 acceleration stay within Ω and A everywhere; T_c = min(T, 4|Δ|/(β (A − K))), K the
 terms that do not depend on T_c, β = :data:`CORRECTION_SHARE` (the correction takes at
@@ -90,8 +90,10 @@ LAW_SAMPLE_S = 5.0
 # The share of the acceleration left after the laws' own that the start-rate correction
 # may take (the eigen-axis profile keeps the rest).
 CORRECTION_SHARE = 0.25
-# A slew is searched over windows this much longer than the duration last found.
-_WINDOW_MARGIN_S = 600.0
+# The target's bounds are taken over a window this much longer than the duration
+# last found, until the window holds the slew.
+_WINDOW_GROWTH = 1.02
+_WINDOW_TRIES = 60
 
 
 @dataclass(frozen=True)
@@ -210,14 +212,18 @@ class Slew:
                 f"{self.key}: the slew has no time: the next event, {deadline_text}, is at the "
                 "same epoch"
             )
-        window_end = min(deadline_s, self.start_s + 2.0 * bang_coast_bang_duration(θ, Ω, A))
-        window_end = min(deadline_s, window_end + _WINDOW_MARGIN_S)
-        for _ in range(8):
+        # W_B and A_B are bounds over the slew itself: from the shortest duration the
+        # limits allow, the window grows to the duration found until it covers it.
+        window_end = min(deadline_s, self.start_s + bang_coast_bang_duration(θ, Ω, A))
+        for _ in range(_WINDOW_TRIES):
             W_B, A_B = self._target_bounds(window_end)
             duration, rate, acceleration, T_c = self._solve(θ, D, Ω, A, W_B, A_B)
             if self.start_s + duration <= window_end or window_end >= deadline_s:
                 break
-            window_end = min(deadline_s, self.start_s + 2.0 * duration + _WINDOW_MARGIN_S)
+            window_end = min(deadline_s, self.start_s + duration * _WINDOW_GROWTH)
+        else:  # not settled: the bounds over the whole time to the deadline
+            W_B, A_B = self._target_bounds(deadline_s)
+            duration, rate, acceleration, T_c = self._solve(θ, D, Ω, A, W_B, A_B)
         if self.start_s + duration > deadline_s:
             raise InputError(
                 f"{self.key}: the slew of {math.degrees(θ):.4g} deg from "

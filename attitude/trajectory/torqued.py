@@ -217,8 +217,11 @@ class TorquedMotion:
         )
 
     def kinetic_energy_at(self, t: ArrayLike) -> NDArray[np.float64]:
-        """½ m(t)·ω(t), J."""
-        return 0.5 * np.sum(self.angular_momentum(t) * self.angular_velocity(t), axis=-1)
+        """½ ω(t)·Iω(t), J: ½ m·ω, the body's with spinning wheels (m − h = Iω)."""
+        m = self.angular_momentum(t)
+        if self.wheel_momentum is not None:
+            m = m - self.wheel_momentum
+        return 0.5 * np.sum(m * self.angular_velocity(t), axis=-1)
 
     # ---- what the closed form has and this motion has not
 
