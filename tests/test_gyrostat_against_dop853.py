@@ -34,7 +34,7 @@ def reference():
 
 @pytest.mark.parametrize("order, ratio", [(4, 16.0), (2, 4.0)])
 def test_convergence_order_without_torques(reference, order, ratio):
-    M_ref, q_ref = reference
+    _M_ref, q_ref = reference
     steps = (20.0, 10.0, 5.0) if order == 4 else (4.0, 2.0, 1.0)
     errors = []
     for step in steps:
@@ -139,7 +139,7 @@ def test_gravity_gradient_with_wheels_against_dop853():
     wheels = np.array([0.0, 0.5, 0.1])
     M_start = inertia * np.array([2e-4, -1.1e-3, 3e-4]) + wheels
     times = np.array([0.0, 311.7, 2900.0, 5800.0])
-    M_ref, q_ref = integrate_gyrostat(
+    _M_ref, q_ref = integrate_gyrostat(
         inertia,
         M_start,
         R0.as_quat(scalar_first=True),

@@ -70,7 +70,7 @@ def test_the_numbers_are_the_csvs(run):
     data = _csv(run / "timeseries.csv")
     assert table.num_rows == len(data) == 481
     names = [n for n in data.dtype.names if n != "time_utc"]
-    assert table.column_names == ["time_utc", "tt_ns", *names]
+    assert table.column_names == ["time_utc", "tt_ns", "timestamp_tt", *names]
     for name in names:
         column = table.column(name).to_numpy()
         assert np.array_equal(column, data[name]), name  # the same doubles, bit for bit

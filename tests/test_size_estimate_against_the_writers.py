@@ -6,12 +6,13 @@ writer actually produces (pointing_columns of real samples) for every shape of s
 and the CSV estimate with the size of a CSV written by a run.
 """
 
+import copy
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from attitude.files.scenario_reader import load_scenario
+from attitude.files.scenario_reader import load_scenario, scenario_from_document
 from attitude.outputs.csv import pointing_column_count, pointing_columns
 from attitude.outputs.formats import OutputChoice
 from attitude.pointing.sampling import pointing_samples
@@ -50,11 +51,11 @@ def test_column_count_is_what_the_writer_writes(on_orbit, constraints, euler):
     else:
         vectors = _vectors(constraints)
     file = load_scenario(SPINNER)
-    spec = PointingSpec(
-        vectors,
-        file.pointing.orbit if on_orbit else None,
-        lvlh_euler_sequence=euler,
-    )
+    if not on_orbit:  # at the Earth's centre: no orbit for the scenario either
+        document = copy.deepcopy(file.document)
+        del document["pointing"]["tle"]
+        file = scenario_from_document(SPINNER, document)
+    spec = PointingSpec(vectors, file.pointing.orbit, lvlh_euler_sequence=euler)
     trajectory = propagate(file.scenario)
     samples = pointing_samples(trajectory, spec, np.array([0.0, 1.0, 2.0]))
     assert pointing_column_count(spec) == len(pointing_columns(samples))

@@ -15,14 +15,15 @@ their limits and boundary conditions.
    cannot end before the next event is refused with the time it would take.
 """
 
+import itertools
+
 import astropy.units as u
 import numpy as np
 import pytest
 from astropy.time import Time
 from scipy.integrate import solve_ivp
-from scipy.spatial.transform import Rotation
 
-from attitude import InputError, KeplerianOrbit, NadirLaw, SunLaw, TargetLaw, GroundSite
+from attitude import GroundSite, InputError, KeplerianOrbit, NadirLaw, SunLaw, TargetLaw
 from attitude.laws.slews import Slew, SlewLimits
 
 EPOCH = Time("2025-05-01T10:00:00", scale="utc")
@@ -72,7 +73,7 @@ def _integrate(slew, start_attitude, t_eval):
     edges = [slew.start_s, *[s for s in switches if slew.start_s < s < slew.end_s], slew.end_s]
     q = start_attitude.as_quat(scalar_first=True)
     out = np.empty((t_eval.size, 4))
-    for a, b in zip(edges[:-1], edges[1:], strict=True):
+    for a, b in itertools.pairwise(edges):
         inside = (t_eval >= a) & (t_eval <= b)
         sol = solve_ivp(
             _kinematics(slew),
@@ -195,9 +196,9 @@ def test_a_slew_that_cannot_end_before_the_deadline_is_refused():
 
 
 def test_limits_are_checked():
-    with pytest.raises(InputError, match="slew.max_rate: must be positive"):
+    with pytest.raises(InputError, match=r"slew\.max_rate: must be positive"):
         SlewLimits(0.0, 1.0)
-    with pytest.raises(InputError, match="slew.max_acceleration"):
+    with pytest.raises(InputError, match=r"slew\.max_acceleration"):
         SlewLimits(1.0, 1e9)
     with pytest.raises(InputError, match="cannot be converted"):
         SlewLimits(1.0 * u.deg / u.s, 1.0 * u.deg / u.s)

@@ -435,6 +435,7 @@ def _body_vector(item: _Table) -> BodyVector:
         "sun_exclusion_half_angle",
         "moon_exclusion_half_angle",
         "earth_limb_exclusion_angle",
+        "sun_inclusion_half_angle",
     )
     name = item.string("name")
     vector = item.quantity("vector", "dimensionless", (3,))
@@ -443,6 +444,13 @@ def _body_vector(item: _Table) -> BodyVector:
     sun = _angle_deg(item, "sun_exclusion_half_angle", 0.0, 180.0)
     moon = _angle_deg(item, "moon_exclusion_half_angle", 0.0, 180.0)
     limb = _angle_deg(item, "earth_limb_exclusion_angle", -90.0, 180.0)
+    inclusion = _angle_deg(item, "sun_inclusion_half_angle", 0.0, 180.0)
+    if inclusion is not None and sun is not None and inclusion <= sun:
+        item.fail(
+            f"{inclusion!r} deg is within sun_exclusion_half_angle ({sun!r} deg): the Sun "
+            "could never be inside the field of view and outside the exclusion cone",
+            "sun_inclusion_half_angle",
+        )
     kind = item.choice("kind", KINDS, default="other")
 
     def radians(degrees: float | None) -> float | None:
@@ -461,6 +469,8 @@ def _body_vector(item: _Table) -> BodyVector:
         moon_exclusion_half_angle_deg=moon,
         earth_limb_exclusion_angle_rad=radians(limb),
         earth_limb_exclusion_angle_deg=limb,
+        sun_inclusion_half_angle_rad=radians(inclusion),
+        sun_inclusion_half_angle_deg=inclusion,
     )
 
 
@@ -542,7 +552,9 @@ def _pointing(root: _Table, scale: str, epoch, name: str) -> PointingSpec:
     sequence = table.string("lvlh_euler_sequence", required=False)
     if sequence is not None:
         options["lvlh_euler_sequence"] = sequence
-    return _checked(table, None, PointingSpec, vectors, orbit, **options)
+    spec = _checked(table, None, PointingSpec, vectors, orbit, **options)
+    _checked(table, None, spec.check_orbit)
+    return spec
 
 
 def _burn(table: _Table, scale: str) -> Burn:
@@ -583,9 +595,8 @@ def _torques(root: _Table, scale: str, orbit: Orbit | None) -> ScenarioTorques |
     if threshold is not None:
         options["horizon_threshold"] = threshold
     try:
-        return ScenarioTorques(
-            orbit if gravity_gradient else None, tuple(burns), order=order, **options
-        )
+        # True: the scenario's orbit, the one of [pointing] (given once, to the Scenario).
+        return ScenarioTorques(gravity_gradient or None, tuple(burns), order=order, **options)
     except InputError as exc:
         raise ScenarioFileError(f"{table.file.name}: {exc}") from None
 

@@ -47,7 +47,8 @@ those formulas bounds the body's rate and acceleration:
 
 where W_B and A_B bound B's |ω_B| and |α_B| over the slew (sampled every
 :data:`LAW_SAMPLE_S` seconds at most, plus the largest change between neighbouring
-samples; over a window from t₀ grown until it holds the slew).  The eigen-axis profile is then given the peak rate w = Ω − W_B − |Δ| and the
+samples; over a window from t₀ grown until it holds the slew).  The eigen-axis
+profile is then given the peak rate w = Ω − W_B − |Δ| and the
 acceleration a = A − A_B − W_B w − (W_B + w)|Δ| − 4|Δ|/T_c, so that the body's rate and
 acceleration stay within Ω and A everywhere; T_c = min(T, 4|Δ|/(β (A − K))), K the
 terms that do not depend on T_c, β = :data:`CORRECTION_SHARE` (the correction takes at

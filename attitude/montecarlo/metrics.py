@@ -82,6 +82,9 @@ _CONSTRAINTS = (
     ("moon_exclusion", "moon_exclusion_half_angle_rad"),
     ("earth_limb_exclusion", "earth_limb_exclusion_angle_rad"),
 )
+# The totals of a vector's "blinded" (the union of its exclusions) and "sun_in_view"
+# (its Sun inclusion cone holding the Sun), as summary.json names them.
+_UNION_TOTALS = ("count", "total_s", "longest_s", "fraction_of_span")
 
 
 def _vector_metric_names(vector, on_orbit: bool) -> list[str]:
@@ -101,6 +104,13 @@ def _vector_metric_names(vector, on_orbit: bool) -> list[str]:
     for constraint, angle in _CONSTRAINTS:
         if getattr(vector, angle) is not None:
             names += [f"{v}_{constraint}_{total}" for total in ("count", "total_s", "longest_s")]
+    # Blinded by any of its exclusions (their union), and the Sun in a Sun sensor's view.
+    for union, present in (
+        ("blinded", bool(vector.exclusions)),
+        ("sun_in_view", vector.sun_inclusion_half_angle_rad is not None),
+    ):
+        if present:
+            names += [f"{v}_{union}_{total}" for total in _UNION_TOTALS]
     return names
 
 
@@ -150,6 +160,10 @@ def pointing_outcome(plan: RunPlan) -> dict[str, float]:
             if constraint in entry:
                 for total in ("count", "total_s", "longest_s"):
                     metrics[f"{name}_{constraint}_{total}"] = entry[constraint][total]
+        for union in ("blinded", "sun_in_view"):
+            if union in entry:
+                for total in _UNION_TOTALS:
+                    metrics[f"{name}_{union}_{total}"] = entry[union][total]
     if "eclipses" in summary:
         eclipses = summary["eclipses"]
         metrics["eclipse_count"] = eclipses["shadow"]["count"]

@@ -37,6 +37,7 @@ from attitude.montecarlo.statistics import (
 )
 from attitude.outputs.budget import DISK_SHARE, ResourceError
 from attitude.outputs.folder import claim
+from attitude.pointing.spec import interval_precision
 from attitude.report.page import (  # the page of attitude run, its look
     _STYLE,
     _figures_and_files,
@@ -44,7 +45,14 @@ from attitude.report.page import (  # the page of attitude run, its look
 )
 from attitude.report.summaries import write_json
 
-__all__ = ["OUTPUT_NAMES", "check_folder", "statistics", "write_report"]
+__all__ = [
+    "OUTPUT_NAMES",
+    "check_folder",
+    "drawn_spread",
+    "stated_precision",
+    "statistics",
+    "write_report",
+]
 
 OUTPUT_NAMES = (
     "samples.parquet",
@@ -225,12 +233,64 @@ def _build(result: MonteCarloResult, tmp: Path) -> list[str]:
     return [*files, *images.values(), "report.html"]
 
 
+# Interval totals and longest intervals: their ends are refined to the pointing's
+# interval precision, each to within half of it (attitude.pointing.intervals).
+_DURATIONS = ("_total_s", "_longest_s", "_sun_visible_s")
+
+
+def stated_precision(name: str, mc: MonteCarloPlan, ok) -> float | None:
+    """How precisely summary.json states the metric ``name`` (None: to the last bit, or
+    not stated): the noise below it is root finding's, not the dispersions'.
+
+    A duration summed over n intervals (``*_total_s``) is within n times the interval
+    precision (half of it at each end), n the largest of the samples' matching count
+    (``*_count``; the eclipses' for the umbra; one where no count is reported), a
+    longest interval within one; a ``*_fraction_of_span`` is that over the span.
+    """
+    spec, scenario = mc.plan.pointing, mc.plan.scenario
+    if spec.is_empty:
+        return None
+    precision = interval_precision(spec, scenario.stop_s)[0]
+    fraction = name.endswith("_fraction_of_span")
+    stem = name.removesuffix("_fraction_of_span") if fraction else name
+    if not (fraction or stem.endswith(_DURATIONS)):
+        return None
+    if stem.endswith("_longest_s"):
+        return precision
+    counts = {"umbra_total_s": "eclipse_count"}
+    count = counts.get(stem, stem.removesuffix("_total_s") + "_count")
+    if fraction:
+        count = stem + "_count"
+    intervals = 1.0
+    if count in ok and ok[count].dtype.kind in "fiu" and len(ok):
+        intervals = max(1.0, float(np.nanmax(ok[count].to_numpy(float))))
+    step = intervals * precision
+    return step / (scenario.stop_s - scenario.start_s) if fraction else step
+
+
+def drawn_spread(values: np.ndarray, precision: float | None) -> np.ndarray | None:
+    """The finite ``values`` rounded to ``precision`` for drawing their spread, or None
+    when they do not spread beyond it (differences within the stated precision are
+    root finding's noise, not a metric that varies)."""
+    values = values[np.isfinite(values)]
+    if values.size == 0:
+        return None
+    if precision is not None and precision > 0.0:
+        values = np.round(values / precision) * precision
+        # Two values one step apart may come from the same true value.
+        if np.ptp(values) <= precision * (1.0 + 1e-9):
+            return None
+    return values if np.ptp(values) > 0 else None
+
+
 def _histogram_columns(mc: MonteCarloPlan, table) -> list[str]:
-    """The metrics worth a histogram: numeric, finite somewhere, not constant; the
-    pointing first, then flips, rates, nutation and periods."""
+    """The metrics worth a histogram: numeric, finite somewhere, spread beyond their
+    stated precision (:func:`drawn_spread`); the pointing first, then flips, rates,
+    nutation and periods."""
     ok = table[table["status"] == "ok"]
     order = [n for n in mc.metrics if "sun_angle" in n and not n.endswith("_at_s")]
     order += [n for n in mc.metrics if n.endswith("_exclusion_total_s")]
+    order += [n for n in mc.metrics if n.endswith(("_blinded_total_s", "_sun_in_view_total_s"))]
     order += [n for n in mc.metrics if n == "eclipse_total_s"]
     order += [n for n in mc.metrics if "_limb_angle_min" in n and not n.endswith("_at_s")]
     order += [n for n in mc.metrics if "_moon_angle_min" in n and not n.endswith("_at_s")]
@@ -240,8 +300,8 @@ def _histogram_columns(mc: MonteCarloPlan, table) -> list[str]:
     chosen = []
     for name in order:
         values = ok[name].to_numpy(float) if ok[name].dtype.kind in "fiu" else np.empty(0)
-        values = values[np.isfinite(values)]
-        if values.size and np.ptp(values) > 0 and name not in chosen:
+        spread = drawn_spread(values, stated_precision(name, mc, ok))
+        if spread is not None and name not in chosen:
             chosen.append(name)
     return chosen[:_MAX_HISTOGRAMS]
 
@@ -256,8 +316,7 @@ def _plot_histograms(result: MonteCarloResult, names, stats, path: Path) -> str:
     figure = Figure(figsize=(3.4 * columns, 2.7 * rows + 0.5), layout="constrained")
     panels = np.atleast_1d(figure.subplots(rows, columns, squeeze=False).ravel())
     for axes, name in zip(panels, names, strict=False):
-        values = ok[name].to_numpy(float)
-        values = values[np.isfinite(values)]
+        values = drawn_spread(ok[name].to_numpy(float), stated_precision(name, result.plan, ok))
         axes.hist(values, bins=int(np.clip(np.sqrt(values.size), 10, 60)), color="C0", alpha=0.8)
         entry = stats["metrics"][name]
         for p, style in (("1", ":"), ("50", "-"), ("99", ":")):

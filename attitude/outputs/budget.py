@@ -48,7 +48,8 @@ _BASE_MEMORY = 300_000_000
 _MEMORY_PER_CHUNK_SAMPLE = 2_500
 _MEMORY_PER_CHUNK_SAMPLE_PER_VECTOR = 500
 # File bytes per output epoch: the time text and each number of the CSV; each column
-# of the Parquet file (zstd; the text and tt_ns included); a record of the AEM.
+# of the Parquet file (zstd; the text, tt_ns and timestamp_tt included); a record of
+# the AEM.
 _CSV_TIME_BYTES = 31
 _CSV_BYTES_PER_COLUMN = 20
 _PARQUET_BYTES_PER_COLUMN = 8
@@ -129,7 +130,8 @@ def estimate(
     if "csv" in formats:
         files["timeseries.csv"] = samples * (_CSV_TIME_BYTES + _CSV_BYTES_PER_COLUMN * columns)
     if "parquet" in formats:
-        files["timeseries.parquet"] = samples * _PARQUET_BYTES_PER_COLUMN * (columns + 2)
+        # The text, tt_ns and timestamp_tt beside the CSV's number columns.
+        files["timeseries.parquet"] = samples * _PARQUET_BYTES_PER_COLUMN * (columns + 3)
     if "aem" in formats:
         records = samples if aem_records is None else aem_records
         files["attitude.aem"] = records * _AEM_BYTES_PER_RECORD

@@ -246,7 +246,7 @@ def pointing_column_count(spec: PointingSpec) -> int:
     the Sun's direction; on an orbit the lit fraction, the Earth's angular radius and
     the LVLH quaternion (and Euler angles when asked); per vector its Sun, Moon, RA
     and Dec columns and incidence, on an orbit its nadir and limb angles, and a flag
-    per constraint."""
+    per constraint (the Sun inclusion's says the Sun is in view)."""
     columns = 3
     if spec.on_orbit:
         columns += 2 + 4 + (3 if spec.lvlh_euler_sequence is not None else 0)
@@ -258,6 +258,7 @@ def pointing_column_count(spec: PointingSpec) -> int:
                 v.sun_exclusion_half_angle_rad,
                 v.moon_exclusion_half_angle_rad,
                 v.earth_limb_exclusion_angle_rad,
+                v.sun_inclusion_half_angle_rad,
             )
         )
     return columns
@@ -367,11 +368,25 @@ def _vector_columns(item: VectorSamples) -> list[Column]:
         item.earth_limb_violated,
         f"1 if {name} is less than its exclusion angle above the Earth's limb",
     )
+    columns += _flag(
+        f"{name}_sun_in_view",
+        item.sun_in_view,
+        f"1 if the Sun is inside {name}'s inclusion cone (its field of view) and not in umbra",
+    )
     return columns
 
 
-# The kinds of interval in intervals.csv: (kind, the VectorAnalysis field), per vector.
-_VECTOR_INTERVALS = ("sun_exclusion", "moon_exclusion", "earth_limb_exclusion", "sun_visible")
+# The kinds of interval in intervals.csv, per vector (each a VectorAnalysis field):
+# ``blinded`` is the union of the vector's exclusions, ``sun_in_view`` its Sun
+# inclusion cone holding the Sun.
+_VECTOR_INTERVALS = (
+    "sun_exclusion",
+    "moon_exclusion",
+    "earth_limb_exclusion",
+    "blinded",
+    "sun_visible",
+    "sun_in_view",
+)
 
 
 def _interval_kinds(analysis: PointingAnalysis) -> list[tuple[str, str, list[Interval]]]:

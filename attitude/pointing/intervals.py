@@ -5,8 +5,9 @@ f > 0 (for a Sun exclusion cone: cos(Sun angle) − cos(half angle)).  It is sam
 on a search grid finer than the motion's fastest time scale, then every sign
 change is refined (regula falsi, then bisection if needed), all of them at once
 (vectorized), until the bracket is narrower than the stated precision: the ends do not depend on the
-output step.  Conditions combine as interval sets (``difference``), e.g. "the Sun is
-in the tracker's cone and the spacecraft is not in umbra".  A long span is searched in
+output step.  Conditions combine as interval sets (``difference``, ``union``), e.g.
+"the Sun is in the tracker's cone and the spacecraft is not in umbra", or "the tracker
+is blinded by the Sun, the Moon or the limb".  A long span is searched in
 chunks (bounded memory); ``join`` puts the pieces of an interval cut by a chunk's end
 back together.
 
@@ -30,6 +31,7 @@ __all__ = [
     "find_intervals",
     "join",
     "total_duration",
+    "union",
 ]
 
 
@@ -206,6 +208,29 @@ def difference(a: list[Interval], b: list[Interval]) -> list[Interval]:
             start, starts_before = max(start, cut.end_s), False
         if start is not None:
             out.append(Interval(start, interval.end_s, starts_before, interval.ends_after))
+    return out
+
+
+def union(*lists: list[Interval]) -> list[Interval]:
+    """The time covered by any of the interval ``lists`` (each sorted and disjoint), as
+    sorted disjoint intervals: overlapping or touching intervals merge into one.
+
+    A merged interval starts before the span if its first piece does, and ends after
+    it if a piece that reaches its end does."""
+    pieces = sorted(
+        (interval for intervals in lists for interval in intervals),
+        key=lambda i: (i.start_s, not i.starts_before),
+    )
+    out: list[Interval] = []
+    for piece in pieces:
+        if out and piece.start_s <= out[-1].end_s:
+            last = out[-1]
+            if piece.end_s > last.end_s:
+                out[-1] = Interval(last.start_s, piece.end_s, last.starts_before, piece.ends_after)
+            elif piece.end_s == last.end_s and piece.ends_after and not last.ends_after:
+                out[-1] = Interval(last.start_s, last.end_s, last.starts_before, True)
+        else:
+            out.append(piece)
     return out
 
 

@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 from attitude.base.errors import InputError
 from attitude.environment.frames import euler_angles_deg, lvlh_to_icrf
-from attitude.pointing.spec import BodyVector, PointingSpec
+from attitude.pointing.spec import BodyVector, PointingSpec, for_scenario
 from attitude.pointing.surroundings import SunMoonEarth, Surroundings, moon_hidden, vector_angles
 from attitude.trajectory.trajectory import Trajectory
 
@@ -33,7 +33,8 @@ class VectorSamples:
 
     ``sun_violated``: the Sun inside the exclusion cone and the spacecraft not in
     umbra; ``moon_violated``: the Moon inside its cone and not hidden by the Earth;
-    ``earth_limb_violated``: the vector less than the exclusion angle above the limb.
+    ``earth_limb_violated``: the vector less than the exclusion angle above the limb;
+    ``sun_in_view``: the Sun inside the inclusion cone and the spacecraft not in umbra.
     None where the constraint (or the orbit) is absent.
     """
 
@@ -48,6 +49,7 @@ class VectorSamples:
     sun_violated: NDArray[np.bool_] | None = None
     moon_violated: NDArray[np.bool_] | None = None
     earth_limb_violated: NDArray[np.bool_] | None = None
+    sun_in_view: NDArray[np.bool_] | None = None
 
 
 @dataclass
@@ -102,6 +104,11 @@ def _vector_samples(vector: BodyVector, icrf: NDArray[np.float64], env: Surround
             item.moon_violated &= hidden <= 0.0
     if vector.earth_limb_exclusion_angle_rad is not None:
         item.earth_limb_violated = item.earth_limb_angle_rad < vector.earth_limb_exclusion_angle_rad
+    if vector.sun_inclusion_half_angle_rad is not None:
+        # In umbra the Sun is hidden: the sensor sees nothing.
+        item.sun_in_view = (item.sun_angle_rad < vector.sun_inclusion_half_angle_rad) & (
+            env.sunlit_fraction > 0.0
+        )
     return item
 
 
@@ -119,6 +126,7 @@ def pointing_samples(
     seconds = np.asarray(seconds, dtype=np.float64).ravel()
     if seconds.size == 0:
         raise InputError("seconds: no times to sample")
+    spec = for_scenario(spec, trajectory.scenario)  # the scenario's orbit, if the spec has none
     if seconds.size == 1:
         # One epoch is evaluated as a pair and the first kept: numpy's one-row products
         # take another path (gemv), which can differ in the last bit, and a stream's

@@ -2,12 +2,13 @@
 
 :func:`pointing_analysis` finds, over [start_s, stop_s], the eclipses (any part of the
 Sun hidden, all of it), the Moon behind the Earth, and for each body vector of the
-:class:`attitude.pointing.spec.PointingSpec` its Sun visibility and constraint
-violations (intervals), the least and greatest of its Sun, Moon, nadir and limb angles
-and of its Sun incidence (extrema), and the time averages of the incidence and of the
-lit fraction.  It finds them on the exact motion, whatever the output step, and in
-bounded memory: the span is searched in chunks of :data:`CHUNK_POINTS` points, and
-only what was found is kept between chunks.  The values it searches are those of
+:class:`attitude.pointing.spec.PointingSpec` its Sun visibility, constraint violations,
+when any of them blinds it, and when its Sun inclusion cone holds the Sun (intervals),
+the least and greatest of its Sun, Moon, nadir and limb angles and of its Sun
+incidence (extrema), and the time averages of the incidence and of the lit fraction.
+It finds them on the exact motion, whatever the output step, and in bounded memory:
+the span is searched in chunks of :data:`CHUNK_POINTS` points, and only what was
+found is kept between chunks.  The values it searches are those of
 :mod:`attitude.pointing.surroundings`, the same as :func:`attitude.pointing.sampling
 .pointing_samples` gives at the same times.
 
@@ -47,8 +48,8 @@ from attitude.environment.orbit import Orbit
 from attitude.environment.timescales import SECONDS_PER_DAY
 from attitude.pointing.eclipse import SUN_RADIUS_M
 from attitude.pointing.extrema import Extremum, Problem, least_of_each
-from attitude.pointing.intervals import Interval, difference, find_all_intervals, join
-from attitude.pointing.spec import BodyVector, PointingSpec, interval_precision
+from attitude.pointing.intervals import Interval, difference, find_all_intervals, join, union
+from attitude.pointing.spec import BodyVector, PointingSpec, for_scenario, interval_precision
 from attitude.pointing.surroundings import SunMoonEarth, moon_hidden, scenario_jd, vector_angles
 from attitude.solver.euler_solver import EulerSolver
 from attitude.trajectory.trajectory import Trajectory
@@ -238,6 +239,7 @@ def search_grid(
     span by default), from the rates of the motion and the orbit (see the module notes).
     """
     scenario = trajectory.scenario
+    spec = for_scenario(spec, scenario)  # the scenario's orbit, when the spec has none
     start_s = scenario.start_s if start_s is None else float(start_s)
     stop_s = scenario.stop_s if stop_s is None else float(stop_s)
     body = _body_rate(trajectory, start_s, stop_s)
@@ -282,6 +284,7 @@ def check_pointing(
     search grid of :func:`pointing_analysis` (None without pointing).
     """
     scenario = trajectory.scenario
+    spec = for_scenario(spec, scenario)  # the scenario's orbit, when the spec has none
     if spec.is_empty:
         return [], None
     notes = []
@@ -340,7 +343,10 @@ class VectorAnalysis:
 
     Intervals (TT s since the epoch): ``sun_visible`` (the Sun in front of the
     vector and the spacecraft not in umbra), ``sun_exclusion``, ``moon_exclusion`` and
-    ``earth_limb_exclusion`` (each constraint violated, as in :class:`VectorSamples`).
+    ``earth_limb_exclusion`` (each constraint violated, as in :class:`VectorSamples`),
+    ``blinded`` (their union: any of the vector's exclusions violated; empty for a
+    vector with none), ``sun_in_view`` (the Sun inside its inclusion cone and the
+    spacecraft not in umbra; empty without an inclusion cone).
     ``extrema``: for each quantity of :data:`EXTREMA` it has, (least, greatest)
     :class:`attitude.pointing.extrema.Extremum`, radians for angles.  ``mean_cos_incidence``:
     the time average of the incidence over the span.
@@ -353,6 +359,8 @@ class VectorAnalysis:
     moon_exclusion: list[Interval] = field(default_factory=list)
     earth_limb_exclusion: list[Interval] = field(default_factory=list)
     mean_cos_incidence: float = 0.0
+    blinded: list[Interval] = field(default_factory=list)
+    sun_in_view: list[Interval] = field(default_factory=list)
 
 
 @dataclass
@@ -427,6 +435,12 @@ def _conditions(spec: PointingSpec) -> dict[str, tuple[str, float, float]]:
                 f"{name}.earth_limb_angle",
                 -1.0,
                 -v.earth_limb_exclusion_angle_rad,
+            )
+        if v.sun_inclusion_half_angle_rad is not None:
+            conditions[f"{name}.sun_in_view"] = (
+                f"{name}.sun_angle",
+                -1.0,
+                -v.sun_inclusion_half_angle_rad,
             )
     return conditions
 
@@ -578,7 +592,9 @@ class _Search:
                 ),
                 earth_limb_exclusion=found.get(f"{name}.earth_limb_exclusion", []),
                 mean_cos_incidence=self.sums[f"{name}.cos_incidence"] / span,
+                sun_in_view=difference(found.get(f"{name}.sun_in_view", []), umbra),
             )
+            item.blinded = union(*(getattr(item, kind) for kind in v.exclusions))
             low, high = extrema["cos_incidence"]
             item.extrema["cos_incidence"] = (_first_dark(item, grid) or low, high)
             analysis.vectors.append(item)
@@ -600,6 +616,7 @@ def pointing_analysis(
     intervals found.  Interval ends are refined to ``spec.interval_precision_s``,
     extrema to 1 µs.
     """
+    spec = for_scenario(spec, trajectory.scenario)  # the scenario's orbit, if the spec has none
     if grid is None:
         grid = search_grid(trajectory, spec, start_s, stop_s)
     search = _Search(trajectory, spec, grid)

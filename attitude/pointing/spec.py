@@ -1,9 +1,11 @@
 """What a scenario asks of the pointing: body vectors, their constraints, the orbit.
 
 A :class:`BodyVector` is a direction fixed in body axes (a panel normal, a boresight, a
-star tracker's axis) with its constraints: a Sun and a Moon exclusion cone, and a least
-angle above the Earth's limb.  A :class:`PointingSpec` gathers the vectors, where the
-spacecraft is (an :class:`attitude.environment.orbit.Orbit`, or the Earth's centre when None), the
+star tracker's axis, a Sun sensor's axis) with its constraints: a Sun and a Moon
+exclusion cone, a least angle above the Earth's limb, and a Sun inclusion cone (the
+field of view of a Sun sensor, which must contain the Sun).  A :class:`PointingSpec`
+gathers the vectors, where the spacecraft is (an
+:class:`attitude.environment.orbit.Orbit`, or the Earth's centre when None), the
 precision of interval ends, the height of the limb's atmosphere and an optional Euler
 sequence for the attitude in LVLH.  Nothing here computes a direction: that is
 :mod:`attitude.pointing.sampling` (at given times) and :mod:`attitude.pointing.search`
@@ -15,6 +17,7 @@ degrees the user wrote, for the reports.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import re
 from dataclasses import dataclass, field
@@ -26,16 +29,18 @@ from numpy.typing import NDArray
 from attitude.base.errors import InputError
 from attitude.base.quantities import as_si_scalar, as_vector3
 from attitude.environment.orbit import Orbit, TleOrbit
+from attitude.scenario.scenario import Scenario, orbit_disagreement
 
 __all__ = [
     "KINDS",
     "BodyVector",
     "PointingSpec",
     "describe_lines",
+    "for_scenario",
     "interval_precision",
 ]
 
-KINDS = ("panel", "instrument", "star_tracker", "other")
+KINDS = ("panel", "instrument", "star_tracker", "sun_sensor", "other")
 
 
 def _angle(value: Any, name: str, what: str, low: float, high: float) -> float | None:
@@ -56,15 +61,22 @@ class BodyVector:
     """A named direction fixed in body axes (normalized on construction), and its
     constraints.
 
-    ``kind``: 'panel' (its Sun incidence is reported), 'instrument', 'star_tracker'
-    or 'other'.  Constraints (radians, or angle Quantities; None for none):
+    ``kind``: 'panel' (its Sun incidence is reported), 'instrument', 'star_tracker',
+    'sun_sensor' or 'other'.  Constraints (radians, or angle Quantities; None for none):
 
     - ``sun_exclusion_half_angle_rad``: the Sun must stay outside this cone about the
       vector (unless the spacecraft is in umbra: a hidden Sun blinds nothing);
     - ``moon_exclusion_half_angle_rad``: the same for the Moon (unless the Earth hides
       the Moon's centre);
     - ``earth_limb_exclusion_angle_rad``: the vector must stay at least this far above
-      the Earth's limb (or the limb of its atmosphere, see :class:`PointingSpec`).
+      the Earth's limb (or the limb of its atmosphere, see :class:`PointingSpec`);
+    - ``sun_inclusion_half_angle_rad``: the Sun must be *inside* this cone about the
+      vector (a Sun sensor's field of view); it is seen there unless the spacecraft is
+      in umbra.  With a Sun exclusion cone too, it must be the wider of the two, or
+      the Sun could never be seen.
+
+    The exclusions together say when the vector is blinded (by any of them); the
+    inclusion when it sees the Sun (:class:`attitude.pointing.search.VectorAnalysis`).
 
     The ``*_deg`` fields carry the same angles in degrees as the user wrote them (30,
     not degrees(radians(30)) = 29.999999999999996), for the reports; computed from the
@@ -80,6 +92,8 @@ class BodyVector:
     moon_exclusion_half_angle_deg: float | None = None
     earth_limb_exclusion_angle_rad: float | None = None
     earth_limb_exclusion_angle_deg: float | None = None
+    sun_inclusion_half_angle_rad: float | None = None
+    sun_inclusion_half_angle_deg: float | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", self.name):
@@ -100,6 +114,7 @@ class BodyVector:
             ("sun_exclusion_half_angle", "sun exclusion half angle", 0.0),
             ("moon_exclusion_half_angle", "moon exclusion half angle", 0.0),
             ("earth_limb_exclusion_angle", "earth limb exclusion angle", -90.0),
+            ("sun_inclusion_half_angle", "sun inclusion half angle", 0.0),
         ):
             radians = _angle(getattr(self, f"{prefix}_rad"), self.name, what, low, 180.0)
             degrees = getattr(self, f"{prefix}_deg")
@@ -110,6 +125,27 @@ class BodyVector:
             object.__setattr__(self, f"{prefix}_rad", radians)
             if radians is not None and degrees is None:
                 object.__setattr__(self, f"{prefix}_deg", math.degrees(radians))
+        inclusion, exclusion = self.sun_inclusion_half_angle_rad, self.sun_exclusion_half_angle_rad
+        if inclusion is not None and exclusion is not None and inclusion <= exclusion:
+            raise InputError(
+                f"body vector {self.name!r}: sun inclusion half angle "
+                f"{self.sun_inclusion_half_angle_deg:g} deg is within its sun exclusion half "
+                f"angle {self.sun_exclusion_half_angle_deg:g} deg: the Sun could never be seen"
+            )
+
+    @property
+    def exclusions(self) -> list[str]:
+        """The exclusions this vector has, by name (``sun_exclusion``, ``moon_exclusion``,
+        ``earth_limb_exclusion``): what can blind it."""
+        return [
+            name
+            for name, angle in (
+                ("sun_exclusion", self.sun_exclusion_half_angle_rad),
+                ("moon_exclusion", self.moon_exclusion_half_angle_rad),
+                ("earth_limb_exclusion", self.earth_limb_exclusion_angle_rad),
+            )
+            if angle is not None
+        ]
 
 
 _EULER_SEQUENCE = re.compile(r"[XYZ]{3}|[xyz]{3}")
@@ -120,8 +156,10 @@ class PointingSpec:
     """What pointing outputs a scenario asks for.
 
     ``body_vectors``: the :class:`BodyVector` list.  ``orbit``: an
-    :class:`attitude.environment.orbit.Orbit`, or the two lines of a TLE; None places the
-    spacecraft at the Earth's centre (Sun and Moon directions only).
+    :class:`attitude.environment.orbit.Orbit`, or the two lines of a TLE; None takes the
+    scenario's orbit (``Scenario(..., orbit=...)``, :func:`for_scenario`), and with none
+    there either places the spacecraft at the Earth's centre (Sun and Moon directions
+    only).
     ``interval_precision_s``: the precision to which interval ends are refined.
     ``earth_limb_atmosphere_height_m``: the height above the Earth's equatorial radius
     of the limb that the limb angles are measured from (0: the solid Earth; 50–100 km
@@ -164,15 +202,21 @@ class PointingSpec:
                 "lvlh_euler_sequence must be three axes, all upper case (intrinsic) or all "
                 f"lower case (extrinsic), no axis twice in a row (ZYX, zxz...), got {sequence!r}"
             )
-        if self.orbit is None:
-            needs = [v.name for v in self.body_vectors if v.earth_limb_exclusion_angle_rad]
-            if needs:
-                raise InputError(
-                    f"body vector {needs[0]!r}: an earth limb exclusion needs an orbit "
-                    "(a TLE, an OEM file or Keplerian elements)"
-                )
-            if sequence is not None:
-                raise InputError("lvlh_euler_sequence needs an orbit (LVLH is the orbit's frame)")
+
+    def check_orbit(self) -> None:
+        """Refuse (InputError) what needs an orbit without one: an Earth limb exclusion,
+        the attitude in LVLH.  Checked where the spec meets its scenario
+        (:func:`for_scenario`), whose orbit it takes when it has none of its own."""
+        if self.orbit is not None:
+            return
+        needs = [v.name for v in self.body_vectors if v.earth_limb_exclusion_angle_rad]
+        if needs:
+            raise InputError(
+                f"body vector {needs[0]!r}: an earth limb exclusion needs an orbit "
+                "(a TLE, an OEM file or Keplerian elements)"
+            )
+        if self.lvlh_euler_sequence is not None:
+            raise InputError("lvlh_euler_sequence needs an orbit (LVLH is the orbit's frame)")
 
     @property
     def is_empty(self) -> bool:
@@ -186,6 +230,26 @@ class PointingSpec:
     def tle(self) -> tuple[str, str] | None:
         """The TLE lines, when the orbit is a TLE."""
         return self.orbit.lines if isinstance(self.orbit, TleOrbit) else None
+
+
+def for_scenario(spec: PointingSpec, scenario: Scenario) -> PointingSpec:
+    """``spec`` as it applies to ``scenario``: with the scenario's orbit when the spec
+    gives none (the orbit is given once, to the Scenario), checked for what needs an
+    orbit.  A spec whose own orbit disagrees with the scenario's is refused
+    (:func:`attitude.scenario.scenario.orbit_disagreement`)."""
+    if scenario.orbit is not None:
+        if spec.orbit is None:
+            spec = dataclasses.replace(spec, orbit=scenario.orbit)
+        else:
+            disagreement = orbit_disagreement(scenario.orbit, spec.orbit, scenario)
+            if disagreement:
+                raise InputError(
+                    f"pointing.orbit: the PointingSpec's orbit is not the scenario's: "
+                    f"{disagreement}; give the orbit once, Scenario(..., orbit=...), and "
+                    "leave it out of the PointingSpec"
+                )
+    spec.check_orbit()
+    return spec
 
 
 def describe_lines(spec: PointingSpec) -> list[str]:
@@ -209,6 +273,7 @@ def describe_lines(spec: PointingSpec) -> list[str]:
                 ("Sun exclusion half angle", vector.sun_exclusion_half_angle_deg),
                 ("Moon exclusion half angle", vector.moon_exclusion_half_angle_deg),
                 ("Earth limb exclusion angle", vector.earth_limb_exclusion_angle_deg),
+                ("Sun inclusion half angle", vector.sun_inclusion_half_angle_deg),
             )
             if angle is not None
         ]

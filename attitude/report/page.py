@@ -66,6 +66,15 @@ def _exclusion(v: dict[str, Any], name: str) -> str | None:
     return None if found is None else f"{found['count']}, {found['total_s']:.6g} s"
 
 
+def _share(v: dict[str, Any], name: str) -> str | None:
+    """'count, total s (percent of the span)' of a union or inclusion of the pointing
+    summary (``blinded``, ``sun_in_view``), or None."""
+    found = v.get(name)
+    if found is None:
+        return None
+    return f"{found['count']}, {found['total_s']:.6g} s ({100.0 * found['fraction_of_span']:.4g} %)"
+
+
 def _pointing_table(vectors: dict[str, Any]) -> str:
     rows = [
         [
@@ -79,6 +88,8 @@ def _pointing_table(vectors: dict[str, Any]) -> str:
             _exclusion(v, "sun_exclusion"),
             _exclusion(v, "moon_exclusion"),
             _exclusion(v, "earth_limb_exclusion"),
+            _share(v, "blinded"),
+            _share(v, "sun_in_view"),
             v["sun_visible"]["total_s"],
             v["mean_cos_incidence"],
         ]
@@ -95,6 +106,8 @@ def _pointing_table(vectors: dict[str, Any]) -> str:
         "Sun exclusions (n, time)",
         "Moon exclusions",
         "limb exclusions",
+        "blinded by any (n, time, % of span)",
+        "Sun in its view (n, time, % of span)",
         "Sun visible (s)",
         "mean cos incidence",
     ]

@@ -27,7 +27,7 @@ from attitude.outputs.csv import pointing_column_count
 from attitude.outputs.formats import OutputChoice
 from attitude.outputs.parquet import check_span
 from attitude.pointing.search import SearchGrid, check_pointing
-from attitude.pointing.spec import PointingSpec
+from attitude.pointing.spec import PointingSpec, for_scenario
 from attitude.report.beside import Beside
 from attitude.scenario.scenario import Scenario
 from attitude.trajectory.guided import GUIDED
@@ -68,7 +68,8 @@ def plan_run(
     (``horizon_deferred`` says it is wanted): a run computes it beside its outputs
     (``attitude.report.run``), since it checks nothing and takes as long as a day's outputs.
     """
-    pointing = pointing or PointingSpec()
+    # The scenario's orbit, when the pointing gives none (the orbit is given once).
+    pointing = for_scenario(pointing or PointingSpec(), scenario)
     outputs = outputs or OutputChoice()
     samples = scenario.output_count()
     if "parquet" in outputs:

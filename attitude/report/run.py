@@ -217,8 +217,11 @@ def _parquet_metadata(scenario: Scenario, source: str) -> dict[str, Any]:
         "epoch_tt": f"{epoch_tt} TT",
         "time_scale": scenario.time_scale.upper(),
         "time_columns": f"time_{scenario.time_scale}: ISO 8601 in {scenario.time_scale.upper()} "
-        "(a UTC leap second is written 23:59:60); tt_ns: int64 TT nanoseconds since epoch_tt; "
-        "t_s: the same in float seconds",
+        "(a UTC leap second is written 23:59:60: parse it with astropy, not with pandas or "
+        "polars, which read it as the next second); timestamp_tt: the epoch in TT as a "
+        "timestamp (TT's calendar, no leap seconds: the column to order, plot and "
+        "difference by from pandas, polars or DuckDB); tt_ns: int64 TT nanoseconds since "
+        "epoch_tt, exact; t_s: the same in float seconds",
         "frames": "body = spacecraft body axes; icrf = ICRF axes (GCRS, geocentric)",
         "quaternion_convention": QUATERNION_CONVENTION,
         "units": "SI (s, rad/s, N m s, J), angles in deg where the name says _deg; "
@@ -243,12 +246,15 @@ class _Stream:
             )
             self.files.append("timeseries.csv")
         if "parquet" in plan.outputs:
+            metadata = _parquet_metadata(scenario, source)
             self.parquet = self.stack.enter_context(
                 ParquetWriter(
                     tmp / "timeseries.parquet",
                     label,
-                    _parquet_metadata(scenario, source),
+                    metadata,
                     f"ISO 8601 epoch in {scenario.time_scale.upper()}",
+                    epoch_tt=metadata["epoch_tt"],
+                    span_s=(scenario.start_s, scenario.stop_s),
                 )
             )
             self.files.append("timeseries.parquet")

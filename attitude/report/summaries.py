@@ -6,7 +6,8 @@ part of it says, from the objects that hold it.
 - :func:`motion_summary`: each segment of the exact motion (its closed form, periods,
   nutation, energy and momentum) and the flips;
 - :func:`pointing_summary`: the pointing's extrema with their times, constraint and
-  visibility totals and eclipses, all from :func:`attitude.pointing.search.pointing_analysis`
+  visibility totals (each exclusion's, their union "blinded", the Sun in a Sun
+  sensor's view) and eclipses, all from :func:`attitude.pointing.search.pointing_analysis`
   on the exact motion, none from the output grid;
 - :func:`outputs_summary`: the formats written, and the AEM's sampling and accuracy.
 
@@ -188,6 +189,11 @@ def _interval_totals(intervals: list[Interval], format_epoch=None) -> dict[str, 
     return totals
 
 
+def _fraction(intervals: list[Interval], span_s: float) -> float:
+    """The fraction of the span the intervals cover (0 for an empty span)."""
+    return total_duration(intervals) / span_s if span_s > 0.0 else 0.0
+
+
 # The extrema in the summary: (key in VectorAnalysis.extrema, summary name, in degrees).
 _EXTREMA = (
     ("sun_angle", "sun_angle", True),
@@ -226,6 +232,20 @@ def pointing_summary(analysis: PointingAnalysis, format_epoch) -> dict[str, Any]
             if getattr(v, angle) is not None:
                 entry[angle] = getattr(v, angle)
                 entry[constraint] = _interval_totals(getattr(item, constraint), format_epoch)
+        span = analysis.stop_s - analysis.start_s
+        if v.exclusions:
+            # Blinded by any: the union of the exclusions, not the sum of their totals.
+            entry["blinded"] = {
+                "by": v.exclusions,
+                **_interval_totals(item.blinded, format_epoch),
+                "fraction_of_span": _fraction(item.blinded, span),
+            }
+        if v.sun_inclusion_half_angle_deg is not None:
+            entry["sun_inclusion_half_angle_deg"] = v.sun_inclusion_half_angle_deg
+            entry["sun_in_view"] = {
+                **_interval_totals(item.sun_in_view, format_epoch),
+                "fraction_of_span": _fraction(item.sun_in_view, span),
+            }
         vectors[v.name] = entry
     summary: dict[str, Any] = {
         "position": analysis.orbit,

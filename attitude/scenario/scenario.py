@@ -20,11 +20,18 @@ Time rules (what a user can rely on):
   years that ISO 8601 and the CCSDS files write with four digits).
 - The output grid must be representable: a step that TT seconds resolve at the end
   of the span (see :meth:`Scenario.output_count`).
+
+The orbit is given once, to the scenario (``orbit``): the gravity gradient of its
+torques (``ScenarioTorques(gravity_gradient=True)``) and the pointing (a
+``PointingSpec`` without an orbit) both use it.  An orbit given to the torques or to the
+pointing as well is accepted when it is the same path (:func:`orbit_disagreement`), and
+refused, with both named, when it is not.
 """
 
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -52,10 +59,13 @@ from attitude.scenario.torques import MAX_STEPS, PlacedBurn, ScenarioTorques
 if TYPE_CHECKING:  # astropy loads only when a Time is made
     from astropy.time import Time
 
-__all__ = ["InitialState", "Scenario"]
+__all__ = ["ORBIT_AGREEMENT_M", "InitialState", "Scenario", "orbit_disagreement"]
 
 # Ten thousand Julian years: no span of years 0001–9999 is longer.
 _LONGEST_SPAN_S = 1e4 * 365.25 * 86400.0
+# Two orbits given for one scenario are the same path when their positions agree to
+# this (m) at its start, middle and end: the same elements or file give the same bits.
+ORBIT_AGREEMENT_M = 1.0
 
 
 @dataclass(frozen=True)
@@ -157,7 +167,7 @@ class Scenario:
     torques
         :class:`~attitude.scenario.torques.ScenarioTorques`: gravity gradient, burns,
         and the splitting's step and order (default: none, the exact torque-free
-        motion).
+        motion).  ``gravity_gradient=True`` acts on ``orbit``.
     orbit
         Where the spacecraft is: an :class:`attitude.environment.orbit.Orbit`
         (``TleOrbit``, ``KeplerianOrbit``, ``OemOrbit``) or the two lines of a TLE; the
@@ -278,6 +288,7 @@ class Scenario:
             torques = ScenarioTorques()
         if not isinstance(torques, ScenarioTorques):
             raise InputError(f"torques must be a ScenarioTorques, got {torques!r}")
+        torques = self._gravity_gradient_on_the_orbit(torques)
         self.torques = torques
         self.burns: list[PlacedBurn] = []
         for index, burn in enumerate(torques.burns):
@@ -306,6 +317,27 @@ class Scenario:
                 f"over the span of {self.stop_s:g} s, more than {MAX_STEPS:g}: give a larger "
                 "step, an accuracy, or a shorter span"
             )
+
+    def _gravity_gradient_on_the_orbit(self, torques: ScenarioTorques) -> ScenarioTorques:
+        """``torques`` with ``gravity_gradient=True`` placed on the scenario's orbit; an
+        orbit of their own accepted if it agrees with the scenario's."""
+        source = torques.gravity_gradient
+        if source is True:
+            if self.orbit is None:
+                raise InputError(
+                    "torques.gravity_gradient: True acts on the scenario's orbit, and it has "
+                    "none: give Scenario(..., orbit=...)"
+                )
+            return dataclasses.replace(torques, gravity_gradient=self.orbit)
+        if source is not None and self.orbit is not None:
+            disagreement = orbit_disagreement(self.orbit, source, self)
+            if disagreement:
+                raise InputError(
+                    f"torques.gravity_gradient: its orbit is not the scenario's: "
+                    f"{disagreement}; give the orbit once, Scenario(..., orbit=...), and "
+                    "gravity_gradient=True"
+                )
+        return torques
 
     def with_torques(self, torques: ScenarioTorques | None) -> Scenario:
         """The same scenario propagated under ``torques`` (e.g. to measure what a
@@ -376,3 +408,39 @@ class Scenario:
             f"Scenario({self.name!r}, {self.spacecraft.name!r}, epoch {self.format_epoch(0.0)}, "
             f"{len(self.events)} events, {self.stop_s:g} s)"
         )
+
+
+def _positions(source: Any, scenario: Scenario, seconds: NDArray[np.float64]) -> NDArray:
+    """The GCRS positions (m) of an orbit source at TT ``seconds`` since the scenario
+    epoch: an Orbit (two-part TT dates), a callable of those seconds, or an object with
+    ``position_velocity``/``position`` taking ``Time``."""
+    if isinstance(source, Orbit):
+        with offline_time():
+            tt = scenario.epoch.tt
+        jd1 = np.full(seconds.shape, float(tt.jd1))
+        return source.state_tt(jd1, float(tt.jd2) + seconds / 86400.0)[0]
+    if callable(source):
+        return np.asarray(source(seconds), dtype=np.float64).reshape(seconds.size, 3)
+    times = scenario.times(seconds)
+    if hasattr(source, "position_velocity"):
+        return np.asarray(source.position_velocity(times)[0], dtype=np.float64)
+    return np.asarray(source.position(times), dtype=np.float64)
+
+
+def orbit_disagreement(orbit: Any, other: Any, scenario: Scenario) -> str | None:
+    """None if ``other`` (an orbit given to the torques or the pointing beside the
+    scenario's) is the scenario's ``orbit``: the same object, or positions within
+    :data:`ORBIT_AGREEMENT_M` at the start, middle and end of the span; else what
+    differs, in words."""
+    if other is orbit:
+        return None
+    seconds = np.array([0.0, 0.5 * scenario.stop_s, scenario.stop_s])
+    mine, theirs = _positions(orbit, scenario, seconds), _positions(other, scenario, seconds)
+    gaps = np.linalg.norm(np.asarray(theirs) - np.asarray(mine), axis=-1)
+    worst = int(np.argmax(gaps))
+    if gaps[worst] <= ORBIT_AGREEMENT_M:
+        return None
+    return (
+        f"{getattr(other, 'describe', lambda: repr(other))()} is {gaps[worst] / 1e3:.6g} km "
+        f"from the scenario's {orbit.describe()} at {scenario.format_epoch(seconds[worst])}"
+    )

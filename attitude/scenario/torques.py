@@ -6,10 +6,12 @@ events.  With :class:`ScenarioTorques` its segments are propagated by
 ``docs/torques.md``) under:
 
 - **gravity gradient** from a point-mass Earth, at the position of the scenario's
-  orbit (``gravity_gradient``: an orbit object with ``position(times)`` or
-  ``position_velocity(times)`` taking ``astropy.time.Time``, such as the ``TleOrbit``,
-  ``OemOrbit`` or ``KeplerianOrbit`` of ``[pointing]``, or a callable of TT seconds
-  since the scenario epoch returning inertial positions in metres);
+  orbit (``gravity_gradient=True``: the orbit given to the ``Scenario``, once for the
+  torques and the pointing; or, given here, an orbit object with ``position(times)``
+  or ``position_velocity(times)`` taking ``astropy.time.Time``, such as a
+  ``TleOrbit``, ``OemOrbit`` or ``KeplerianOrbit``, or a callable of TT seconds since
+  the scenario epoch returning inertial positions in metres; the scenario refuses one
+  that disagrees with its own orbit);
 - **burns** (:class:`Burn`): a constant torque, N m, fixed in the body axes or in
   inertial axes, from a start epoch over a duration.  A burn is continuous across the
   scenario's events: an impulse, an inertia change or an attitude reset during a burn
@@ -90,9 +92,10 @@ class Burn:
 class ScenarioTorques:
     """The torques a scenario is propagated under, and the splitting's step and order.
 
-    See the module docstring.  ``gravity_gradient``: the orbit (or position callable)
-    whose gravity gradient acts, or None; ``burns``: :class:`Burn` s; ``step`` (s) or
-    ``accuracy`` (rad), not both; ``order``: 2, 4 or 6; ``horizon_threshold``: rad.
+    See the module docstring.  ``gravity_gradient``: True for the scenario's orbit,
+    the orbit (or position callable) whose gravity gradient acts, or None (False);
+    ``burns``: :class:`Burn` s; ``step`` (s) or ``accuracy`` (rad), not both;
+    ``order``: 2, 4 or 6; ``horizon_threshold``: rad.
     """
 
     gravity_gradient: Any = None
@@ -133,15 +136,21 @@ class ScenarioTorques:
                 f"got {math.degrees(threshold)!r} deg"
             )
         object.__setattr__(self, "horizon_threshold", threshold)
-        if self.gravity_gradient is not None and not (
-            callable(self.gravity_gradient)
-            or hasattr(self.gravity_gradient, "position")
-            or hasattr(self.gravity_gradient, "position_velocity")
+        if self.gravity_gradient is False:
+            object.__setattr__(self, "gravity_gradient", None)
+        if (
+            self.gravity_gradient is not None
+            and self.gravity_gradient is not True
+            and not (
+                callable(self.gravity_gradient)
+                or hasattr(self.gravity_gradient, "position")
+                or hasattr(self.gravity_gradient, "position_velocity")
+            )
         ):
             raise InputError(
-                "torques.gravity_gradient: must be an orbit (position(times) or "
-                "position_velocity(times)) or a callable t -> inertial position (m), "
-                f"got {self.gravity_gradient!r}"
+                "torques.gravity_gradient: must be True (the scenario's orbit), an orbit "
+                "(position(times) or position_velocity(times)) or a callable t -> inertial "
+                f"position (m), got {self.gravity_gradient!r}"
             )
 
     @property
