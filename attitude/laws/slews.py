@@ -256,16 +256,18 @@ class Slew:
         fmt = math.degrees
         rate = Ω - W_B - D
         if not rate > 0.0:
-            what = (
-                f"the body turns at {fmt(D):.4g} deg/s relative to the target law"
-                if D > W_B
-                else f"the target law turns at up to {fmt(W_B):.4g} deg/s"
-            )
-            raise InputError(
-                f"{self.key}: {what} (and the target at up to {fmt(W_B):.4g} deg/s): "
-                f"nothing is left for the slew under max_rate {fmt(Ω):.4g} deg/s, which "
-                "cannot capture it; give a larger max_rate"
-            )
+            if W_B >= Ω:
+                why = (
+                    f"the target law itself turns at up to {fmt(W_B):.4g} deg/s, beyond "
+                    f"max_rate {fmt(Ω):.4g} deg/s: no slew within it can join the law"
+                )
+            else:
+                why = (
+                    f"the body turns at {fmt(D):.4g} deg/s relative to the target law, which "
+                    f"turns at up to {fmt(W_B):.4g} deg/s: max_rate {fmt(Ω):.4g} deg/s cannot "
+                    "capture it"
+                )
+            raise InputError(f"{self.key}: {why}; give a larger max_rate")
         K = A_B + W_B * rate + (W_B + rate) * D
         available = A - K
         if not available > 0.0:

@@ -1,0 +1,285 @@
+"""Hostile attitude laws, slews and control losses: one clear line from both `check` and
+`run`, naming the file and the key, and nothing written.
+
+Parallel directions (given so, and reached during the run), parallel body vectors,
+slews that cannot finish before the next event, a tumble too fast to capture, a
+control loss with absurd wheel momentum, a law that needs an orbit in a scenario
+without one, events out of place (a mode change while control is lost, a resume
+under a law, an impulse under a law), and the scenario file's own mistakes.  And two
+that must run: a ground site at the pole (regular), and a ground target that never
+rises above the horizon in its segment, which the run states (check's notes and
+summary.json), not tracked silently through the Earth.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+
+import astropy.units as u
+import numpy as np
+import pytest
+from astropy.time import Time
+
+from attitude import KeplerianOrbit, SunLaw
+from attitude.cli.main import main
+
+BASE = """
+[scenario]
+name = "guided"
+epoch = "2025-05-01T10:00:00"
+
+[spacecraft]
+name = "eo"
+principal_moments = [820.0, 1040.0, 610.0]
+
+[pointing.keplerian]
+semi_major_axis = { value = 7078.137, unit = "km" }
+eccentricity = 0.001
+inclination = { value = 98.2, unit = "deg" }
+raan = { value = 170.0, unit = "deg" }
+argument_of_perigee = { value = 0.0, unit = "deg" }
+mean_anomaly = { value = 0.0, unit = "deg" }
+j2 = true
+
+[[sites]]
+name = "kiruna"
+latitude = { value = 67.857, unit = "deg" }
+longitude = { value = 20.964, unit = "deg" }
+height = 400.0
+
+[initial_state.law]
+name = "nadir"
+yaw_steering = "zero_doppler"
+
+[[events]]
+type = "mode_change"
+offset = 600.0
+law = { name = "sun", axis = "-z", constraint_axis = "+x", constraint = "orbit_normal" }
+[events.slew]
+max_rate = { value = 1.0, unit = "deg/s" }
+max_acceleration = { value = 0.05, unit = "deg/s2" }
+
+[[events]]
+type = "control_loss"
+offset = 1200.0
+wheels = { case = "spinning", momentum = [0.0, 2.0, 0.0] }
+
+[output]
+duration = 1800.0
+step = 10.0
+formats = ["csv"]
+"""
+
+SUN_LAW = 'law = { name = "sun", axis = "-z", constraint_axis = "+x", constraint = "orbit_normal" }'
+
+
+def _replace(old: str, new: str, text: str = BASE) -> str:
+    assert old in text, old
+    return text.replace(old, new, 1)
+
+
+def _apparent_sun_at(seconds: float) -> list[float]:
+    """The apparent Sun from the spacecraft at ``seconds`` (ICRF unit vector)."""
+    epoch = Time("2025-05-01T10:00:00", scale="utc")
+    orbit = KeplerianOrbit(
+        epoch,
+        7078.137 * u.km,
+        0.001,
+        98.2 * u.deg,
+        170 * u.deg,
+        0 * u.deg,
+        mean_anomaly=0 * u.deg,
+        j2=True,
+    )
+    bound = SunLaw("+z", "+x").bind(epoch, 0.0, 1800.0, orbit)
+    return bound.state([seconds]).attitude[0].apply([0.0, 0.0, 1.0]).tolist()
+
+
+REFUSED = {
+    "parallel body vectors": (
+        _replace(
+            SUN_LAW,
+            'law = { name = "align_constrain", primary_axis = "+x", primary = "sun", '
+            'secondary_axis = "-x", secondary = "orbit_normal" }',
+        ),
+        r"events\[0\]\.law: align_constrain: the primary and secondary body vectors are parallel",
+    ),
+    "the same direction twice": (
+        _replace(
+            SUN_LAW,
+            'law = { name = "align_constrain", primary_axis = "+x", primary = "nadir", '
+            'secondary_axis = "+y", secondary = "-nadir" }',
+        ),
+        r"events\[0\]\.law: .*cannot make a pair: they are opposite",
+    ),
+    "directions parallel during the run": (
+        _replace(
+            SUN_LAW,
+            'law = { name = "align_constrain", primary_axis = "+x", primary = "sun", '
+            f'secondary_axis = "+y", secondary = {_apparent_sun_at(900.0)!r} }}',
+        ),
+        r"events\[0\]\.law: the align_constrain law is undefined at 2025-05-01T10:1[45]:.* UTC "
+        r"\(t = 9\d\d\.\d* s\): .* come within .* rad of each other",
+    ),
+    "a slew that cannot end before the next event": (
+        _replace("offset = 1200.0", "offset = 650.0"),
+        r"events\[0\]\.slew: the slew of 1\d\d\.\d deg from .* takes \d+\.?\d* s .* after the next "
+        r"event, events\[1\] at 2025-05-01T10:10:50",
+    ),
+    "a resume onto a law faster than the slew's limit": (
+        _replace(
+            "[output]",
+            '[[events]]\ntype = "control_resume"\noffset = 1500.0\nlaw = { name = "nadir" }\n'
+            'slew = { max_rate = { value = 0.01, unit = "deg/s" }, max_acceleration = '
+            '{ value = 0.05, unit = "deg/s2" } }\n\n[output]',
+        ),
+        r"events\[2\]\.slew: the target law itself turns at up to 0\.06\d* deg/s, beyond "
+        r"max_rate 0\.01 deg/s: no slew within it can join the law; give a larger max_rate",
+    ),
+    "a resume from a tumble too fast to capture": (
+        _replace(
+            "[output]",
+            '[[events]]\ntype = "control_resume"\noffset = 1500.0\nlaw = { name = "nadir" }\n'
+            'slew = { max_rate = { value = 0.15, unit = "deg/s" }, max_acceleration = '
+            '{ value = 0.05, unit = "deg/s2" } }\n\n[output]',
+            _replace(
+                'case = "spinning", momentum = [0.0, 2.0, 0.0]',
+                'case = "locked", momentum = [0.5, 2.0, 1.0]',
+            ),
+        ),
+        r"events\[2\]\.slew: the body turns at 0\.1\d* deg/s relative to the target law, which "
+        r"turns at up to 0\.06\d* deg/s: max_rate 0\.15 deg/s cannot capture it; give a "
+        r"larger max_rate",
+    ),
+    "absurd wheel momentum": (
+        _replace("momentum = [0.0, 2.0, 0.0]", "momentum = [0.0, 2.0e7, 0.0]"),
+        r"events\[1\]\.wheels\.momentum: \[0\.0, 20000000\.0, 0\.0\] N m s would turn the body "
+        r"at 1\.92e\+04 rad/s .*no reaction wheel holds that much",
+    ),
+    "wheel momentum beyond floats": (
+        _replace("momentum = [0.0, 2.0, 0.0]", "momentum = [0.0, 1e400, 0.0]"),
+        r"events\[1\]\.wheels\.momentum: expected finite numbers, got \[0\.0, inf, 0\.0\]",
+    ),
+    "a law that needs an orbit without one": (
+        re.sub(r"(?s)\[pointing\.keplerian\].*?j2 = true\n", "", BASE),
+        r"initial_state\.law: the nadir law \(\+z on geodetic nadir, zero-Doppler yaw "
+        r"steering\) needs an orbit .* and the scenario has none",
+    ),
+    "a mode change while control is lost": (
+        _replace(
+            "[output]",
+            f'[[events]]\ntype = "mode_change"\noffset = 1500.0\n{SUN_LAW}\n\n[output]',
+        ),
+        r"events\[2\] \(mode_change at .*\): control is lost at that epoch .*: use "
+        r"control_resume to return to a law",
+    ),
+    "a resume under a law": (
+        _replace(
+            'type = "control_loss"', 'type = "control_resume"\nlaw = { name = "nadir" }'
+        ).replace('wheels = { case = "spinning", momentum = [0.0, 2.0, 0.0] }\n', ""),
+        r"events\[1\] \(control_resume at .*\): control is not lost at that epoch",
+    ),
+    "an impulse under a law": (
+        _replace(
+            "[output]",
+            '[[events]]\ntype = "angular_impulse"\noffset = 300.0\nimpulse = [0.1, 0.0, 0.0]'
+            "\n\n[output]",
+        ),
+        r"events\[2\] \(angular_impulse at .*\): an angular_impulse needs a free body, and a "
+        r"law holds the attitude",
+    ),
+    "an unknown law": (
+        _replace('name = "nadir"\nyaw', 'name = "nadirr"\nyaw'),
+        r"initial_state\.law\.name: expected one of inertial, orbit_frame, nadir, sun, target, "
+        r"align_constrain, got 'nadirr'",
+    ),
+    "an unknown site": (
+        _replace(SUN_LAW, 'law = { name = "target", target = "kourou" }'),
+        r"events\[0\]\.law\.target: unknown direction 'kourou'",
+    ),
+    "a key of another law": (
+        _replace('yaw_steering = "zero_doppler"', 'yaw_steering = "zero_doppler"\naxis = "+x"'),
+        r"initial_state\.law: unknown key 'axis'; expected one of: name, yaw_steering, vertical, "
+        r"phasing_axis",
+    ),
+    "a law beside an attitude": (
+        _replace(
+            "[initial_state.law]",
+            "[initial_state]\nquaternion = [1.0, 0.0, 0.0, 0.0]\n[initial_state.law]",
+        ),
+        r"initial_state: give \[initial_state\.law\] alone",
+    ),
+    "a slew without its acceleration": (
+        _replace('max_acceleration = { value = 0.05, unit = "deg/s2" }\n', ""),
+        r"events\[0\]\.slew\.max_acceleration: missing key",
+    ),
+    "a slew acceleration in deg/s": (
+        _replace('unit = "deg/s2"', 'unit = "deg/s"'),
+        r"events\[0\]\.slew\.max_acceleration: unit 'deg / s' cannot be converted",
+    ),
+    "a negative slew rate": (
+        _replace('value = 1.0, unit = "deg/s" }', 'value = -1.0, unit = "deg/s" }'),
+        r"events\[0\]\.slew\.max_rate: must be positive",
+    ),
+    "wheels of no known case": (
+        _replace('case = "spinning"', 'case = "coasting"'),
+        r"events\[1\]\.wheels\.case: expected one of locked, spinning, got 'coasting'",
+    ),
+    "a site named like a direction": (
+        _replace('name = "kiruna"', 'name = "sun"'),
+        r"sites\[0\]\.name: expected a name that is not a direction's",
+    ),
+    "a site beyond the pole": (
+        _replace("value = 67.857", "value = 97.857"),
+        r"sites\[0\]: latitude must be between -90 and 90 deg",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", sorted(REFUSED))
+def test_refused_in_one_line_by_check_and_run(case, tmp_path, capsys):
+    text, message = REFUSED[case]
+    path = tmp_path / "guided.toml"
+    path.write_text(text)
+    out = tmp_path / "out"
+    for command in ("check", "run"):
+        argv = [command, str(path)] + (["--out", str(out)] if command == "run" else [])
+        assert main(argv) == 2, case
+        err = capsys.readouterr().err
+        assert len(err.strip().splitlines()) == 1, err
+        assert err.startswith("attitude: error: guided.toml: "), err
+        assert re.search(message, err), err
+    assert not out.exists()
+
+
+def test_a_site_at_the_pole_is_tracked(tmp_path, capsys):
+    text = _replace("value = 67.857", "value = 90.0")
+    text = _replace(SUN_LAW, 'law = { name = "target", target = "kiruna" }', text)
+    path = tmp_path / "pole.toml"
+    path.write_text(text)
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    target = [s for s in summary["guidance"]["segments"] if s.get("law") == "target"]
+    assert target and all(np.isfinite(s["rate_bound_deg_s"]) for s in target)
+    assert any(s["ground_site_passes"] for s in target if "ground_site_passes" in s)
+
+
+def test_a_target_that_never_rises_is_stated(tmp_path, capsys):
+    # Kiruna is below the horizon from 10:00 to 10:15 (it rises at about 10:22).
+    text = _replace("offset = 600.0", "offset = 120.0")
+    text = _replace(SUN_LAW, 'law = { name = "target", target = "kiruna" }', text)
+    text = _replace("offset = 1200.0", "offset = 900.0", text)
+    path = tmp_path / "below.toml"
+    path.write_text(text)
+    assert main(["check", str(path)]) == 0
+    shown = capsys.readouterr().out
+    assert re.search(r"note +events\[0\]\.law: kiruna never rises above the horizon between", shown)
+    assert main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    notes = summary["guidance"]["notes"]
+    assert any("kiruna never rises above the horizon" in note for note in notes), notes
+    target = [s for s in summary["guidance"]["segments"] if s.get("law") == "target"]
+    assert [s["ground_site_visible"] for s in target if "ground_site_visible" in s] == [False]
+    assert math.isfinite(target[-1]["rate_bound_deg_s"])
