@@ -45,8 +45,14 @@ def _best(function, repeats: int) -> float:
 
 def main() -> None:
     orbit = KeplerianOrbit(
-        EPOCH, 7_078_137.0, 0.001, math.radians(98.2), math.radians(170.0), 0.0,
-        mean_anomaly=0.0, j2=True,
+        EPOCH,
+        7_078_137.0,
+        0.001,
+        math.radians(98.2),
+        math.radians(170.0),
+        0.0,
+        mean_anomaly=0.0,
+        j2=True,
     )
     bound = NadirLaw("zero_doppler").bind(EPOCH, 0.0, 86400.0, orbit)
     taus = np.arange(0.0, 86400.0, 10.0)
@@ -94,8 +100,10 @@ def main() -> None:
             )
 
     cost = _best(batch, 1)
-    print(f"propagate_batch, spinning, 10 s:   {cost / taus.size * 1e3:8.3f} ms an instant "
-          f"({cost:.1f} s for the day)")
+    print(
+        f"propagate_batch, spinning, 10 s:   {cost / taus.size * 1e3:8.3f} ms an instant "
+        f"({cost:.1f} s for the day)"
+    )
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 
