@@ -20,9 +20,14 @@ the reports ask of a segment's solver (the interface of
   each instant where the law's two directions come closest, where its rate peaks), and
   the bound is the largest sampled |ω| plus the largest change of ω between
   neighbouring samples; for a slew, never more than the slew's own analytic bound
-  (max_rate).  ``angular_momentum_norm`` (I_max × that bound) and ``kinetic_energy``
-  (½ I_max × its square) are upper bounds of |Iω| and ½ω·Iω over the segment, as the
-  torqued segments' are (the layers above use them as rate bounds).
+  (max_rate).  It holds wherever |ω| rises and falls at most once between samples:
+  laws change on the orbit's time scale (the fastest, a ground station passed
+  overhead, over tens of seconds), and where a law's rate spikes (its directions
+  closest) is a sample (``tests/test_guided_rate_bound_against_dense_sampling.py``
+  checks it against 10 ms sampling at both).  ``angular_momentum_norm`` (I_max × that
+  bound) and ``kinetic_energy`` (½ I_max × its square) are upper bounds of |Iω| and
+  ½ω·Iω over the segment, as the torqued segments' are (the layers above use them as
+  rate bounds).
 
 A guided segment is refused (one line, naming the law's key and the epoch) where the
 law is undefined: its two directions parallel within
