@@ -81,7 +81,9 @@ def test_our_aem_read_by_orekit_is_within_its_declared_tolerance(example):
         f"t = {rows['t_s'][worst]:.6f} s (segment {int(rows['segment'][worst])}), "
         f"{tolerance:g} declared"
     )
-    assert len(json.loads(header["records_per_segment"])) == len(scenario.events) + 1
+    # A segment per stretch between events, and more where a stretch is not smooth
+    # inside (a slew's switches, a law taking over after its slew).
+    assert len(json.loads(header["records_per_segment"])) >= len(scenario.events) + 1
 
 
 def _times(start_utc: str, offsets_s: np.ndarray) -> Time:
