@@ -210,8 +210,7 @@ class Slew:
         θ = self.angle_rad
         if not deadline_s > self.start_s:
             raise InputError(
-                f"{self.key}: the slew has no time: the next event, {deadline_text}, is at the "
-                "same epoch"
+                f"{self.key}: the slew has no time: {deadline_text} is at the same epoch"
             )
         # W_B and A_B are bounds over the slew itself: from the shortest duration the
         # limits allow, the window grows to the duration found until it covers it.

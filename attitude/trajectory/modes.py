@@ -186,9 +186,10 @@ class _Builder:
                 deadline_text=deadline_text,
                 format_epoch=self.scenario.format_epoch,
             )
-            motion = self.guided(slew, inertia, start, slew.end_s, key)
-            self.add(start, slew.end_s, motion, motion.state, event, before)
-            t = slew.end_s
+            if slew.duration_s > SAME_INSTANT_S:  # else already on the law, at its rate
+                motion = self.guided(slew, inertia, start, slew.end_s, key)
+                self.add(start, slew.end_s, motion, motion.state, event, before)
+                t = slew.end_s
         if t == start or end - t > SAME_INSTANT_S:
             motion = self.guided(bound, inertia, t, end, key)
             # After a slew the law takes over without an event of its own.
