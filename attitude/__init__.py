@@ -6,7 +6,8 @@ checks it, and that the README's "Layout" table lists the same layers and module
 
 1. ``attitude.base``: errors, units, quaternions, vectors, the compile policy
 2. ``attitude.elliptic``: Jacobi elliptic functions and elliptic integrals, the phase table
-3. ``attitude.solver``: the exact torque-free solver (``EulerSolver``) and its free flow
+3. ``attitude.solver``: the exact torque-free solver (``EulerSolver``), its free flow and
+   its sensitivities
 4. ``attitude.torques``: torques by splitting with the exact free flow (``TorquedSolver``)
 5. ``attitude.environment``: time scales, the Sun and Moon, the Earth, frames, orbits
 6. ``attitude.laws``: attitude laws (nadir, Sun, target, align-and-constrain, ...) and their rates
@@ -16,8 +17,9 @@ checks it, and that the README's "Layout" table lists the same layers and module
 10. ``attitude.outputs``: CSV, Parquet and AEM files, the output budget and folder
 11. ``attitude.report``: a run's plan, summaries, figures, page and streamed writing
 12. ``attitude.files``: scenario files read and written
-13. ``attitude.montecarlo``: Monte Carlo dispersions on Dask
-14. ``attitude.cli``: the command line
+13. ``attitude.estimation``: spin state and inertia ratios fitted to telemetry
+14. ``attitude.montecarlo``: Monte Carlo dispersions on Dask
+15. ``attitude.cli``: the command line
 
 The names below are importable from ``attitude`` directly; all but the errors are
 loaded on first use, so that ``import attitude`` stays light (numpy, scipy, astropy,
@@ -40,6 +42,8 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.environment.keplerian import KeplerianOrbit
     from attitude.environment.oem import OemOrbit
     from attitude.environment.orbit import TleOrbit
+    from attitude.estimation.fit import FitRefused, SpinStateFit, fit_spin_state
+    from attitude.estimation.telemetry_files import TelemetryFile, read_telemetry
     from attitude.files.scenario_reader import load_scenario
     from attitude.laws.align_constrain import (
         AlignConstrainLaw,
@@ -64,6 +68,7 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.scenario.spacecraft import Spacecraft
     from attitude.scenario.torques import Burn, ScenarioTorques
     from attitude.solver.euler_solver import EulerSolver
+    from attitude.solver.sensitivities import FlowSensitivities, flow_sensitivities
     from attitude.torques.models import ConstantTorque, GravityGradient, UserTorque
     from attitude.torques.solver import TorquedSolver, departure_time, propagate_batch
     from attitude.trajectory.handoff import hand_off, hand_off_at, hand_off_states
@@ -73,6 +78,13 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
 
 _LAZY = {
     "EulerSolver": "attitude.solver.euler_solver",
+    "FlowSensitivities": "attitude.solver.sensitivities",
+    "flow_sensitivities": "attitude.solver.sensitivities",
+    "fit_spin_state": "attitude.estimation.fit",
+    "SpinStateFit": "attitude.estimation.fit",
+    "FitRefused": "attitude.estimation.fit",
+    "read_telemetry": "attitude.estimation.telemetry_files",
+    "TelemetryFile": "attitude.estimation.telemetry_files",
     "TorquedSolver": "attitude.torques.solver",
     "propagate_batch": "attitude.torques.solver",
     "departure_time": "attitude.torques.solver",
@@ -144,7 +156,9 @@ __all__ = [
     "ControlResume",
     "DegenerateLawError",
     "EulerSolver",
+    "FitRefused",
     "FixedDirection",
+    "FlowSensitivities",
     "GravityGradient",
     "GroundSite",
     "InertiaChange",
@@ -164,8 +178,10 @@ __all__ = [
     "Slew",
     "SlewLimits",
     "Spacecraft",
+    "SpinStateFit",
     "SunLaw",
     "TargetLaw",
+    "TelemetryFile",
     "TleOrbit",
     "TorquedSolver",
     "Trajectory",
@@ -174,6 +190,8 @@ __all__ = [
     "__version__",
     "analyze",
     "departure_time",
+    "fit_spin_state",
+    "flow_sensitivities",
     "hand_off",
     "hand_off_at",
     "hand_off_states",
@@ -182,6 +200,7 @@ __all__ = [
     "pointing_samples",
     "propagate",
     "propagate_batch",
+    "read_telemetry",
     "run_montecarlo",
     "validity_horizon",
     "visible_intervals",

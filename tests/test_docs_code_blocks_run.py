@@ -6,8 +6,8 @@
   written into the clone).  It imports the package only as ``from attitude import``
   or ``import attitude``: the public API is what ``attitude`` exports.
 - A ``toml`` block parses.
-- A ``sh`` block's ``attitude check`` and ``attitude run`` lines run to exit 0 (the
-  others install, build or benchmark: CI's own steps, or ``benchmarks/``).
+- A ``sh`` block's ``attitude check``, ``attitude run`` and ``attitude fit`` lines run to
+  exit 0 (the others install, build or benchmark: CI's own steps, or ``benchmarks/``).
 """
 
 import os
@@ -110,7 +110,8 @@ def _commands() -> list[tuple[str, list[str]]]:
             for part in text.split("#", 1)[0].split("&&"):
                 words = shlex.split(part)
                 template = any(_PLACEHOLDER.match(word) for word in words)
-                if words[:2] in (["attitude", "check"], ["attitude", "run"]) and not template:
+                commands = (["attitude", "check"], ["attitude", "run"], ["attitude", "fit"])
+                if words[:2] in commands and not template:
                     found.append((f"{_name(page)}:{line + 1 + offset}", words))
     return found
 

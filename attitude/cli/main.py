@@ -101,6 +101,9 @@ def _parser() -> argparse.ArgumentParser:
             'of the exact attitude, with its unit: "1e-6 rad" (the default), "0.2 arcsec"',
         )
     _montecarlo_parser(commands)
+    from attitude.cli.fit import add_parser as add_fit_parser
+
+    add_fit_parser(commands)
     return parser
 
 
@@ -244,6 +247,10 @@ def _run(args, state: dict) -> int:
 
     with warnings.catch_warnings():
         warnings.showwarning = show_warning
+        if args.command == "fit":
+            from attitude.cli.fit import command
+
+            return command(args)
         return _checked_run(args, state)
 
 

@@ -15,4 +15,6 @@ Modules:
   full tensor.
 - ``invariants``: Δ1, Δ2, Δ3 and mc of float inputs: the exact case test, for one state
   or a batch.
+- ``sensitivities``: Sensitivities of the exact torque-free motion: its Jacobian with
+  respect to the initial attitude, the initial body momentum and the principal moments.
 """
