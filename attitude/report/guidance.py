@@ -184,7 +184,11 @@ def guidance_section(guidance: dict[str, Any] | None, table: Any) -> list[str]:
                     s["start"],
                     s["end"],
                     s["kind"],
-                    s.get("law_description") or s.get("propagation"),
+                    (
+                        f"onto {s['law_description']}"
+                        if s["kind"] == "slew"
+                        else s.get("law_description") or s.get("propagation")
+                    ),
                 ]
                 for s in guidance["segments"]
             ],
@@ -193,7 +197,14 @@ def guidance_section(guidance: dict[str, Any] | None, table: Any) -> list[str]:
     if guidance["slews"]:
         parts.append(
             table(
-                ["slew (segment)", "from", "angle (deg)", "duration (s)", "peak rate (deg/s)"],
+                [
+                    "slew (segment)",
+                    "from",
+                    "angle (deg)",
+                    "duration (s)",
+                    "peak rate (deg/s)",
+                    "off the eigen axis, at most (deg)",
+                ],
                 [
                     [
                         s["segment"],
@@ -201,6 +212,7 @@ def guidance_section(guidance: dict[str, Any] | None, table: Any) -> list[str]:
                         s["angle_deg"],
                         s["duration_s"],
                         s["profile_peak_rate_deg_s"],
+                        s["off_eigen_axis_at_most_deg"],
                     ]
                     for s in guidance["slews"]
                 ],
