@@ -14,7 +14,8 @@ For ``summary.json`` (``guidance``), ``attitude check`` and the HTML report, fro
 - each control loss: the wheels, the body rate just after, and the total momentum;
 - the ground sites a law tracks: their passes above the horizon over the segment,
   and a note for a site never seen there;
-- the notes of :class:`~attitude.trajectory.modes.ModeTimeline`.
+- the notes of the guided segments (a site never seen, the Earth orientation table's
+  coverage).
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from attitude.trajectory.guided import GuidedMotion
+from attitude.trajectory.modes import uses_laws
 
 if TYPE_CHECKING:
     from attitude.report.plan import RunPlan
@@ -60,8 +62,7 @@ def _law_entry(solver: GuidedMotion) -> dict[str, Any]:
 def guidance_summary(plan: RunPlan) -> dict[str, Any] | None:
     """The ``guidance`` entry of ``summary.json`` (None without laws)."""
     trajectory = plan.trajectory
-    modes = trajectory.modes
-    if modes is None:
+    if not uses_laws(plan.scenario):
         return None
     fmt = plan.scenario.format_epoch
     segments, slews, losses = [], [], []
@@ -78,12 +79,11 @@ def guidance_summary(plan: RunPlan) -> dict[str, Any] | None:
         if isinstance(solver, GuidedMotion):
             entry.update(_law_entry(solver))
             entry["rate_bound_deg_s"] = math.degrees(solver.angular_rate_bound)
-            if k in modes.visibility:
+            if solver.passes is not None:
                 entry["ground_site_passes"] = [
-                    {"start": fmt(a), "end": fmt(b), "duration_s": b - a}
-                    for a, b in modes.visibility[k]
+                    {"start": fmt(a), "end": fmt(b), "duration_s": b - a} for a, b in solver.passes
                 ]
-                entry["ground_site_visible"] = bool(modes.visibility[k])
+                entry["ground_site_visible"] = bool(solver.passes)
             slew = solver.slew
             if slew is not None:
                 slews.append(
@@ -126,7 +126,9 @@ def guidance_summary(plan: RunPlan) -> dict[str, Any] | None:
         "segments": segments,
         "slews": slews,
         "control_losses": losses,
-        "notes": list(modes.notes),
+        "notes": list(
+            dict.fromkeys(n for s in trajectory.segments for n in getattr(s.solver, "notes", ()))
+        ),
         "torques_note": "the scenario's torques act on the free segments only: while a law "
         "holds the attitude, its controller absorbs them",
     }

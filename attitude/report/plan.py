@@ -85,8 +85,9 @@ def plan_run(
     check_fits(budget)
     motion = analyze(trajectory)
     notes, search = check_pointing(trajectory, pointing)
-    if trajectory.modes is not None:  # attitude laws: ground sites never seen, EOP coverage
-        notes = [*trajectory.modes.notes, *notes]
+    # Attitude laws: ground sites never seen, the Earth orientation table's coverage.
+    guided = [n for s in trajectory.segments for n in getattr(s.solver, "notes", ())]
+    notes = [*dict.fromkeys(guided), *notes]
     undersampled = undersampling_note(trajectory, motion)
     if undersampled:
         notes.append(undersampled)

@@ -397,7 +397,7 @@ def _summary_of_the_stream(plan: RunPlan, source: str, stream: _Stream) -> dict[
         "scenario": scenario_summary(scenario, source),
         "motion": motion_summary(plan.trajectory, plan.motion),
         "torques": torques_summary(plan),
-        **({"guidance": guidance_summary(plan)} if plan.trajectory.modes is not None else {}),
+        **({"guidance": guidance} if (guidance := guidance_summary(plan)) else {}),
         "extrema": {
             "max_rate_deg_s": math.degrees(stream.peak_rate[0]),
             "max_rate_at": scenario.format_epoch(stream.peak_rate[1]),

@@ -101,6 +101,11 @@ class GuidedMotion:
         self.key = key
         self.formula = "slew" if isinstance(profile, Slew) else "guided"
         self._last: tuple[NDArray[np.float64], LawState] | None = None
+        # What the run should say about the segment (the Earth orientation table's
+        # coverage, a ground site never seen), and the passes of a ground site the law
+        # tracks (attitude.trajectory.modes fills them).
+        self.notes: list[str] = list(self.bound_law.notes)
+        self.passes: list[tuple[float, float]] | None = None
         self._check_defined()
         start = self._state(np.array([self._t0, self._t0]))
         self.state = State(

@@ -26,15 +26,15 @@ loss or resume), and each is a segment of the AEM.
 :func:`mode_segments` returns the segments as tuples for
 :mod:`attitude.trajectory.trajectory`, which hands in its own builder of free and
 torqued solvers (so that both paths make them alike).  A ground site a law tracks is
-checked for visibility over its segment: one that never rises above the horizon is a
-note (:attr:`ModeTimeline.notes`), stated by ``check`` and in the summary.
+checked for visibility over its segment (``GuidedMotion.passes``): one that never rises
+above the horizon is a note of that segment (``GuidedMotion.notes``, with the Earth
+orientation table's coverage), stated by ``check`` and in the summary.
 """
 
 from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -51,7 +51,7 @@ from attitude.solver.inertia import PrincipalAxes
 from attitude.trajectory.guided import GuidedMotion
 from attitude.trajectory.torqued import TorquedMotion
 
-__all__ = ["GYROSTAT_ACCURACY_RAD", "ModeTimeline", "mode_segments", "uses_laws"]
+__all__ = ["GYROSTAT_ACCURACY_RAD", "mode_segments", "uses_laws"]
 
 # The accuracy (rad) a gyrostat's step is chosen for when [torques] states none: the
 # gyroscopic term is not small, and the splitting's dense output bends at each grid
@@ -68,17 +68,6 @@ def uses_laws(scenario: Scenario) -> bool:
     if getattr(scenario.initial_state, "law", None) is not None:
         return True
     return any(event.kind in MODE_EVENTS for _, event in scenario.events)
-
-
-@dataclass
-class ModeTimeline:
-    """The segments of a scenario with laws, and what the run should say about them:
-    ``notes`` (a ground site never visible, the Earth orientation table's coverage)
-    and, per guided segment index, the visibility of the ground site its law tracks."""
-
-    segments: list[RawSegment]
-    notes: list[str] = field(default_factory=list)
-    visibility: dict[int, list[tuple[float, float]]] = field(default_factory=dict)
 
 
 def _orbit(scenario: Scenario) -> Any:
@@ -101,7 +90,7 @@ class _Builder:
         self.free_solver = free_solver
         self.check_resolved = check_resolved
         self.orbit = _orbit(scenario)
-        self.timeline = ModeTimeline([])
+        self.segments: list[RawSegment] = []
         self.wheels: Wheels | None = None  # spinning wheels of the free body, or None
         self.law_key = ""
 
@@ -111,18 +100,14 @@ class _Builder:
         return f"events[{index}] ({event.kind} at {self.scenario.format_epoch(offset)})"
 
     def step_for(self) -> float | None:
-        k = len(self.timeline.segments)
+        k = len(self.segments)
         return self.steps[k] if k < len(self.steps) else None
 
     def add(self, start: float, end: float, solver: Any, state: State, event, before) -> None:
-        self.timeline.segments.append((start, end, solver, state, event, before))
+        self.segments.append((start, end, solver, state, event, before))
 
     def bind(self, law: Any, start: float, end: float, key: str) -> BoundLaw:
-        bound = law.bind(self.scenario.epoch, start, end, self.orbit, key)
-        for note in bound.notes:
-            if note not in self.timeline.notes:
-                self.timeline.notes.append(note)
-        return bound
+        return law.bind(self.scenario.epoch, start, end, self.orbit, key)
 
     def guided(
         self, profile: BoundLaw | Slew, inertia: PrincipalAxes, start: float, end: float, key: str
@@ -131,9 +116,9 @@ class _Builder:
         self.check_resolved(motion, start, end, key)
         return motion
 
-    def visibility(self, motion: GuidedMotion, index: int) -> None:
-        """The ground site of a target law: its passes over the segment; a note when
-        it never rises above the horizon there."""
+    def visibility(self, motion: GuidedMotion) -> None:
+        """The ground site of a target law: its passes over the segment
+        (``motion.passes``); a note when it never rises above the horizon there."""
         bound = motion.bound_law
         try:
             site = ground_site(bound)
@@ -142,15 +127,14 @@ class _Builder:
         a, b = motion.t0, motion.end_s
         if b - a <= SAME_INSTANT_S:
             return
-        passes = [
+        motion.passes = [
             (max(p0, a), min(p1, b))
             for p0, p1 in visible_intervals(bound, 0.0)
             if p1 > a and p0 < b
         ]
-        self.timeline.visibility[index] = passes
-        if not passes:
+        if not motion.passes:
             fmt = self.scenario.format_epoch
-            self.timeline.notes.append(
+            motion.notes.append(
                 f"{motion.key}: {site.name} never rises above the horizon between {fmt(a)} and "
                 f"{fmt(b)}: the law points the body through the Earth at it the whole time"
             )
@@ -194,17 +178,17 @@ class _Builder:
             motion = self.guided(bound, inertia, t, end, key)
             # After a slew the law takes over without an event of its own.
             self.add(t, end, motion, motion.state, event, before if t == start else None)
-            self.visibility(motion, len(self.timeline.segments) - 1)
+            self.visibility(motion)
         return self.state_at(end)
 
     def state_at(self, t: float) -> State:
         """The state at ``t`` of the last segment (the state just before an event)."""
-        solver = self.timeline.segments[-1][2]
+        solver = self.segments[-1][2]
         pair = np.array([t, t])
         attitude = solver.attitude(pair)[0]
         momentum = solver.angular_momentum(pair)[0]
         self.rate_before = solver.angular_velocity(pair)[0]
-        inertia = self.timeline.segments[-1][3].inertia
+        inertia = self.segments[-1][3].inertia
         return State(attitude, momentum, inertia)
 
     # ---- the free stretches
@@ -243,7 +227,7 @@ class _Builder:
 
     # ---- the walk
 
-    def build(self, models: list) -> ModeTimeline:
+    def build(self, models: list) -> list[RawSegment]:
         scenario = self.scenario
         self.models = models
         initial = scenario.initial_state
@@ -281,7 +265,7 @@ class _Builder:
                 state, guided = self.on_guided(event, index, where, before, offset, end, following)
             else:
                 state, guided = self.on_free(event, index, where, before, offset, end, following)
-        return self.timeline
+        return self.segments
 
     def on_guided(self, event, index, where, before, offset, end, following):
         key = f"events[{index}]"
@@ -300,7 +284,7 @@ class _Builder:
             )
             return state, True
         if isinstance(event, InertiaChange):  # the law holds on, with the new I·ω
-            law = self.timeline.segments[-1][2].law
+            law = self.segments[-1][2].law
             state = self.law_stretch(law, self.law_key, event.inertia, offset, end, event, before)
             return state, True
         if isinstance(event, ControlLoss):
@@ -366,8 +350,9 @@ def mode_segments(
     free_solver: Callable[..., Any],
     check_resolved: Callable[..., None],
     models: list,
-) -> ModeTimeline:
-    """The segments of ``scenario`` (which uses laws: :func:`uses_laws`), in time order.
+) -> list[RawSegment]:
+    """The segments of ``scenario`` (which uses laws: :func:`uses_laws`), in time order,
+    as (start, end, solver, state, event, before).
 
     ``steps``: per segment, the torqued solver's step (None: as the scenario says);
     ``free_solver(state, t0, end, where, step)``: the free or torqued solver from a

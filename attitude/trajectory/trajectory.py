@@ -32,7 +32,7 @@ from attitude.scenario.scenario import Scenario
 from attitude.solver.euler_solver import EulerSolver
 from attitude.torques.solver import angles_between
 from attitude.trajectory.guided import GuidedMotion
-from attitude.trajectory.modes import ModeTimeline, mode_segments, uses_laws
+from attitude.trajectory.modes import mode_segments, uses_laws
 from attitude.trajectory.torqued import TorquedMotion, scenario_torque_models
 
 if TYPE_CHECKING:  # astropy loads only when a Time is made
@@ -132,7 +132,7 @@ def propagate(scenario: Scenario, steps: list[float | None] | None = None) -> Tr
     """
     models = scenario_torque_models(scenario) if scenario.torques.any else []
     if uses_laws(scenario):  # laws, slews and control losses: attitude.trajectory.modes
-        timeline = mode_segments(
+        raw = mode_segments(
             scenario,
             steps or [],
             lambda state, t0, end, where, step: _solver(
@@ -141,7 +141,7 @@ def propagate(scenario: Scenario, steps: list[float | None] | None = None) -> Tr
             _check_resolved,
             models,
         )
-        return Trajectory(scenario, [Segment(*raw) for raw in timeline.segments], timeline)
+        return Trajectory(scenario, [Segment(*item) for item in raw])
     initial = scenario.initial_state
     axes = scenario.spacecraft.principal_axes
     if initial.angular_momentum is not None:
@@ -184,13 +184,9 @@ class Trajectory:
     body axes unless the name says inertial.
     """
 
-    def __init__(
-        self, scenario: Scenario, segments: list[Segment], modes: ModeTimeline | None = None
-    ) -> None:
+    def __init__(self, scenario: Scenario, segments: list[Segment]) -> None:
         self.scenario = scenario
         self.segments = segments
-        # With attitude laws: the notes and ground-site passes (attitude.trajectory.modes).
-        self.modes = modes
         # Segment k is in force from _starts[k] on (an event's epoch gets its post-event state).
         self._starts = np.array([segment.start_s for segment in segments]) - _SPAN_TOLERANCE_S
         self._starts[0] = -np.inf
