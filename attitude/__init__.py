@@ -67,7 +67,9 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.scenario.scenario import InitialState, Scenario
     from attitude.scenario.spacecraft import Spacecraft
     from attitude.scenario.torques import Burn, ScenarioTorques
+    from attitude.solver.batch import EulerSolverBatch
     from attitude.solver.euler_solver import EulerSolver
+    from attitude.solver.free_flow import advance
     from attitude.solver.sensitivities import FlowSensitivities, flow_sensitivities
     from attitude.torques.models import ConstantTorque, GravityGradient, UserTorque
     from attitude.torques.solver import TorquedSolver, departure_time, propagate_batch
@@ -78,6 +80,8 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
 
 _LAZY = {
     "EulerSolver": "attitude.solver.euler_solver",
+    "EulerSolverBatch": "attitude.solver.batch",
+    "advance": "attitude.solver.free_flow",
     "FlowSensitivities": "attitude.solver.sensitivities",
     "flow_sensitivities": "attitude.solver.sensitivities",
     "fit_spin_state": "attitude.estimation.fit",
@@ -156,6 +160,7 @@ __all__ = [
     "ControlResume",
     "DegenerateLawError",
     "EulerSolver",
+    "EulerSolverBatch",
     "FitRefused",
     "FixedDirection",
     "FlowSensitivities",
@@ -188,6 +193,7 @@ __all__ = [
     "UserTorque",
     "Wheels",
     "__version__",
+    "advance",
     "analyze",
     "departure_time",
     "fit_spin_state",

@@ -1,7 +1,8 @@
 """Benchmark: the free-flow map ``attitude.solver.free_flow.advance``, against scipy's ellipj.
 
-In one run, as ratios to peers timed side by side (absolute times depend on the load,
-which is printed):
+In one run, as ratios to peers timed side by side: CPU time (``time.process_time``),
+the best of short windows of each in turn, both warm, with the peer's own cost printed
+beside the ratio and the load average before and after:
 
 - one state, one step: ``advance`` on a single state (its constants included), and
   ``advance_floats`` (tuples in and out: what the torqued solver calls for one
@@ -43,20 +44,62 @@ from attitude.solver.free_flow import UnitBatch, advance, advance_floats
 RESULTS = Path(__file__).parent / "results"
 
 
-def _best_per_call(function, repeats: int, window_s: float = 0.003) -> float:
-    """The best, over ``repeats`` runs of about ``window_s`` each, of the mean time of a
-    call (seconds).  Short runs, so that on a loaded machine some of them run
-    uninterrupted: the best is close to the tool's own cost, for ours and the peer's."""
-    start = time.perf_counter()
+def _cpu_per_call(function, repeats: int, window_s: float = 0.003) -> float:
+    """The best, over ``repeats`` runs of about ``window_s`` of CPU each, of the mean CPU
+    time of a call (seconds, ``time.process_time``).  Short runs, so that on a loaded
+    machine some of them are not disturbed (cache, frequency): the best is close to the
+    code's own cost, for ours and the peer's."""
+    start = time.process_time()
     function()  # warm up, and size the runs
-    calls = max(1, int(window_s / max(time.perf_counter() - start, 1e-7)))
+    calls = max(1, int(window_s / max(time.process_time() - start, 1e-7)))
     best = np.inf
     for _ in range(repeats):
-        start = time.perf_counter()
+        start = time.process_time()
         for _ in range(calls):
             function()
-        best = min(best, (time.perf_counter() - start) / calls)
+        best = min(best, (time.process_time() - start) / calls)
     return best
+
+
+def _paired_per_call(ours, peer, repeats: int) -> tuple[float, float]:
+    """``_cpu_per_call`` of ``ours`` and ``peer``, a window of each in turn (both warm),
+    so that both see the same load."""
+    best_ours = best_peer = np.inf
+    _cpu_per_call(ours, 1)
+    _cpu_per_call(peer, 1)
+    for _ in range(repeats):
+        best_ours = min(best_ours, _cpu_per_call(ours, 1))
+        best_peer = min(best_peer, _cpu_per_call(peer, 1))
+    return best_ours, best_peer
+
+
+def _cpu_best(function, repeats: int = 3) -> float:
+    """The best CPU time of one call of ``function`` over ``repeats`` calls."""
+    best = np.inf
+    for _ in range(repeats):
+        start = time.process_time()
+        function()
+        best = min(best, time.process_time() - start)
+    return best
+
+
+def _machine_line() -> str:
+    """The processor, its cores and the versions the figures depend on."""
+    cpu = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    import numba
+    import scipy
+
+    return (
+        f"{cpu}, {os.cpu_count()} cores, Python {platform.python_version()}, numpy "
+        f"{np.__version__}, scipy {scipy.__version__}, numba {numba.__version__}"
+    )
 
 
 def _state(kind: str, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
@@ -126,35 +169,41 @@ def main(argv=None) -> dict:
 
     report: dict = {
         "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
-        "machine": f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores",
-        "python": platform.python_version(),
-        "numpy": np.__version__,
+        "machine": _machine_line(),
+        "clock": "CPU (time.process_time), best of alternated windows",
         "scalar": {},
         "batch": {},
     }
+    print(f"{report['machine']}; {report['clock']}; load average {load_before[0]:.2f}")
 
     # ------------------------------------------------------------ one state, one step
-    ellipj = _best_per_call(lambda: special.ellipj(0.7, 0.3), repeats)
-    report["scalar_ellipj_us"] = ellipj * 1e6
-    print(f"one scalar scipy.special.ellipj call: {ellipj * 1e9:.0f} ns")
+    scalar_ellipj = lambda: special.ellipj(0.7, 0.3)  # noqa: E731
     print(
         f"{'one state, one step':34s} {'advance':>10s} {'/ellipj':>8s} "
-        f"{'advance_floats':>15s} {'/ellipj':>8s} {'EulerSolver':>12s}"
+        f"{'advance_floats':>15s} {'/ellipj':>8s} {'EulerSolver':>12s} [ellipj]"
     )
     for kind in SCALAR_KINDS:
         inertia, m = _state(kind, rng)
         q = Rotation.random(random_state=3).as_quat(scalar_first=True)
         dt = 3.7
-        step = _best_per_call(lambda: advance(inertia, m, q, dt), repeats)  # noqa: B023
+        step, ellipj = _paired_per_call(
+            lambda: advance(inertia, m, q, dt),  # noqa: B023
+            scalar_ellipj,
+            repeats,
+        )
         floats = (tuple(inertia.tolist()), tuple(m.tolist()), tuple(q.tolist()), dt)
-        step_floats = _best_per_call(lambda: advance_floats(*floats), repeats)  # noqa: B023
+        step_floats, _ = _paired_per_call(
+            lambda: advance_floats(*floats),  # noqa: B023
+            scalar_ellipj,
+            repeats,
+        )
         attitude0 = Rotation.from_quat(q, scalar_first=True)
 
         def solver_step():
             solver = EulerSolver(inertia, m, attitude0)  # noqa: B023
             return solver.angular_momentum(dt), solver.attitude_quaternion(dt)  # noqa: B023
 
-        solver = _best_per_call(solver_step, repeats)
+        solver, _ = _paired_per_call(solver_step, scalar_ellipj, repeats)
         report["scalar"][kind] = {
             "advance_us": step * 1e6,
             "ratio_to_ellipj": step / ellipj,
@@ -162,11 +211,12 @@ def main(argv=None) -> dict:
             "advance_floats_ratio_to_ellipj": step_floats / ellipj,
             "euler_solver_us": solver * 1e6,
             "ratio_euler_solver_to_advance": solver / step,
+            "scalar_ellipj_us": ellipj * 1e6,
         }
         print(
             f"  {kind:32s} {step * 1e6:8.1f} µs {step / ellipj:7.1f}x "
             f"{step_floats * 1e6:13.1f} µs {step_floats / ellipj:7.1f}x "
-            f"{solver * 1e6:9.0f} µs ({solver / step:.0f}x advance)"
+            f"{solver * 1e6:9.0f} µs ({solver / step:.0f}x advance) [{ellipj * 1e6:.2f} µs]"
         )
 
     # ------------------------------------------------------------ N states, one step each
@@ -177,15 +227,19 @@ def main(argv=None) -> dict:
         for count in sizes:
             moments, momentum, q, dt = _batch(kind, count, rng)
             u, mpar = rng.uniform(-3.0, 3.0, count), rng.uniform(0.0, 1.0, count)
-            ours = _best_per_call(lambda: advance(moments, momentum, q, dt), repeats)  # noqa: B023
+            ours, peer = _paired_per_call(
+                lambda: advance(moments, momentum, q, dt),  # noqa: B023
+                lambda: special.ellipj(u, mpar),  # noqa: B023
+                repeats,
+            )
             # The torqued batch's flow: moments kept from call to call (UnitBatch).
             unit_batch = UnitBatch(np.ascontiguousarray(moments, dtype=np.float64))
             q_unit = q / np.linalg.norm(q, axis=1, keepdims=True)
-            kept = _best_per_call(
+            kept, _ = _paired_per_call(
                 lambda: unit_batch.advance(momentum, q_unit, dt),  # noqa: B023
+                lambda: special.ellipj(u, mpar),  # noqa: B023
                 repeats,
             )
-            peer = _best_per_call(lambda: special.ellipj(u, mpar), repeats)  # noqa: B023
             report["batch"][kind][count] = {
                 "advance_ns_per_state": ours / count * 1e9,
                 "unit_batch_ns_per_state": kept / count * 1e9,

@@ -25,9 +25,7 @@ PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 _BLOCK = re.compile(r"^```(\w*)\n(.*?)^```", re.S | re.M)
 _DEEP_IMPORT = re.compile(r"^\s*(?:from|import)\s+attitude\.\w", re.M)
 # Blocks that still name a module path, each with what makes it public.
-_NOT_YET_PUBLIC = {
-    "docs/solver.md:60": "the free-flow map becomes public with the batched solver interface",
-}
+_NOT_YET_PUBLIC: dict[str, str] = {}
 _PLACEHOLDER = re.compile(r"^[A-Z][A-Z_]*(\.toml)?$")  # FILE, DIR, SCENARIO.toml: a template
 
 

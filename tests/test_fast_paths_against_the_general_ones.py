@@ -19,11 +19,12 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-import attitude.solver.euler_solver as euler_solver
 import attitude.solver.free_flow as free_flow
+import attitude.solver.numpy_backend as numpy_backend
 from attitude import EulerSolver
 from attitude.base.errors import InputError
-from attitude.solver.euler_solver import _TABLE_MIN_SAMPLES, _one_rotation
+from attitude.solver.backends import TABLE_MIN_SAMPLES as _TABLE_MIN_SAMPLES
+from attitude.solver.euler_solver import _one_rotation
 
 ATTITUDE0 = Rotation.from_euler("ZYX", [10.0, 20.0, 30.0], degrees=True)
 STATES = {
@@ -75,13 +76,13 @@ def test_attitude_and_attitude_quaternion_are_the_same_numbers(name):
 
 @pytest.mark.parametrize("name", ["case i", "case ii", "separatrix", "tensor", "rest"])
 def test_no_result_depends_on_the_slice_size_or_on_the_other_times(name, monkeypatch):
-    """Arrays evaluate in slices of ``_CHUNK`` samples: every sample is computed alone
+    """Arrays evaluate in slices of ``numpy_backend.CHUNK`` samples: every sample is computed alone
     (no reduction across samples), so a time gives the same bits in any slice and
     beside any other times (on either side of the table threshold)."""
     t = np.random.default_rng(4).uniform(-1e4, 1e5, 3 * _TABLE_MIN_SAMPLES)
     solver = EulerSolver(*STATES[name], ATTITUDE0)
     q, m, w = solver.attitude_quaternion(t), solver.angular_momentum(t), solver.angular_velocity(t)
-    monkeypatch.setattr(euler_solver, "_CHUNK", 1000)
+    monkeypatch.setattr(numpy_backend, "CHUNK", 1000)
     other = EulerSolver(*STATES[name], ATTITUDE0)
     np.testing.assert_array_equal(other.attitude_quaternion(t), q)
     np.testing.assert_array_equal(other.angular_momentum(t), m)
@@ -154,7 +155,7 @@ def test_a_state_alone_equals_the_same_state_in_a_batch_of_1e5():
 def test_a_batch_gives_the_same_bits_in_slices_of_any_size(monkeypatch):
     moments, momentum, q, dt, _ = _mixed_batch(20_000, seed=13)
     m_new, q_new = free_flow.advance(moments, momentum, q, dt)
-    monkeypatch.setattr(free_flow, "_CHUNK", 777)
+    monkeypatch.setattr(numpy_backend, "FLOW_CHUNK", 777)
     m_other, q_other = free_flow.advance(moments, momentum, q, dt)
     np.testing.assert_array_equal(m_other, m_new)
     np.testing.assert_array_equal(q_other, q_new)
@@ -209,7 +210,7 @@ def test_a_unit_batch_kept_over_many_flows_gives_the_bits_of_fresh_calls(monkeyp
     flow leaves take the numpy path in slices."""
     moments, momentum, q, dt, kinds = _mixed_batch(3000, seed=15)
     q = q / np.linalg.norm(q, axis=1, keepdims=True)
-    monkeypatch.setattr(free_flow, "_CHUNK", 1100)  # three slices, the last a short one
+    monkeypatch.setattr(numpy_backend, "FLOW_CHUNK", 1100)  # three slices, the last short
     unit_batch = free_flow.UnitBatch(moments)
     rng = np.random.default_rng(16)
     for flow in range(4):

@@ -1,7 +1,7 @@
 """The table of ψ's periodic part (attitude.elliptic.phase_table) against mpmath and the formula.
 
 ``EulerSolver`` takes the periodic part of ψ from a piecewise Chebyshev table when a
-call asks for many times (``euler_solver._TABLE_MIN_SAMPLES``).  A table is only
+call asks for many times (``backends.TABLE_MIN_SAMPLES``).  A table is only
 acceptable if it is as exact as the formula it replaces:
 
 - per(r) from the table and from the formula (``Elliptic.periodic_angle``), both
@@ -25,8 +25,8 @@ from scipy.spatial.transform import Rotation
 
 from attitude import EulerSolver
 from attitude.elliptic.phase_table import PiecewiseChebyshev
+from attitude.solver.backends import TABLE_MIN_SAMPLES as _TABLE_MIN_SAMPLES
 from attitude.solver.closed_form import Elliptic
-from attitude.solver.euler_solver import _TABLE_MIN_SAMPLES
 
 ATTITUDE0 = Rotation.from_euler("ZYX", [10.0, 20.0, 30.0], degrees=True)
 

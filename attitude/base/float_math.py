@@ -42,8 +42,6 @@ class _FloatMath:
     sqrt = staticmethod(math.sqrt)
     exp = staticmethod(_exp)
     log = staticmethod(_log)
-    sin = staticmethod(math.sin)
-    cos = staticmethod(math.cos)
     tan = staticmethod(math.tan)
     tanh = staticmethod(math.tanh)
     arctan = staticmethod(math.atan)
@@ -54,14 +52,9 @@ class _FloatMath:
     abs = staticmethod(abs)
     rint = staticmethod(_rint)
     where = staticmethod(_where)
-    isfinite = staticmethod(math.isfinite)
     minimum = staticmethod(min)
     pi = math.pi
     inf = math.inf
-
-    @staticmethod
-    def all(condition: bool) -> bool:
-        return bool(condition)
 
 
 FLOAT = _FloatMath()

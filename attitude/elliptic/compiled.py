@@ -1,6 +1,6 @@
 """Compiled (numba) elliptic kernels for one parameter and one argument at a time.
 
-The exact free flow of one state (attitude.solver.compiled_flow) needs, per step, the AGM of
+The exact free flow of one state (attitude.solver.numba_backend) needs, per step, the AGM of
 its parameter, K, Bulirsch's sn, cn, dn at two arguments, F for the phase, Π − K and
 Carlson's R_J twice.  In numpy on a batch of 1000 states, each of these costs a few
 hundred numpy calls per flow, ~2 µs a state in all (docs/benchmarks.md); compiled,
@@ -36,8 +36,9 @@ import math
 
 import numpy as np
 
+from attitude.base import double_double
 from attitude.base.double_double import two_prod
-from attitude.base.jit import jit
+from attitude.base.jit import inline, jit
 
 __all__ = [
     "AGM_LEVELS",
@@ -62,6 +63,8 @@ AGM_LEVELS = 40
 # in these distances for R_F, [OLBC10] 19.36.1; degree 6 for R_J, 19.36.2).
 _RF_SPREAD = 2.0**-10
 _RJ_SPREAD = 2.0**-10
+
+inline(double_double.FUNCTIONS)  # two_prod, in complete_first_kind
 
 # π/2 as a float and its rounding error (π/2 − HALF_PI = 6.1e-17, −0.35 ulp of K).
 _HALF_PI = 0.5 * math.pi

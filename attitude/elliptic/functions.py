@@ -51,6 +51,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy import special
+from scipy.special import cython_special
 
 from attitude.base.float_math import FLOAT
 
@@ -190,9 +191,9 @@ def _bulirsch(z: Any, mc: Any, xp: Any, agm: tuple | None = None) -> tuple[Any, 
     """
     a_seq, b_seq, c, levels = _agm(mc, xp) if agm is None else agm
     x = z * c  # |x| ≤ π/4, since c K = π/2
-    a = 1.0 / xp.tan(x)  # cot x: one tangent (numpy's is vectorized; sin, cos are not)
+    a: Any = 1.0 / xp.tan(x)  # cot x: one tangent (numpy's is vectorized; sin, cos are not)
     c = c * a
-    d = 1.0
+    d: Any = 1.0
     shared = len(a_seq) if levels is None else int(levels.min())  # levels every element has
     for i in range(len(a_seq) - 1, -1, -1):
         a_i, b_i = a_seq[i], b_seq[i]
@@ -272,7 +273,7 @@ def reduced_sn_cn_dn(
     if not np.any(far):
         return s, c, d
     shifted = _quarter_shift(np.copysign(1.0, r), mc, s, c, d, np)
-    return tuple(np.where(far, f, g) for f, g in zip(shifted, (s, c, d), strict=True))
+    return np.where(far, shifted[0], s), np.where(far, shifted[1], c), np.where(far, shifted[2], d)
 
 
 def _reduced_sn_cn_dn_positive_mc(
@@ -374,11 +375,18 @@ def _split_angle(phi: ArrayLike) -> tuple[NDArray[np.float64], ...]:
     return j, np.sin(phir), np.cos(phir)
 
 
-def _f_of_sin_cos(s: Any, c: Any, mc: Any) -> Any:
+def _f_of_sin_cos(s: Any, c: Any, mc: Any, xp: Any = np) -> Any:
     """F(φ|m) for |φ| ≤ π/2 from s = sin φ and c = cos φ ≥ 0: [OLBC10] 19.25.5,
     F = s R_F(c², c² + mc s², 1) (``c² + mc s²`` is 1 − m s² without cancellation)."""
     c2 = c * c
-    return s * special.elliprf(c2, c2 + mc * s * s, 1.0)
+    return s * _special(xp).elliprf(c2, c2 + mc * s * s, 1.0)
+
+
+def _special(xp: Any) -> Any:
+    """scipy's special functions for arrays (ufuncs), or for floats their Cython
+    versions (``scipy.special.cython_special``: the same code and bits, a float in and
+    out, without the ufunc's dispatch, a third of its cost on one float)."""
+    return cython_special if xp is FLOAT else special
 
 
 def elliptic_f(phi: ArrayLike, mc: ArrayLike) -> NDArray[np.float64]:
@@ -394,9 +402,7 @@ def elliptic_f(phi: ArrayLike, mc: ArrayLike) -> NDArray[np.float64]:
         return np.where(j == 0.0, f, f + 2.0 * j * complete_first_kind(mc))
 
 
-def pi_minus_f(
-    j: ArrayLike, sn: ArrayLike, cn: ArrayLike, dn: ArrayLike, n: ArrayLike, mc: ArrayLike
-) -> NDArray[np.float64]:
+def pi_minus_f(j: Any, sn: Any, cn: Any, dn: Any, n: Any, mc: Any) -> Any:
     """Π(φ, n|m) − F(φ|m) at the amplitude φ = jπ + φr, given sin φr, cos φr ≥ 0, Δ(φr).
 
     From [OLBC10] 19.25.14 (Carlson form of Π, valid for |φr| ≤ π/2):
@@ -465,11 +471,12 @@ def _cel(kc: Any, p: Any, a: Any, b: Any, xp: Any = np) -> Any:
     """
     sqrt = xp.sqrt
     e = kc
-    mean = 1.0
+    mean: Any = 1.0
     p = sqrt(p)
     a = a + 0.0 * kc
     b = b / p
-    final = pending = None
+    final: list[Any] | None = None
+    pending: Any = None
     for _ in range(40):
         f = a
         a = a + b / p
@@ -505,7 +512,7 @@ def _cel(kc: Any, p: Any, a: Any, b: Any, xp: Any = np) -> Any:
 # ----------------------------------------------------------------- m within 2^-128 of 1
 
 
-def complete_first_kind_near_one(log_mc: ArrayLike) -> NDArray[np.float64]:
+def complete_first_kind_near_one(log_mc: Any) -> Any:
     """K from ln mc, for mc < ``NEAR_ONE_MC``: K = ln 4 − ½ ln mc.
 
     [OLBC10] 19.12.1: K = ln(4/k') + O(k'² ln k') with k' = √mc; the neglected term is
@@ -598,10 +605,11 @@ class JacobiParameter:
         self.mc = mc
         self.log_mc = log_mc
         self.near_one = near_one
+        self.K: Any
         if near_one:
             self.K = complete_first_kind_near_one(log_mc)
         elif xp is FLOAT:
-            self.K = float(special.ellipkm1(mc))
+            self.K = cython_special.ellipkm1(mc)
         else:
             self.K = special.ellipkm1(mc)
         self.kc = xp.exp(0.5 * log_mc)  # k' = √mc (0 below the float range)
@@ -611,6 +619,7 @@ class JacobiParameter:
     def jacobi(self, u: Any, xp: Any) -> tuple[Any, Any, Any, Any, Any]:
         """j, r, sn r, cn r, dn r for u = 2jK + r, |r| ≤ K."""
         K = self.K
+        j: Any
         if xp is FLOAT:
             j = float(round(u / (2.0 * K)))
             r = u - j * (2.0 * K)
@@ -658,8 +667,8 @@ class JacobiParameter:
             incomplete = 0.0 * r
         else:
             c2, s2 = cn * cn, sn * sn
-            r_j = special.elliprj(c2, dn * dn, 1.0, c2 + (1.0 - n) * s2)
-            incomplete = (n / 3.0) * sn * s2 * (float(r_j) if xp is FLOAT else r_j)
+            r_j = _special(xp).elliprj(c2, dn * dn, 1.0, c2 + (1.0 - n) * s2)
+            incomplete = (n / 3.0) * sn * s2 * r_j
         return incomplete + 2.0 * j * complete
 
     def f_of_sin_cos(self, s: Any, c: Any, xp: Any) -> Any:
@@ -669,7 +678,5 @@ class JacobiParameter:
         beyond.  Working from (s, c) rather than from φ = atan2 keeps F accurate near
         φ = ±π/2, where dF/dφ = 1/dn is large close to the separatrix.
         """
-        f = _f_of_sin_cos(s, abs(c), self.mc)
-        if xp is FLOAT:
-            f = float(f)
+        f = _f_of_sin_cos(s, abs(c), self.mc, xp)
         return xp.where(c >= 0.0, f, xp.copysign(2.0 * self.K, s) - f)

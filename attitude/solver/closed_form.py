@@ -6,12 +6,17 @@ separatrix) and the attitude through the angle ψ(t) of [Leroy] "Integrals", wit
 elliptic integral of the third kind.  The project's own derivation, with every step
 used here, is docs/derivation.md.
 
-Every formula takes its constants and its times as floats or as numpy arrays that
-broadcast together, and the namespace ``xp`` of their functions (numpy, or
-``attitude.base.float_math.FLOAT`` for floats).  So one implementation serves one state at
-many times (``EulerSolver``: float constants, an array of times), many states at one
-time each (``attitude.solver.free_flow``: arrays of constants and of steps) and one state at
-one time (floats throughout, ~100 times cheaper than numpy on arrays of one).
+This module is the formula set: what is computed, once.  Each case's constants and
+formulas (``Elliptic``, ``Separatrix``, ``Steady``, ``Rest``: the ``CaseFormula``
+protocol), the frames (S, P, Y), one state's attitude q(t) = M (Y ⊗ P)(t)
+(``Motion``) and the step of the flow (``step``).  Every formula takes its constants
+and its times as floats or as numpy arrays that broadcast together, and the namespace
+``xp`` of their functions (numpy, or ``attitude.base.float_math.FLOAT`` for floats).
+The backends evaluate it, each in a module of its own (attitude.solver.backends: which
+states each takes and leaves, and the one rule that picks them): ``float_backend`` on
+Python floats, ``numpy_backend`` on arrays, ``table_backend`` on arrays with ψ's
+periodic part from a table, and ``numba_backend``, a compiled copy of the elliptic
+cases.
 
 Frames.  A state's principal axes (moments in any order) are mapped onto the frame of
 its formula by a signed permutation with determinant +1, in three steps:
@@ -52,28 +57,50 @@ References
 
 from __future__ import annotations
 
+import functools
 import math
+from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
 
 from attitude.base.float_math import FLOAT
-from attitude.elliptic.functions import NEAR_ONE_MC, JacobiParameter, amplitude
-from attitude.solver.invariants import Invariants, MomentConstants, invariants
+from attitude.elliptic.functions import JacobiParameter, amplitude
+from attitude.solver.invariants import Invariants
 
 __all__ = [
+    "FLIP_23",
+    "FLIP_NONE",
+    "RELABEL",
     "CaseFormula",
     "Elliptic",
+    "Motion",
+    "NotRepresentable",
     "Rest",
     "Separatrix",
-    "SortedMoments",
     "Steady",
+    "hamilton",
+    "norm",
     "p_quaternion",
+    "permutation_quaternion",
+    "preferred_flips",
+    "step",
     "y_times_p",
 ]
 
 _LN2 = math.log(2.0)
+
+
+class NotRepresentable(ArithmeticError):
+    """A result beyond the float range: the angles λτ or ψ(τ) of a time too far from t0
+    (or of a step too long).  ``index``: the first such time (or state) of an array.
+    The front ends turn it into an InputError that names the time."""
+
+    def __init__(self, index: int = 0) -> None:
+        super().__init__(index)
+        self.index = index
 
 
 class CaseFormula(Protocol):
@@ -83,9 +110,15 @@ class CaseFormula(Protocol):
     c ≥ 0; ``momentum_and_angle`` adds ψ(τ).  ``τ`` broadcasts with the constants.
     """
 
-    name: str
-    period: Any
-    mc: Any  # the complementary parameter 1 − m (0 on the separatrix, NaN if none)
+    @property
+    def name(self) -> str: ...
+
+    @property
+    def period(self) -> Any: ...
+
+    @property
+    def mc(self) -> Any:  # the complementary parameter 1 − m (0 on the separatrix, NaN if none)
+        ...
 
     def momentum(self, τ: Any, xp: Any) -> tuple[Any, Any, Any]: ...
 
@@ -219,7 +252,7 @@ class Elliptic:
         return self._evaluate(τ, xp, with_ψ=True)
 
     def _evaluate(self, τ: Any, xp: Any, with_ψ: bool):
-        j, r, sn_r, cn_r, dn_r = self.phase(τ, xp)
+        j, r, sn_r, cn_r, dn_r = self.parameter.jacobi(self.λ * τ - self.ν, xp)  # phase()
         a, b, c = self.momentum_of_phase(j, sn_r, cn_r, dn_r, xp)
         if not with_ψ:
             return a, b, c, None
@@ -407,9 +440,10 @@ def y_times_p(half_ψ: Any, p0: Any, p1: Any, p2: Any, xp: Any) -> tuple[Any, An
 # ----------------------------------------------------------------- frames and case choice
 
 
-# The preferred flips (step 2 of the module docstring) and the relabelling into the
-# P-frame (step 3), per case: P[k] = sign[k] · preferred[index[k]].
-_FLIP_NONE, _FLIP_13, _FLIP_12, _FLIP_23 = (1, 1, 1), (-1, 1, -1), (-1, -1, 1), (1, -1, -1)
+# No flip, and the turn by π about e1 that makes m3 ≥ 0 (a steady state's flip).
+FLIP_NONE, FLIP_23 = (1.0, 1.0, 1.0), (1.0, -1.0, -1.0)
+# The relabelling into the P-frame (step 3 of the module docstring), after the preferred
+# flips (step 2), per case: P[k] = sign[k] · preferred[index[k]].
 RELABEL: dict[str, tuple[tuple[int, int, int], tuple[int, int, int]]] = {
     "i": ((1, 2, 0), (1, 1, 1)),
     "ii": ((1, 0, 2), (1, -1, 1)),
@@ -432,266 +466,113 @@ def preferred_flips(flip1: Any, flip3: Any, xp: Any) -> tuple[Any, Any, Any]:
     return f1, f2, f3
 
 
+@functools.lru_cache(maxsize=64)
+def permutation_quaternion(
+    index: tuple[int, int, int], sign: tuple[float, float, float]
+) -> tuple[float, float, float, float]:
+    """The quaternion (scalar first) of the signed permutation S[k, index[k]] = sign[k]
+    with determinant +1: one of 24 rotations, each converted once by scipy."""
+    matrix = np.zeros((3, 3))
+    matrix[np.arange(3), index] = sign
+    w, x, y, z = Rotation.from_matrix(matrix).as_quat(scalar_first=True).tolist()
+    return w, x, y, z
+
+
 def norm(m1: Any, m2: Any, m3: Any, xp: Any) -> Any:
     """G = |m| without overflow or underflow of the squares, the same on floats and arrays
     (so that one state gives the same constants alone and in a batch)."""
     return xp.hypot(xp.hypot(m1, m2), m3)
 
 
-class OneState:
-    """The case formula of a single state and its frame, on Python floats.
+def hamilton(p: tuple, q: tuple) -> tuple[Any, Any, Any, Any]:
+    """p ⊗ q, scalar first (floats or arrays)."""
+    pw, px, py, pz = p
+    qw, qx, qy, qz = q
+    return (
+        pw * qw - px * qx - py * qy - pz * qz,
+        pw * qx + px * qw + py * qz - pz * qy,
+        pw * qy - px * qz + py * qw + pz * qx,
+        pw * qz + px * qy - py * qx + pz * qw,
+    )
 
-    ``moments`` are principal moments along the principal axes (any order),
-    ``momentum`` the momentum in those axes.  ``index``/``sign``: the signed permutation
-    to the P-frame, P[k] = sign[k] · principal[index[k]] (a proper rotation).
+
+# ----------------------------------------------------------------- one state's attitude
+
+
+@dataclass
+class Motion:
+    """One state's motion: its case formula and the constants that turn the formula's
+    m(τ) and ψ(τ) into body vectors and attitudes, τ = t − t0.
+
+    The attitude is q(t) = r ⊗ Y(ψ(τ) − ψ(0)) ⊗ P(m(τ)) ⊗ s ([Leroy] "An alternative
+    quaternionic solution", with R = Q0 ∘ S⁻¹ ∘ P(m(0))⁻¹ so that q(t0) = Q0), that is
+    ``M`` (Y ⊗ P)(τ) with the constant 4×4 matrix M = L(r) R(s) (docs/derivation.md
+    §10; ``M_rows``, its rows as floats).  S is the signed permutation
+    P[k] = sign[k] · principal[index[k]] onto the formula's frame, after the rotation
+    ``body_to_principal`` of a tensor (None for principal body axes); a vector of the
+    formula's frame goes back to the body as v_frame @ S (``S_columns``: the non-zero
+    entries (i, S_ik) of each column k of S).  Built by ``float_backend.motion``; the
+    backends evaluate it.  What only arrays need (``S_matrix``, ``I_frame``, ``M``) is
+    made at first use, and ``table`` is the table backend's.
     """
 
     formula: CaseFormula
+    G: float
+    t0: float
+    moments: tuple[float, float, float]  # I1 ≤ I2 ≤ I3
+    preferred: tuple[float, float, float]  # m at t0 in the preferred (sorted, flipped) axes
+    index: tuple[int, int, int]
+    sign: tuple[float, float, float]
+    body_to_principal: NDArray[np.float64] | None
+    S_columns: tuple[tuple[tuple[int, float], ...], ...]
+    I_frame_floats: tuple[float, float, float]  # the moments along the frame's axes
+    M_rows: tuple[tuple[float, float, float, float], ...]
+    ψ_t0: float
+    q0: tuple[float, float, float, float]  # the attitude at t0, scalar first
+    table: Any = None
 
-    def __init__(self, moments: tuple[float, float, float], momentum: tuple[float, ...]) -> None:
-        order = sorted(range(3), key=moments.__getitem__)  # stable, as numpy's
-        o0, o1, o2 = order
-        odd = (o1 - o0) * (o2 - o0) * (o2 - o1) < 0
-        sorted_signs = (1.0, -1.0 if odd else 1.0, 1.0)
-        I1, I2, I3 = moments[o0], moments[o1], moments[o2]
-        m1, m2, m3 = momentum[o0], sorted_signs[1] * momentum[o1], momentum[o2]
-        G = norm(m1, m2, m3, FLOAT)
-        self.G, self.I = G, (I1, I2, I3)
-        if G == 0.0:
-            case, flips = "rest", _FLIP_NONE
-        elif I1 == I3:
-            case, flips = "steady", (_FLIP_23 if m3 < 0.0 else _FLIP_NONE)
-        else:
-            inv = invariants(I1, I2, I3, m1, m2, m3, FLOAT)
-            if inv.sign == 0.0:
-                case = "iii"
-                flips = preferred_flips(m1 < 0.0, m3 < 0.0, FLOAT)
-            else:
-                case = "ii" if inv.sign > 0.0 else "i"
-                flips = preferred_flips(case == "i" and m1 < 0.0, case == "ii" and m3 < 0.0, FLOAT)
-        m1, m2, m3 = flips[0] * m1, flips[1] * m2, flips[2] * m3
-        formula: CaseFormula
-        if case in ("i", "ii"):
-            formula = Elliptic(
-                I1, I2, I3, m1, m2, m3, G, inv, case == "ii", inv.mc < NEAR_ONE_MC, FLOAT
-            )
-            if formula.λ == 0.0:  # underflows: see Steady
-                case, more = "steady", (_FLIP_23 if m3 < 0.0 else _FLIP_NONE)
-                flips = tuple(f * g for f, g in zip(flips, more, strict=True))
-                m1, m2, m3 = (f * m for f, m in zip(more, (m1, m2, m3), strict=True))
-        if case == "iii":
-            formula = Separatrix(I1, I2, I3, m1, m2, m3, G, inv, FLOAT)
-            if formula.onto_e1:
-                case = "iii-e1"
-        if case == "steady":
-            formula = Steady(I1, I2, I3, m1, m2, m3, G, FLOAT)
-        if case == "rest":
-            formula = Rest()
-        self.formula = formula
-        self.preferred = (m1, m2, m3)
-        # P[k] = r_sign[k] f[r_index[k]] s[r_index[k]] principal[order[r_index[k]]].
-        (r0, r1, r2), (rs0, rs1, rs2) = RELABEL[case]
-        self.index = (order[r0], order[r1], order[r2])
-        self.sign = (
-            rs0 * flips[r0] * sorted_signs[r0],
-            rs1 * flips[r1] * sorted_signs[r1],
-            rs2 * flips[r2] * sorted_signs[r2],
+    @functools.cached_property
+    def S_matrix(self) -> NDArray[np.float64]:
+        """S as a 3×3 matrix (body → the formula's frame)."""
+        S = np.zeros((3, 3))
+        S[np.arange(3), self.index] = self.sign
+        if self.body_to_principal is not None:
+            S = np.ascontiguousarray(S @ self.body_to_principal)
+        return S
+
+    @functools.cached_property
+    def I_frame(self) -> NDArray[np.float64]:
+        """The moments along the axes of the formula's frame, as an array."""
+        return np.array(self.I_frame_floats)
+
+    @functools.cached_property
+    def M(self) -> NDArray[np.float64]:
+        """M as a 4×4 array."""
+        return np.array(self.M_rows)
+
+    @property
+    def fastest_rate(self) -> float:
+        """The largest angular rate of the motion, |λ| or |ω| ≤ G/I1 (rad/s)."""
+        return max(abs(getattr(self.formula, "λ", 0.0)), self.G / self.moments[0])
+
+
+# ----------------------------------------------------------------- a step of the flow
+
+
+def step(formula: CaseFormula, G: Any, τ: Any, xp: Any) -> tuple[tuple[Any, Any, Any], tuple]:
+    """m(τ) in the formula's frame and P(m(0))⁻¹ ⊗ Y(ψ(τ) − ψ(0)) ⊗ P(m(τ)): the flow's
+    step, q(t0 + τ) = q(t0) ⊗ S⁻¹ ⊗ (this) ⊗ S (attitude.solver.free_flow)."""
+    # Both ends from the same formula (not m(0) from the state), so that their rounding
+    # errors, a shift of the phase ν, are the same and cancel in the step: a zero step
+    # is the identity, and ψ(τ) − ψ(0) is as accurate as τ is short.
+    if xp is FLOAT:
+        a0, b0, c0, ψ0 = formula.momentum_and_angle(0.0, xp)
+        a1, b1, c1, ψ1 = formula.momentum_and_angle(τ, xp)
+    else:  # both times in one pass over the states: (2, n) against constants (n,)
+        (a0, a1), (b0, b1), (c0, c1), (ψ0, ψ1) = formula.momentum_and_angle(
+            np.stack([np.zeros_like(τ), τ]), xp
         )
-
-
-class ManyStates:
-    """The case formulas of a batch of states, grouped by case, on numpy arrays.
-
-    ``moments`` (N, 3) and ``momentum`` (N, 3) as in ``OneState``.  ``groups`` lists
-    (indices, formula) with one formula per case present (the elliptic cases split by
-    the regime of their kernels, mc above or below ``NEAR_ONE_MC``); ``index`` and
-    ``sign`` (N, 3) are the signed permutations to each state's P-frame.
-
-    In the steps of the module docstring: sorted (``SortedMoments``, step 1), each
-    state's case (``_cases``), the preferred flips (``_preferred_flips_per_case``,
-    step 2), the formulas (``_group_formulas``: an elliptic rate that underflows makes
-    the state steady) and the relabelling into the P-frame (``_relabel``, step 3).
-    """
-
-    def __init__(self, moments: np.ndarray, momentum: np.ndarray) -> None:
-        sorted_moments = SortedMoments(moments)
-        I1, I2, I3 = sorted_moments.I
-        order, sorted_signs = sorted_moments.order, sorted_moments.sorted_signs
-        m_sorted = momentum.take(sorted_moments.flat_order)  # its rows permuted alike
-        m1, m2, m3 = m_sorted[:, 0], sorted_signs[:, 1] * m_sorted[:, 1], m_sorted[:, 2]
-        m = np.stack([m1, m2, m3], axis=-1)
-        G = norm(m1, m2, m3, np)
-        self.G = G
-        case, inv = _cases(I1, I2, I3, m1, m2, m3, G, sorted_moments.constants)
-        flips = _preferred_flips_per_case(case, m1, m3)
-        m = flips * m
-        self.groups = _group_formulas((I1, I2, I3), m, G, inv, case, flips)
-        self.index, self.sign = _relabel(case, order, flips, sorted_signs)
-
-
-def _cases(I1: Any, I2: Any, I3: Any, m1: Any, m2: Any, m3: Any, G: Any, constants: Any):
-    """Each state's case code (``_CODE``: rest for G = 0, steady for the sphere I1 = I3,
-    else i, ii or iii by the sign of Δ2) and its invariants δ1, δ3, mc, log mc (zeros and
-    NaNs where the case has none; ``sign`` left out).  ``constants``: a callable giving
-    the moments' ``MomentConstants`` (``SortedMoments.constants``)."""
-    N = G.shape[0]
-    case = np.full(N, _CODE["rest"], dtype=np.int8)
-    sphere = (G > 0.0) & (I1 == I3)
-    general = (G > 0.0) & ~sphere
-    case[sphere] = _CODE["steady"]
-    if general.all():  # the usual batch: no gather
-        inv = invariants(I1, I2, I3, m1, m2, m3, np, constants())
-        case = np.where(
-            inv.sign < 0.0, _CODE["i"], np.where(inv.sign > 0.0, _CODE["ii"], _CODE["iii"])
-        ).astype(np.int8)
-        return case, Invariants(None, inv.δ1, inv.δ3, inv.mc, inv.log_mc)
-    g = np.flatnonzero(general)
-    mc = np.full(N, np.nan)
-    log_mc = np.full(N, np.nan)
-    δ1 = np.zeros(N)
-    δ3 = np.zeros(N)
-    if g.size:
-        inv = invariants(I1[g], I2[g], I3[g], m1[g], m2[g], m3[g], np)
-        case[g] = np.where(
-            inv.sign < 0.0, _CODE["i"], np.where(inv.sign > 0.0, _CODE["ii"], _CODE["iii"])
-        )
-        mc[g], log_mc[g], δ1[g], δ3[g] = inv.mc, inv.log_mc, inv.δ1, inv.δ3
-    return case, Invariants(None, δ1, δ3, mc, log_mc)
-
-
-def _preferred_flips_per_case(case: np.ndarray, m1: np.ndarray, m3: np.ndarray) -> np.ndarray:
-    """(N, 3) axis signs of step 2: the component carrying dn (m1 in case i, m3 in case
-    ii), both sech components on the separatrix, and m3 of a steady state made ≥ 0."""
-    flip1 = (m1 < 0.0) & ((case == _CODE["i"]) | (case == _CODE["iii"]))
-    flip3 = (m3 < 0.0) & ((case == _CODE["ii"]) | (case == _CODE["iii"]))
-    flip3 |= (m3 < 0.0) & (case == _CODE["steady"])
-    return np.stack(preferred_flips(flip1, flip3, np), axis=-1)
-
-
-def _group_formulas(
-    moments: tuple[np.ndarray, np.ndarray, np.ndarray],
-    m: np.ndarray,
-    G: np.ndarray,
-    inv: Invariants,
-    case: np.ndarray,
-    flips: np.ndarray,
-) -> list[tuple[np.ndarray, CaseFormula]]:
-    """(indices, formula) per case present, from the preferred components ``m`` (N, 3).
-
-    An elliptic state whose rate λ underflows is steady (``_elliptic_groups``): its
-    ``case``, ``flips`` and ``m`` are updated in place.  A separatrix state that P maps
-    onto e1 gets the case code iii-e1 (its relabelling).
-    """
-
-    def constants(k):
-        return _constants(k, moments, m, G, inv)
-
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
-        groups = _elliptic_groups(constants, inv.mc, case, flips, m)
-        k = np.flatnonzero(case == _CODE["iii"])
-        if k.size:
-            formula = Separatrix(*constants(k), np)
-            case[k[formula.onto_e1]] = _CODE["iii-e1"]
-            groups.append((k, formula))
-        k = np.flatnonzero(case == _CODE["steady"])
-        if k.size:
-            groups.append((k, Steady(*constants(k)[:7], np)))
-        k = np.flatnonzero(case == _CODE["rest"])
-        if k.size:
-            groups.append((k, Rest()))
-    return groups
-
-
-def _constants(k: np.ndarray, moments, m: np.ndarray, G: np.ndarray, inv: Invariants) -> tuple:
-    """I1, I2, I3, m1, m2, m3, G and the invariants of the states ``k``, as the formulas
-    take them (every state: the arrays themselves, no gather)."""
-    I1, I2, I3 = moments
-    if k.size == G.shape[0]:
-        return (I1, I2, I3, m[:, 0], m[:, 1], m[:, 2], G, inv)
-    inv_k = Invariants(None, inv.δ1[k], inv.δ3[k], inv.mc[k], inv.log_mc[k])
-    return (I1[k], I2[k], I3[k], m[k, 0], m[k, 1], m[k, 2], G[k], inv_k)
-
-
-def _elliptic_groups(
-    constants: Any, mc: np.ndarray, case: np.ndarray, flips: np.ndarray, m: np.ndarray
-) -> list[tuple[np.ndarray, CaseFormula]]:
-    """The elliptic formulas, one per regime of the kernels (mc above or below
-    ``NEAR_ONE_MC``).  A state whose rate λ underflows cannot move (``Steady``): it is
-    made steady, its ``case``, ``flips`` and ``m`` updated in place with Steady's flip
-    of m3, and the formula of the others made again."""
-    groups: list[tuple[np.ndarray, CaseFormula]] = []
-    elliptic = (case == _CODE["i"]) | (case == _CODE["ii"])
-    for near_one in (False, True):
-        k = np.flatnonzero(elliptic & ((mc < NEAR_ONE_MC) == near_one))
-        if not k.size:
-            continue
-        formula = Elliptic(*constants(k), case[k] == _CODE["ii"], near_one, np)
-        still = formula.λ != 0.0
-        if not np.all(still):
-            lost = k[~still]
-            case[lost] = _CODE["steady"]
-            sign3 = np.where(m[lost, 2] < 0.0, -1.0, 1.0)  # Steady's flip of m3
-            more = np.stack([np.ones_like(sign3), sign3, sign3], axis=-1)
-            flips[lost] *= more
-            m[lost] *= more
-            k = k[still]
-            if k.size:
-                formula = Elliptic(*constants(k), case[k] == _CODE["ii"], near_one, np)
-        if k.size:
-            groups.append((k, formula))
-    return groups
-
-
-def _relabel(
-    case: np.ndarray, order: np.ndarray, flips: np.ndarray, sorted_signs: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """Step 3: the signed permutations (N, 3) to each state's P-frame,
-    P[k] = r_sign[k] f[r_index[k]] s[r_index[k]] principal[order[r_index[k]]]."""
-    # Flat indices into the rows (N, 3): one gather each, cheaper than take_along_axis.
-    flat = _RELABEL_INDEX[case] + 3 * np.arange(case.shape[0])[:, None]
-    index = order.take(flat)
-    sign = _RELABEL_SIGN[case] * flips.take(flat) * sorted_signs.take(flat)
-    return index, sign
-
-
-class SortedMoments:
-    """The moments of a batch sorted, step 1 of the module docstring, with what the case
-    test needs of them alone (``constants``, made only if a state needs the test).
-
-    ``I``: the sorted moments as columns (I1, I2, I3); ``order`` (N, 3): the stable
-    permutation that sorts each row; ``sorted_signs`` (N, 3): the middle axis reversed
-    for an odd permutation.  A sorting network of three compare-exchanges over columns
-    (bubble sort, stable), several times cheaper than ``argsort`` along rows of three.
-    """
-
-    def __init__(self, moments: np.ndarray) -> None:
-        Is = [moments[:, 0], moments[:, 1], moments[:, 2]]
-        N = moments.shape[0]
-        index = [np.zeros(N, np.intp), np.ones(N, np.intp), np.full(N, 2, np.intp)]
-        odd = np.zeros(N, dtype=bool)
-        for a, b in ((0, 1), (1, 2), (0, 1)):
-            swap = Is[a] > Is[b]
-            for column in (Is, index):
-                column[a], column[b] = (
-                    np.where(swap, column[b], column[a]),
-                    np.where(swap, column[a], column[b]),
-                )
-            odd ^= swap
-        self.I = tuple(Is)
-        self.order = np.stack(index, axis=-1)
-        self.flat_order = self.order + 3 * np.arange(N)[:, None]  # into a flat (N, 3) array
-        self.sorted_signs = np.ones((N, 3))
-        self.sorted_signs[:, 1] = np.where(odd, -1.0, 1.0)
-        self._constants: MomentConstants | None = None
-
-    def constants(self) -> MomentConstants:
-        """The double-double constants of the sorted moments (made on first use)."""
-        if self._constants is None:
-            self._constants = MomentConstants(*self.I)
-        return self._constants
-
-
-# The relabelling of each case as arrays indexed by a small integer code, for batches.
-_CODE = {name: code for code, name in enumerate(RELABEL)}
-_RELABEL_INDEX = np.array([RELABEL[name][0] for name in RELABEL])
-_RELABEL_SIGN = np.array([RELABEL[name][1] for name in RELABEL], dtype=float)
+    p0 = p_quaternion(a0, b0, c0, G, xp)
+    p1 = p_quaternion(a1, b1, c1, G, xp)
+    yp = y_times_p(0.5 * (ψ1 - ψ0), *p1, xp)
+    return (a1, b1, c1), hamilton((p0[0], -p0[1], -p0[2], 0.0 * p0[0]), yp)

@@ -43,31 +43,15 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
 from attitude.base.errors import InputError
-from attitude.base.float_math import FLOAT
 from attitude.base.quantities import as_si_array, as_si_scalar, as_vector3
-from attitude.base.quaternions import left_matrix, right_matrix
 from attitude.elliptic.phase_table import PiecewiseChebyshev
-from attitude.solver.closed_form import (
-    CaseFormula,
-    Elliptic,
-    OneState,
-    Separatrix,
-    p_quaternion,
-    y_times_p,
-)
+from attitude.solver import float_backend
+from attitude.solver.backends import select
+from attitude.solver.closed_form import CaseFormula, Elliptic, Motion, NotRepresentable, Separatrix
 from attitude.solver.inertia import PrincipalAxes, principal_axes
 
 __all__ = ["EulerSolver"]
 
-# Evaluations over many times run in slices of this many samples (see _evaluate): a
-# slice's temporaries (at most ~130 B a sample) stay in the processor's cache, and
-# bound what a call holds besides its output to ~1 MB.
-_CHUNK = 8192
-# From this many times in one call, the attitude takes the periodic part of ψ from a
-# table built once (``_angle_table``: 1000 to 6000 formula evaluations, which cost
-# about as much as this many samples of the formula) instead of one R_J a sample.
-_TABLE_MIN_SAMPLES = 16384
-_UNBUILT = object()
 try:  # numpy's array-API namespace as scipy's Rotation keeps it (see _one_rotation)
     from scipy._lib._array_api import array_namespace as _array_namespace
 
@@ -76,9 +60,35 @@ except ImportError:  # pragma: no cover
     _NUMPY_NAMESPACE = None
 
 
-def _as_rotation(attitude: Any) -> Rotation:
+def _three_floats(value: Any) -> tuple[float, float, float] | None:
+    """``value`` as three finite Python floats when it is plainly three numbers (a list
+    or tuple of floats and ints, or a float64 array of shape (3,)), else None: the
+    general checks of attitude.base.quantities then run (Quantities, other types, and
+    every error message).  They cost more than the rest of the construction."""
+    if type(value) is np.ndarray:
+        if value.shape != (3,) or value.dtype != np.float64:
+            return None
+        a, b, c = value.tolist()
+    elif type(value) in (list, tuple) and len(value) == 3:
+        a, b, c = value
+        for v in (a, b, c):
+            if not (type(v) is float or type(v) is int or type(v) is np.float64):
+                return None
+        try:
+            a, b, c = float(a), float(b), float(c)
+        except OverflowError:  # an int beyond the float range: refused by the checks
+            return None
+    else:
+        return None
+    if not (math.isfinite(a) and math.isfinite(b) and math.isfinite(c)):
+        return None
+    return a, b, c
+
+
+def _attitude_quaternion(attitude: Any) -> tuple[float, float, float, float]:
+    """The attitude at t0 as a unit quaternion (w, x, y, z), checked."""
     if attitude is None:
-        return Rotation.identity()
+        return 1.0, 0.0, 0.0, 0.0
     if not isinstance(attitude, Rotation):
         raise InputError(
             "attitude must be a scipy.spatial.transform.Rotation (body -> inertial), "
@@ -86,10 +96,10 @@ def _as_rotation(attitude: Any) -> Rotation:
         )
     if not attitude.single:
         raise InputError(f"attitude must be a single rotation, got a stack of {len(attitude)}")
-    q = attitude.as_quat(scalar_first=True)
-    if not np.all(np.isfinite(q)):
-        raise InputError(f"attitude must be finite, got quaternion {q.tolist()}")
-    return attitude
+    x, y, z, w = attitude.as_quat().tolist()  # scalar last: scipy's own order, no copy
+    if not (math.isfinite(w) and math.isfinite(x) and math.isfinite(y) and math.isfinite(z)):
+        raise InputError(f"attitude must be finite, got quaternion {[w, x, y, z]}")
+    return w, x, y, z
 
 
 def _one_rotation(q_scalar_last: NDArray[np.float64]) -> Rotation:
@@ -142,81 +152,70 @@ class EulerSolver:
         attitude: Rotation | None = None,
         t0: float = 0.0,
     ) -> None:
-        axes = principal_axes(inertia)
-        m_body = as_vector3(angular_momentum, "angular_momentum", "angular_momentum")
-        self._initial_attitude = _as_rotation(attitude)
-        self._t0 = as_si_scalar(t0, "time", "t0")
-        self._axes = axes
+        # Three plain positive moments (the usual case) need neither the checks of
+        # principal_axes nor its rotation; a tensor, a Quantity or anything else does.
+        moments = _three_floats(inertia)
+        self._axes: PrincipalAxes | None = None
+        if moments is None or not (moments[0] > 0.0 and moments[1] > 0.0 and moments[2] > 0.0):
+            self._axes = principal_axes(inertia)
+            moments = _three_floats(self._axes.moments)
+            assert moments is not None
+        self._moments = moments
+        m_body = _three_floats(angular_momentum)
+        if m_body is None:
+            m_body = _three_floats(
+                as_vector3(angular_momentum, "angular_momentum", "angular_momentum")
+            )
+            assert m_body is not None
+        q0 = _attitude_quaternion(attitude)
+        self._initial_attitude = attitude
+        if type(t0) is float and math.isfinite(t0):
+            self._t0 = t0
+        else:
+            self._t0 = as_si_scalar(t0, "time", "t0")
         self._initial_angular_momentum = m_body
-        self._state = self._select_formula(axes, m_body)
-        self._formula: CaseFormula = self._state.formula
-        self._G = self._state.G
-        self._S_matrix = self._body_to_formula_frame(axes)
-        # The moments along the axes of the formula's frame (for ω = m/I there).
-        self._I_frame = np.array([float(axes.moments[k]) for k in self._state.index])
-        self._I_frame_floats = tuple(self._I_frame.tolist())
-        # Column k of S: its non-zero entries (i, S_ik), all three for a tensor.
-        S = self._S_matrix.tolist()
-        self._S_columns = tuple(
-            tuple((i, S[i][k]) for i in range(3) if S[i][k] != 0.0)
-            if axes.is_diagonal
-            else tuple((i, S[i][k]) for i in range(3))
-            for k in range(3)
-        )
-        self._M, self._ψ_t0 = self._constant_rotation()
-        self._M_rows = tuple(tuple(row) for row in self._M.tolist())  # for one time
-        self._table = _UNBUILT  # the periodic part of ψ tabulated: see _angle_table
-        I1, I2, I3 = self._state.I
-        m1, m2, m3 = self._state.preferred
+        self._motion = self._solve(moments, m_body, q0, self._t0, self._axes)
+        self._formula: CaseFormula = self._motion.formula
+        self._G = self._motion.G
+        I1, I2, I3 = self._motion.moments
+        m1, m2, m3 = self._motion.preferred
         G = self._G
         x1, x2, x3 = (m1 / G, m2 / G, m3 / G) if G > 0.0 else (0.0, 0.0, 0.0)
         # 2T = G² Σ xj²/Ij; Python floats: an energy beyond the float range is inf.
         self._kinetic_energy = 0.5 * G * (G * (x1 * x1 / I1 + x2 * x2 / I2 + x3 * x3 / I3))
-        self._inertial_angular_momentum = self._initial_attitude.apply(m_body)
 
     @staticmethod
-    def _select_formula(axes: PrincipalAxes, m_body: NDArray[np.float64]) -> OneState:
-        """The case, its formula and the preferred flips (attitude.solver.closed_form.OneState).
+    def _solve(
+        moments: tuple[float, float, float],
+        m_body: tuple[float, float, float],
+        q0: tuple[float, float, float, float],
+        t0: float,
+        axes: PrincipalAxes | None,
+    ) -> Motion:
+        """The state's ``Motion`` (attitude.solver.float_backend.motion): its case,
+        formula and frame, and the constant rotations.
 
         Refuses a state whose angular velocity |m|/I1 is beyond the float range.
         """
-        m_principal = m_body if axes.is_diagonal else axes.body_to_principal.apply(m_body)
-        I1, I2, I3 = axes.moments
-        moments = (float(I1), float(I2), float(I3))
-        momentum = tuple(float(v) for v in m_principal)
+        V = None if axes is None or axes.is_diagonal else axes.body_to_principal
+        momentum = m_body
+        if V is not None:
+            a, b, c = V.apply(np.array(m_body)).tolist()
+            momentum = (a, b, c)
         G = math.hypot(*momentum)  # math.hypot scales: no overflow of the squares
         if not math.isfinite(G / min(moments)):
             raise InputError(
-                f"angular_momentum {m_body.tolist()} with moments {axes.moments.tolist()}: the "
+                f"angular_momentum {list(m_body)} with moments {list(moments)}: the "
                 f"angular velocity |m|/I1 = {G / min(moments):g} rad/s is beyond the float range"
             )
-        return OneState(moments, momentum)
+        return float_backend.motion(moments, momentum, q0, t0, V)
 
-    def _body_to_formula_frame(self, axes: PrincipalAxes) -> NDArray[np.float64]:
-        """S as a matrix: the signed permutation of the principal axes onto the
-        formula's frame, after the body → principal rotation of a tensor.  Row vectors
-        go back to the body as v_frame @ S (exact for a signed permutation)."""
-        S_matrix = np.zeros((3, 3))
-        S_matrix[np.arange(3), self._state.index] = self._state.sign
-        if not axes.is_diagonal:
-            S_matrix = S_matrix @ axes.body_to_principal.as_matrix()
-        return np.ascontiguousarray(S_matrix)
-
-    def _constant_rotation(self) -> tuple[NDArray[np.float64], float]:
-        """R = Q0 ∘ S⁻¹ ∘ P(t0)⁻¹, folded with S into one 4×4 matrix M, and ψ(t0).
-
-        q(t) = R ⊗ (Y ⊗ P)(t) ⊗ S = L(R) Rr(S) (Y ⊗ P)(t) = M (Y ⊗ P)(t), scalar first.
-        """
-        S = Rotation.from_matrix(self._S_matrix).as_quat(scalar_first=True)
-        Q0 = self._initial_attitude.as_quat(scalar_first=True)
-        a, b, c, ψ_t0 = self._formula.momentum_and_angle(0.0, FLOAT)  # float constants
-        if self._formula.name == "rest":
-            P0 = np.array([1.0, 0.0, 0.0, 0.0])
-        else:
-            P0 = np.array([*p_quaternion(a, b, c, self._G, FLOAT), 0.0])
-        conjugate = np.array([1.0, -1.0, -1.0, -1.0])
-        R = left_matrix(Q0) @ left_matrix(S * conjugate) @ (P0 * conjugate)
-        return left_matrix(R) @ right_matrix(S), float(ψ_t0)
+    @property
+    def _principal_axes(self) -> PrincipalAxes:
+        """The inertia's principal axes (made at first use for three plain moments)."""
+        if self._axes is None:
+            self._axes = principal_axes(np.array(self._moments))
+        return self._axes
 
     @classmethod
     def from_angular_velocity(
@@ -227,194 +226,64 @@ class EulerSolver:
         t0: float = 0.0,
     ) -> EulerSolver:
         """Build the solver from the body angular velocity at ``t0`` (rad/s)."""
+        moments, ω = _three_floats(inertia), _three_floats(angular_velocity)
+        if moments is not None and ω is not None and min(moments) > 0.0:
+            # tensor @ ω of a diagonal tensor, term by term
+            m = [moments[0] * ω[0], moments[1] * ω[1], moments[2] * ω[2]]
+            return cls(moments, m, attitude, t0)
         tensor = principal_axes(inertia).tensor
-        ω = as_vector3(angular_velocity, "angular_velocity", "angular_velocity")
-        return cls(inertia, tensor @ ω, attitude, t0)
+        ω_array = as_vector3(angular_velocity, "angular_velocity", "angular_velocity")
+        return cls(inertia, tensor @ ω_array, attitude, t0)
 
     # ----------------------------------------------------------------- evaluation
 
     def _times(self, t: Any) -> NDArray[np.float64]:
         """``t`` as float seconds (no copy of a float64 array); τ = t − t0 is formed a
-        slice at a time by ``_evaluate``."""
+        slice at a time by the backends."""
         return as_si_array(t, "time", "t")
 
-    def _evaluate(self, chunk, t: Any, width: int, times: NDArray[np.float64] | None = None):
-        """``chunk(τ, out)`` over τ = t − t0 in slices of ``_CHUNK``, into one array.
-
-        A slice's temporaries stay in the processor's cache (over a million samples
-        this is several times faster than whole-array passes), and each writes its own
-        rows of the output: besides the result, memory holds only a slice's
-        temporaries.  Far enough from t0 (|t − t0| beyond ~1.8e308 divided by the
-        motion's fastest angular rate) an angle λ(t − t0) or ψ(t) leaves the float
-        range and the result would be NaN: that time gets an InputError that names it
-        instead.
-        """
-        if times is None:
-            times = self._times(t)
-        flat = times.ravel()
-        out = np.empty((flat.size, width))
-        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            for start in range(0, flat.size, _CHUNK):
-                block = out[start : start + _CHUNK]
-                chunk(flat[start : start + _CHUNK] - self._t0, block)
-                if not np.isfinite(block).all():
-                    bad = start + int(np.flatnonzero(~np.isfinite(block).all(axis=1))[0])
-                    raise self._too_far(t, bad)
-        return out.reshape((*times.shape, width))
-
     def _too_far(self, t: Any, index: int) -> InputError:
+        """Far enough from t0 (|t − t0| beyond ~1.8e308 divided by the motion's fastest
+        angular rate) an angle λ(t − t0) or ψ(t) leaves the float range and the result
+        would be NaN: that time gets an InputError that names it instead."""
         t_bad = np.ravel(as_si_array(t, "time", "t"))[index] if np.ndim(t) else t
-        rate = max(abs(getattr(self._formula, "λ", 0.0)), self._G / self._state.I[0])
         return InputError(
             f"t = {float(t_bad)!r} s is too far from t0 = {self._t0!r} s for this motion: "
-            f"its angles, at rates up to {rate:.3g} rad/s, times t - t0 exceed the float "
-            "range (1.8e308)"
+            f"its angles, at rates up to {self._motion.fastest_rate:.3g} rad/s, times t - t0 "
+            "exceed the float range (1.8e308)"
         )
 
-    def _to_body(self, v_frame: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Row vectors of the formula's frame in body axes, v_frame @ S."""
-        return np.dot(v_frame, self._S_matrix)
+    @property
+    def _table(self) -> PiecewiseChebyshev | None:
+        """The table of ψ's periodic part (attitude.solver.table_backend), if a call
+        has built one."""
+        return self._motion.table.per if self._motion.table else None
 
-    def _write_body(self, components: tuple, out: NDArray[np.float64], divisors=None) -> None:
-        """``out[:, k]``: the body components of a vector given by its ``components`` in
-        the formula's frame (each divided by ``divisors``, if given), that is v_frame @ S
-        written column by column: a signed permutation for principal body axes (exact),
-        three fused sums for a tensor.  No BLAS call: numpy's (n, 3) @ (3, 3) starts
-        OpenBLAS threads above some n, and its cost per row jumps by a large factor."""
-        if divisors is not None:
-            components = tuple(c / d for c, d in zip(components, divisors, strict=True))
-        for k, column in enumerate(self._S_columns):
-            if len(column) == 1:  # v_body[k] = ±v_frame[i]
-                i, S_ik = column[0]
-                np.multiply(components[i], S_ik, out=out[:, k])
-            else:
-                out[:, k] = components[0] * column[0][1] + components[1] * column[1][1]
-                out[:, k] += components[2] * column[2][1]
-
-    def _momentum_chunk(self, τ: NDArray[np.float64], out: NDArray[np.float64]) -> None:
-        self._write_body(self._formula.momentum(τ, np), out)
-
-    def _velocity_chunk(self, τ: NDArray[np.float64], out: NDArray[np.float64]) -> None:
-        self._write_body(self._formula.momentum(τ, np), out, self._I_frame)
-
-    def _quaternion_chunk(
-        self, τ: NDArray[np.float64], out: NDArray[np.float64], table, columns: tuple
-    ) -> None:
-        """Unit attitude quaternions at τ = t − t0, body → inertial, component i of
-        (w, x, y, z) into ``out[:, columns[i]]``.
-
-        q = M (Y(ψ − ψ(t0)) ⊗ P)  (``_constant_rotation``), the 4×4 product written as
-        four fused sums (no BLAS: see ``_write_body``).  With a ``table`` of the periodic
-        part of ψ (``_angle_table``), ψ(τ) − ψ(t0) = Ω τ + per(r(τ)) − per(r(0)):
-        no R_J per sample.
-        """
-        f = self._formula
-        # Each intermediate is dropped as soon as it is used, and the product is
-        # summed into ``out`` itself: a slice holds as few arrays as the formulas allow
-        # (the same operations in the same order as without the in-place forms: the
-        # same bits).
-        if table is None:
-            a, b, c, ψ = f.momentum_and_angle(τ, np)
-            ψ -= self._ψ_t0
-            ψ *= 0.5
-            half_ψ = ψ
-        else:
-            assert isinstance(f, Elliptic)  # only Elliptic formulas get a table
-            j, r, sn_r, cn_r, dn_r = f.phase(τ, np)
-            a, b, c = f.momentum_of_phase(j, sn_r, cn_r, dn_r, np)
-            del j, sn_r, cn_r, dn_r
-            periodic = table(r)
-            del r
-            periodic -= self._per_t0
-            half_ψ = self._Ω * τ
-            half_ψ += periodic
-            half_ψ *= 0.5
-            del periodic
-        p = p_quaternion(a, b, c, self._G, np)
-        del a, b, c
-        yp = y_times_p(half_ψ, *p, np)
-        del p, half_ψ
-        M = self._M
-        term = np.empty_like(yp[0])
-        for i in range(4):
-            q_i = out[:, columns[i]]
-            np.multiply(yp[0], M[i, 0], out=q_i)
-            for k in (1, 2, 3):
-                q_i += np.multiply(yp[k], M[i, k], out=term)
-        del yp
-        q = [out[:, columns[i]] for i in range(4)]
-        norm = np.multiply(q[0], q[0])
-        for i in (1, 2, 3):
-            norm += np.multiply(q[i], q[i], out=term)
-        np.sqrt(norm, out=norm)
-        for q_i in q:
-            q_i /= norm
-
-    def _quaternion_at(self, τ: float, t: Any) -> tuple[float, float, float, float]:
-        """The unit attitude quaternion (w, x, y, z) at one time, on Python floats: the
-        formulas of ``_quaternion_chunk`` (without a table) at ~1/100 of numpy's cost."""
-        f = self._formula
-        if f.name == "rest":
-            return tuple(self._initial_attitude.as_quat(scalar_first=True).tolist())
+    def _body_vectors(self, t: Any, velocity: bool) -> NDArray[np.float64]:
+        """The body momentum (or angular velocity) at ``t``, shape ``np.shape(t) + (3,)``."""
+        if isinstance(t, float) and math.isfinite(t):  # one time: no numpy on the way
+            try:
+                return float_backend.body_vector(
+                    self._motion, t - self._t0, self._motion.I_frame_floats if velocity else None
+                )
+            except NotRepresentable:
+                raise self._too_far(t, 0) from None
+        times = self._times(t)
         try:
-            a, b, c, ψ = f.momentum_and_angle(τ, FLOAT)
-            yp = y_times_p(0.5 * (ψ - self._ψ_t0), *p_quaternion(a, b, c, self._G, FLOAT), FLOAT)
-        except (ValueError, OverflowError):  # math on an angle beyond the float range
-            raise self._too_far(t, 0) from None
-        q = [yp[0] * M0 + yp[1] * M1 + yp[2] * M2 + yp[3] * M3 for M0, M1, M2, M3 in self._M_rows]
-        norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
-        if not math.isfinite(norm):
-            raise self._too_far(t, 0)
-        return q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm
-
-    def _angle_table(self):
-        """The periodic part of ψ tabulated (attitude.elliptic.phase_table), built at the first
-        call with at least ``_TABLE_MIN_SAMPLES`` times; None where the formula has no
-        R_J to save (separatrix, symmetric bodies, the near-one kernels: their ψ costs
-        a few elementary functions) or the table would not reach its rounding."""
-        if self._table is _UNBUILT:
-            self._table = None
-            f = self._formula
-            if isinstance(f, Elliptic) and not f.parameter.near_one and f.n != 0.0:
-                table = PiecewiseChebyshev.fit(f.periodic_angle, -float(f.K), float(f.K))
-                if table is not None:
-                    _, r0, *_ = f.phase(np.zeros(1), np)
-                    self._per_t0 = float(table(r0)[0])
-                    self._Ω = f.angle_rates()[1]
-                    self._table = table
-        return self._table
-
-    def _body_vector_at(self, τ: float, t: Any, divisors=None) -> NDArray[np.float64]:
-        """``_write_body`` of the momentum (or, with ``divisors``, the angular velocity)
-        at one time, on Python floats: the same operations, at ~1/30 of numpy's cost."""
-        try:
-            v = self._formula.momentum(τ, FLOAT)
-        except (ValueError, OverflowError):  # math on an angle beyond the float range
-            raise self._too_far(t, 0) from None
-        if divisors is not None:
-            v = tuple(c / d for c, d in zip(v, divisors, strict=True))
-        out = np.empty(3)
-        for k, column in enumerate(self._S_columns):
-            if len(column) == 1:
-                i, S_ik = column[0]
-                out[k] = v[i] * S_ik
-            else:
-                out[k] = (v[0] * column[0][1] + v[1] * column[1][1]) + v[2] * column[2][1]
-        if not np.isfinite(out).all():
-            raise self._too_far(t, 0)
-        return out
+            backend = select(1, times.size, self._formula)
+            assert backend is not None  # one state
+            out = backend.body_vectors(self._motion, times.ravel(), velocity)
+        except NotRepresentable as error:
+            raise self._too_far(t, error.index) from None
+        return out.reshape((*times.shape, 3))
 
     def angular_momentum(self, t: ArrayLike) -> NDArray[np.float64]:
         """Body-frame angular momentum at ``t`` (N m s), shape ``np.shape(t) + (3,)``."""
-        if isinstance(t, float) and math.isfinite(t):
-            return self._body_vector_at(t - self._t0, t)
-        return self._evaluate(self._momentum_chunk, t, 3)
+        return self._body_vectors(t, velocity=False)
 
     def angular_velocity(self, t: ArrayLike) -> NDArray[np.float64]:
         """Body-frame angular velocity at ``t`` (rad/s), shape ``np.shape(t) + (3,)``."""
-        if isinstance(t, float) and math.isfinite(t):
-            return self._body_vector_at(t - self._t0, t, self._I_frame_floats)
-        return self._evaluate(self._velocity_chunk, t, 3)
+        return self._body_vectors(t, velocity=True)
 
     def attitude(self, t: ArrayLike) -> Rotation:
         """Rotation taking body coordinates to inertial coordinates at ``t``.
@@ -422,7 +291,7 @@ class EulerSolver:
         One ``Rotation`` for a scalar ``t``, a stack for a 1-D array.
         """
         if isinstance(t, float) and math.isfinite(t):  # one time: no numpy on the way
-            w, x, y, z = self._quaternion_at(t - self._t0, t)
+            w, x, y, z = self._quaternion_at(t, t)
             return _one_rotation(np.array([x, y, z, w]))
         times = self._times(t)
         if times.ndim > 1:
@@ -430,7 +299,7 @@ class EulerSolver:
                 f"t must be a scalar or a 1-D array for attitude(), got shape {times.shape}"
             )
         if times.ndim == 0:
-            w, x, y, z = self._quaternion_at(float(times) - self._t0, t)
+            w, x, y, z = self._quaternion_at(float(times), t)
             return _one_rotation(np.array([x, y, z, w]))
         # Unit quaternions, scalar last: scipy takes them as they are, without a copy.
         return Rotation(self._quaternions(t, times, (3, 0, 1, 2)), normalize=False, copy=False)
@@ -445,21 +314,26 @@ class EulerSolver:
         columns = (0, 1, 2, 3) if scalar_first else (3, 0, 1, 2)
         times = np.float64(t) if isinstance(t, float) and math.isfinite(t) else self._times(t)
         if times.ndim == 0:
-            q = self._quaternion_at(float(times) - self._t0, t)
+            q = self._quaternion_at(float(times), t)
             return np.array(q if scalar_first else (q[1], q[2], q[3], q[0]))
         return self._quaternions(t, times, columns)
 
+    def _quaternion_at(self, t_float: float, t: Any) -> tuple[float, float, float, float]:
+        """The unit attitude quaternion (w, x, y, z) at one time (the float backend)."""
+        try:  # one time: the float backend (backends.select's rule 1)
+            return float_backend.quaternion(self._motion, t_float - self._t0)
+        except NotRepresentable:
+            raise self._too_far(t, 0) from None
+
     def _quaternions(self, t: Any, times: NDArray[np.float64], columns: tuple) -> NDArray:
-        if self._formula.name == "rest":
-            q = np.empty((*times.shape, 4))
-            q[..., list(columns)] = self._initial_attitude.as_quat(scalar_first=True)
-            return q
-        table = self._angle_table() if times.size >= _TABLE_MIN_SAMPLES else None
-
-        def chunk(τ, out):
-            self._quaternion_chunk(τ, out, table, columns)
-
-        return self._evaluate(chunk, t, 4, times)
+        """The attitude quaternions at an array of times (the numpy or table backend)."""
+        backend = select(1, times.size, self._formula)
+        assert backend is not None  # one state
+        try:
+            q = backend.quaternions(self._motion, times.ravel(), columns)
+        except NotRepresentable as error:
+            raise self._too_far(t, error.index) from None
+        return q.reshape((*times.shape, 4))
 
     def spin_axis_cone(self) -> tuple[NDArray[np.float64], float, float] | None:
         """The body axis about which m circulates, and the cone it describes about m.
@@ -475,7 +349,7 @@ class EulerSolver:
         if not isinstance(f, Elliptic):
             return None
         B = f.A_d  # B13 (case i) or B31 (case ii), along e3 of the formula's frame
-        axis = self._to_body(np.array([0.0, 0.0, 1.0]))
+        axis = np.dot(np.array([0.0, 0.0, 1.0]), self._motion.S_matrix)  # v_frame @ S
         G = self._G
         return axis, math.acos(min(1.0, B / G)), math.acos(min(1.0, B * f.parameter.kc / G))
 
@@ -494,7 +368,7 @@ class EulerSolver:
         t_start = as_si_scalar(t_start, "time", "t_start")
         t_end = as_si_scalar(t_end, "time", "t_end")
         f = self._formula
-        I1, I2, I3 = self._state.I
+        I1, I2, I3 = self._motion.moments
         if not (I1 < I2 < I3) or not isinstance(f, Elliptic | Separatrix) or f.λ == 0.0:
             return None
         if not math.isfinite(f.ν):  # a steady spin about the intermediate axis
@@ -596,21 +470,23 @@ class EulerSolver:
     @property
     def moments_of_inertia(self) -> NDArray[np.float64]:
         """Principal moments, kg m²: as given, or ascending for a tensor."""
-        return self._axes.moments.copy()
+        return np.array(self._moments)
 
     @property
     def inertia_tensor(self) -> NDArray[np.float64]:
         """The inertia tensor in body axes, kg m²."""
-        return self._axes.tensor.copy()
+        return self._principal_axes.tensor.copy()
 
     @property
     def initial_angular_momentum(self) -> NDArray[np.float64]:
         """Body-frame angular momentum at ``t0``, N m s."""
-        return self._initial_angular_momentum.copy()
+        return np.array(self._initial_angular_momentum)
 
     @property
     def initial_attitude(self) -> Rotation:
         """Attitude (body → inertial) at ``t0``."""
+        if self._initial_attitude is None:
+            self._initial_attitude = Rotation.identity()
         return self._initial_attitude
 
     @property
@@ -626,14 +502,14 @@ class EulerSolver:
         float range (|m| above ~1e154 N m s on unit moments), whose motion is computed.
         """
         if not math.isfinite(self._kinetic_energy):
-            I1, I2, I3 = self._state.I
-            m1, m2, m3 = self._state.preferred
+            I1, I2, I3 = self._motion.moments
+            m1, m2, m3 = self._motion.preferred
             G = self._G
             x2_over_I = (m1 / G) ** 2 / I1 + (m2 / G) ** 2 / I2 + (m3 / G) ** 2 / I3
             log10_T = 2.0 * math.log10(G) + math.log10(0.5 * x2_over_I)
             raise InputError(
-                f"the kinetic energy of angular_momentum {self._initial_angular_momentum.tolist()}"
-                f" with moments {self._axes.moments.tolist()}, about 1e{log10_T:.0f} J, is "
+                f"the kinetic energy of angular_momentum {list(self._initial_angular_momentum)}"
+                f" with moments {list(self._moments)}, about 1e{log10_T:.0f} J, is "
                 "beyond the float range"
             )
         return self._kinetic_energy
@@ -641,11 +517,11 @@ class EulerSolver:
     @property
     def inertial_angular_momentum(self) -> NDArray[np.float64]:
         """The angular momentum in inertial axes, N m s (conserved)."""
-        return self._inertial_angular_momentum.copy()
+        return self.initial_attitude.apply(np.array(self._initial_angular_momentum))
 
     def __repr__(self) -> str:
         return (
-            f"EulerSolver(inertia={self._axes.moments.tolist()}, "
-            f"angular_momentum={self._initial_angular_momentum.tolist()}, t0={self._t0}, "
+            f"EulerSolver(inertia={list(self._moments)}, "
+            f"angular_momentum={list(self._initial_angular_momentum)}, t0={self._t0}, "
             f"formula={self.formula!r}, period={self.period:.6g} s)"
         )

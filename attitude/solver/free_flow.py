@@ -5,18 +5,17 @@ each of N free rigid bodies after its own time step, vectorized over the states:
 primitive that torque splitting (a kick, then the exact free flow: Celledoni, Fassò,
 Säfström and Zanna, SIAM J. Sci. Comput. 30(4), 2008, doi:10.1137/070704393) and
 Monte Carlo batches stand on.  ``EulerSolver`` is the other axis (one state, many
-times); both evaluate the same closed form, attitude.solver.closed_form.
+times), ``EulerSolverBatch`` both; all evaluate the same formula set,
+attitude.solver.closed_form, through its backends (attitude.solver.backends).
 
-Every state goes first through the compiled flow (attitude.solver.compiled_flow, numba): the
+Every state goes first through the numba backend (attitude.solver.numba_backend): the
 elliptic cases (i) and (ii) with a certain double-double case test and mc ≥ 2^-128,
 nearly every state of a real spacecraft, at about 1 µs a state, one state alone or a
 batch.  The states it leaves (the separatrix and its 1e-13 neighbourhood, the sphere,
-bodies whose rate underflows, rest, mc < 2^-128) take the path
-of every case: split by their exact case (attitude.solver.invariants: double-double with an
-error bound, the exact integers where the bound leaves the case or mc in doubt), each
-case's formula once over all of its states on numpy arrays, or a few states one by one
-on Python floats (attitude.base.float_math).  Both paths evaluate the same formulas; their
-results agree to rounding (tests/test_compiled_flow_against_numpy_flow.py).
+bodies whose rate underflows, rest, mc < 2^-128) take the backend ``select`` picks for
+them: the float backend for a few, one at a time, the numpy backend for more (split by
+their exact case, each case's formula once over all of its states).  The backends
+agree to rounding (tests/test_compiled_flow_against_numpy_flow.py).
 
 The attitude step is, with the frame S of the state's formula, P(m) the rotation taking
 m onto G e3 and Y(ψ) the rotation by ψ about e3 (attitude.solver.closed_form):
@@ -37,15 +36,10 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from attitude.base.errors import InputError
-from attitude.base.float_math import FLOAT
 from attitude.base.quantities import as_si_array
-from attitude.solver.closed_form import (
-    ManyStates,
-    OneState,
-    Rest,
-    p_quaternion,
-    y_times_p,
-)
+from attitude.solver import float_backend
+from attitude.solver.backends import select
+from attitude.solver.closed_form import NotRepresentable
 
 __all__ = ["UnitBatch", "advance", "advance_floats", "advance_unit_batch"]
 
@@ -54,20 +48,14 @@ _KERNELS: list[Any] = []  # flow_one and flow_many, once imported
 
 
 def _kernels() -> list[Any]:
-    """attitude.solver.compiled_flow's flow_one and flow_many, imported on first use: numba's
-    import and the loading of the compiled code (~0.6 s) are paid only by a process
-    that flows (a run without torques or orbit does not)."""
+    """attitude.solver.numba_backend's flow_one and flow_many, imported on first use:
+    numba's import and the loading of the compiled code (~0.6 s) are paid only by a
+    process that flows (a run without torques or orbit does not)."""
     if not _KERNELS:
-        from attitude.solver import compiled_flow
+        from attitude.solver import numba_backend
 
-        _KERNELS[:] = [compiled_flow.flow_one, compiled_flow.flow_many]
+        _KERNELS[:] = [numba_backend.flow_one, numba_backend.flow_many]
     return _KERNELS
-
-
-# Below this many states, those the compiled flow leaves run one at a time on floats.
-_SMALL_BATCH = 36
-# A larger batch runs in slices of this many states: their temporaries stay in cache.
-_CHUNK = 4096
 
 
 def advance(
@@ -190,19 +178,21 @@ class UnitBatch:
 
 
 def _one_compiled(inertia: tuple, m: tuple, q0: tuple, τ: float, at: str = ""):
-    """One state on floats: the compiled flow (attitude.solver.compiled_flow), or the float
-    path of every case (``_advance_one``) for a state that it leaves."""
+    """One state on floats: the numba backend, or the float backend for a state that
+    it leaves (``at``: the state's index, for messages)."""
     ok, m1, m2, m3, qw, qx, qy, qz = _kernels()[0](*inertia, *m, *q0, τ)
     if ok:
         return (m1, m2, m3), (qw, qx, qy, qz)
-    return _advance_one(inertia, m, q0, τ, at)
+    try:
+        return float_backend.advance_one(inertia, m, q0, τ)
+    except NotRepresentable:
+        raise InputError(_too_far(τ, at)) from None
 
 
 def _many_compiled(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray):
-    """A checked batch (C-contiguous float64 arrays): the compiled flow over every
-    state, then the states it leaves (attitude.solver.compiled_flow: the separatrix and its
-    neighbourhood, the sphere, underflowing rates, rest, mc < 2^-128) down the numpy path
-    of every case, or one by one on floats if they are few."""
+    """A checked batch (C-contiguous float64 arrays): the numba backend over every
+    state, then the states it leaves (the separatrix and its neighbourhood, the sphere,
+    underflowing rates, rest, mc < 2^-128) to the backend ``select`` picks for them."""
     n = inertia.shape[0]
     m_new, q_new = np.empty((n, 3)), np.empty((n, 4))
     ok = np.empty(n, dtype=np.bool_)
@@ -210,22 +200,13 @@ def _many_compiled(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray):
     if ok.all():
         return m_new, q_new
     left = np.flatnonzero(~ok)
-    if left.size < _SMALL_BATCH:
-        # numpy's fixed cost (~1 ms for the few hundred calls of a batch) exceeds that
-        # of this many states on the float path (~40 µs each): one at a time.
-        for k in left.tolist():
-            m_k, q_k = _advance_one(
-                tuple(inertia[k].tolist()),
-                tuple(m[k].tolist()),
-                tuple(q[k].tolist()),
-                float(τ[k]),
-                f"[{k}]",
-            )
-            m_new[k], q_new[k] = m_k, q_k
-        return m_new, q_new
-    for start in range(0, left.size, _CHUNK):  # slices whose temporaries stay in cache
-        part = left[start : start + _CHUNK]
-        m_new[part], q_new[part] = _advance_many(inertia[part], m[part], q[part], τ[part], part)
+    backend = select(left.size, None)
+    assert backend is not None  # one time each
+    try:
+        m_new[left], q_new[left] = backend.advance(inertia[left], m[left], q[left], τ[left])
+    except NotRepresentable as error:
+        k = int(left[error.index])
+        raise InputError(_too_far(float(τ[k]), f"[{k}]")) from None
     return m_new, q_new
 
 
@@ -283,11 +264,9 @@ def _broadcast(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray):
             f"{m.shape}, quaternion_wxyz {q.shape}, dt {τ.shape}"
         ) from None
     n = N[0] if N else 1
-    return (
-        np.broadcast_to(inertia, (n, 3)),
-        np.broadcast_to(m, (n, 3)),
-        np.broadcast_to(q, (n, 4)),
-        np.broadcast_to(τ, (n,)),
+    return tuple(
+        array if array.shape == shape else np.broadcast_to(array, shape)  # as given, or a view
+        for array, shape in ((inertia, (n, 3)), (m, (n, 3)), (q, (n, 4)), (τ, (n,)))
     )
 
 
@@ -323,95 +302,6 @@ def _checked_batch(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray) -> NDA
             f"the angular velocity |m|/I1 is beyond the float range"
         )
     return q / norms[:, None]
-
-
-def _hamilton(p: tuple, q: tuple) -> tuple[Any, Any, Any, Any]:
-    """p ⊗ q, scalar first (floats or arrays)."""
-    pw, px, py, pz = p
-    qw, qx, qy, qz = q
-    return (
-        pw * qw - px * qx - py * qy - pz * qz,
-        pw * qx + px * qw + py * qz - pz * qy,
-        pw * qy - px * qz + py * qw + pz * qx,
-        pw * qz + px * qy - py * qx + pz * qw,
-    )
-
-
-def _step_in_formula_frame(formula: Any, G: Any, τ: Any, xp: Any):
-    """m(dt) in the formula's frame and P(m(0))⁻¹ ⊗ Y(ψ(dt) − ψ(0)) ⊗ P(m(dt))."""
-    # Both ends from the same formula (not m(0) from the state), so that their rounding
-    # errors, a shift of the phase ν, are the same and cancel in the step: a zero step
-    # is the identity, and ψ(dt) − ψ(0) is as accurate as dt is short.
-    if xp is FLOAT:
-        a0, b0, c0, ψ0 = formula.momentum_and_angle(0.0, xp)
-        a1, b1, c1, ψ1 = formula.momentum_and_angle(τ, xp)
-    else:  # both times in one pass over the states: (2, n) against constants (n,)
-        (a0, a1), (b0, b1), (c0, c1), (ψ0, ψ1) = formula.momentum_and_angle(
-            np.stack([np.zeros_like(τ), τ]), xp
-        )
-    p0 = p_quaternion(a0, b0, c0, G, xp)
-    p1 = p_quaternion(a1, b1, c1, G, xp)
-    yp = y_times_p(0.5 * (ψ1 - ψ0), *p1, xp)
-    step = _hamilton((p0[0], -p0[1], -p0[2], 0.0 * p0[0]), yp)
-    return (a1, b1, c1), step
-
-
-def _advance_one(inertia: tuple, m: tuple, q0: tuple, τ: float, at: str = ""):
-    """One state, on Python floats throughout (``at``: its index, for messages)."""
-    state = OneState(inertia, m)
-    if isinstance(state.formula, Rest):
-        return (0.0, 0.0, 0.0), tuple(q0)
-    try:
-        m_frame, step = _step_in_formula_frame(state.formula, state.G, τ, FLOAT)
-    except (ValueError, OverflowError):  # math on an angle beyond the float range
-        raise InputError(_too_far(τ, at)) from None
-    # Back to the body: x_body[index[k]] = sign[k] x_frame[k].
-    m_new = [0.0, 0.0, 0.0]
-    v = [0.0, 0.0, 0.0]
-    (i0, i1, i2), (s0, s1, s2) = state.index, state.sign
-    m_new[i0], m_new[i1], m_new[i2] = s0 * m_frame[0], s1 * m_frame[1], s2 * m_frame[2]
-    v[i0], v[i1], v[i2] = s0 * step[1], s1 * step[2], s2 * step[3]
-    w, x, y, z = _hamilton(q0, (step[0], v[0], v[1], v[2]))
-    norm = math.sqrt(w * w + x * x + y * y + z * z)  # 1 to a few ulps; kept from drifting
-    if not (math.isfinite(norm) and all(map(math.isfinite, m_new))):
-        raise InputError(_too_far(τ, at))
-    return tuple(m_new), (w / norm, x / norm, y / norm, z / norm)
-
-
-def _advance_many(
-    inertia: NDArray,
-    m: NDArray,
-    q: NDArray,
-    τ: NDArray,
-    labels: NDArray,
-):
-    """A batch on numpy arrays: each case's formula over all of its states at once
-    (``labels``: the indices of the states in the caller's batch, for messages)."""
-    states = ManyStates(inertia, m)
-    n = inertia.shape[0]
-    m_frame = np.zeros((n, 3))
-    step = np.zeros((n, 4))
-    step[:, 0] = 1.0  # rest: the attitude stays
-    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-        for k, formula in states.groups:
-            if isinstance(formula, Rest):
-                continue
-            picked = slice(None) if k.size == n else k  # one case for every state: no gather
-            (a, b, c), s = _step_in_formula_frame(formula, states.G[picked], τ[picked], np)
-            m_frame[picked] = np.stack([a, b, c], axis=-1)
-            step[picked] = np.stack(s, axis=-1)
-    # Back to the body, x_body[index[k]] = sign[k] x_frame[k], by flat indices.
-    flat = states.index + 3 * np.arange(n)[:, None]
-    m_new = np.empty((n, 3))
-    m_new.put(flat, states.sign * m_frame)
-    v = np.empty((n, 3))
-    v.put(flat, states.sign * step[:, 1:])
-    q_new = np.stack(_hamilton(tuple(q.T), (step[:, 0], *v.T)), axis=-1)
-    if not (np.isfinite(q_new).all() and np.isfinite(m_new).all()):
-        finite = np.isfinite(q_new).all(axis=1) & np.isfinite(m_new).all(axis=1)
-        bad = int(np.flatnonzero(~finite)[0])
-        raise InputError(_too_far(float(τ[bad]), f"[{labels[bad]}]"))
-    return m_new, q_new / np.linalg.norm(q_new, axis=1, keepdims=True)
 
 
 def _too_far(τ: float, at: str) -> str:

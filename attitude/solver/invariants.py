@@ -8,8 +8,9 @@ of its digits (δj = Δj/G²), a relative error of 1e-2 at |δ2| = 1e-14, which 
 flip period by 1e-8.  So the case is decided on the exact value for the float inputs,
 and mc is its correctly rounded value:
 
-1. For a batch, in double-double arithmetic (a float plus its rounding error,
-   numpy-vectorized), with a proved error bound: the products m_k² and the differences
+1. For a batch, in double-double arithmetic (a float plus its rounding error:
+   attitude.base.double_double, elementwise over numpy arrays), with a proved error
+   bound: the products m_k² and the differences
    I_k − I_j are exact, each product of double-doubles errs by at most 7u² and each sum
    by 3u² relative (u = 2^-53; Joldes, Muller and Popescu, "Tight and rigorous error
    bounds for basic building blocks of double-word arithmetic", ACM Trans. Math. Softw.
@@ -36,6 +37,7 @@ from typing import Any
 
 import numpy as np
 
+from attitude.base import double_double as dd
 from attitude.base.float_math import FLOAT
 
 __all__ = ["Invariants", "MomentConstants", "invariants"]
@@ -65,88 +67,31 @@ class Invariants:
     log_mc: Any
 
 
-# ----------------------------------------------------------------- double-double
-
-
-def _two_sum(a: Any, b: Any) -> tuple[Any, Any]:
-    """s + e = a + b exactly (Knuth)."""
-    s = a + b
-    bb = s - a
-    return s, (a - (s - bb)) + (b - bb)
-
-
-def _fast_two_sum(a: Any, b: Any) -> tuple[Any, Any]:
-    """s + e = a + b exactly, for |a| ≥ |b| (Dekker)."""
-    s = a + b
-    return s, b - (s - a)
-
-
-def _split(a: Any) -> tuple[Any, Any]:
-    """a = hi + lo with 26-bit halves (Veltkamp; |a| < 2^995)."""
-    c = 134217729.0 * a  # 2^27 + 1
-    hi = c - (c - a)
-    return hi, a - hi
-
-
-def _two_prod(a: Any, b: Any) -> tuple[Any, Any]:
-    """p + e = a b exactly (Dekker), barring underflow."""
-    p = a * b
-    ah, al = _split(a)
-    bh, bl = _split(b)
-    return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
-
-
-def _dd_times_dd(x: tuple, y: tuple) -> tuple[Any, Any]:
-    p, e = _two_prod(x[0], y[0])
-    return _fast_two_sum(p, e + (x[0] * y[1] + x[1] * y[0]))
-
-
-def _dd_times_float(x: tuple, b: Any) -> tuple[Any, Any]:
-    p, e = _two_prod(x[0], b)
-    return _fast_two_sum(p, e + x[1] * b)
-
-
-def _dd_plus_dd(x: tuple, y: tuple) -> tuple[Any, Any]:
-    s, e = _two_sum(x[0], y[0])
-    t, f = _two_sum(x[1], y[1])
-    s, e = _fast_two_sum(s, e + t)
-    return _fast_two_sum(s, e + f)
-
-
-def _dd_over_dd(x: tuple, y: tuple) -> tuple[Any, Any]:
-    q = x[0] / y[0]
-    p = _dd_times_float(y, q)
-    r = _dd_plus_dd(x, (-p[0], -p[1]))
-    return _fast_two_sum(q, r[0] / y[0])
-
-
 # ----------------------------------------------------------------- the invariants
 
 
-def _split_float(b: Any) -> tuple[Any, Any, Any]:
-    """b with its Veltkamp halves: an operand of ``_two_prod_split``, kept when b is a
-    constant of many products (the moments of a batch)."""
-    return (b, *_split(b))
+def _presplit(b: Any) -> tuple[Any, Any, Any]:
+    """b with its Veltkamp halves (``double_double.split``): the operand of the
+    ``*_presplit`` operations, kept when b is a factor of many products (the moments of
+    a batch)."""
+    return (b, *dd.split(b))
 
 
-def _two_prod_split(a: Any, b: tuple) -> tuple[Any, Any]:
-    """``_two_prod(a, b[0])`` with b given split (``_split_float``): the same operations."""
-    p = a * b[0]
-    ah, al = _split(a)
-    _, bh, bl = b
-    return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
+# The double-double operations on pairs (hi, lo), as the batch below holds them.
+def _times_float(x: tuple, b: tuple) -> tuple[Any, Any]:
+    return dd.dd_times_float_presplit(x[0], x[1], *b)
 
 
-def _dd_times_dd_split(x: tuple, y: tuple, y_split: tuple) -> tuple[Any, Any]:
-    """``_dd_times_dd(x, y)`` with y[0] given split (``y_split``)."""
-    p, e = _two_prod_split(x[0], y_split)
-    return _fast_two_sum(p, e + (x[0] * y[1] + x[1] * y[0]))
+def _times_dd(x: tuple, y: tuple, y_split: tuple) -> tuple[Any, Any]:
+    return dd.dd_times_dd_presplit(x[0], x[1], y[0], y[1], y_split[1], y_split[2])
 
 
-def _dd_times_float_split(x: tuple, b: tuple) -> tuple[Any, Any]:
-    """``_dd_times_float(x, b[0])`` with b given split (``_split_float``)."""
-    p, e = _two_prod_split(x[0], b)
-    return _fast_two_sum(p, e + x[1] * b[0])
+def _plus(x: tuple, y: tuple) -> tuple[Any, Any]:
+    return dd.dd_plus_dd(x[0], x[1], y[0], y[1])
+
+
+def _over(x: tuple, y: tuple) -> tuple[Any, Any]:
+    return dd.dd_over_dd(x[0], x[1], y[0], y[1])
 
 
 class MomentConstants:
@@ -162,21 +107,21 @@ class MomentConstants:
         with np.errstate(over="ignore", under="ignore", invalid="ignore"):
             moments = np.ldexp(np.stack([I1, I2, I3]), -np.frexp(I3)[1])
             self.valid = moments[0] >= _SMALLEST_SCALED
-            I_diff = _two_sum(moments[[1, 2, 2]], -moments[[0, 0, 1]])  # I21, I31, I32, exact
+            I_diff = dd.two_sum(moments[[1, 2, 2]], -moments[[0, 0, 1]])  # I21, I31, I32, exact
             # The six terms of Δ's (see _double_double): the difference and the third
             # moment of each.
             d, other = [0, 2, 1, 2, 0, 1], [2, 0, 1, 0, 2, 1]
             self.t_diff = (I_diff[0][d], I_diff[1][d])
-            self.t_diff_split = _split_float(self.t_diff[0])
-            self.t_other = _split_float(moments[other])
-            self.G2_factors = (_split_float(moments[[1, 0]]), _split_float(moments[[2, 1]]))
-            self.I2 = _split_float(moments[1])
+            self.t_diff_split = _presplit(self.t_diff[0])
+            self.t_other = _presplit(moments[other])
+            self.G2_factors = (_presplit(moments[[1, 0]]), _presplit(moments[[2, 1]]))
+            self.I2 = _presplit(moments[1])
             self.I31 = (I_diff[0][1], I_diff[1][1])
-            self.I31_split = _split_float(I_diff[0][1])
+            self.I31_split = _presplit(I_diff[0][1])
             # Case (i) and case (ii) factors of mc's denominator: I3 and I21, I1 and I32.
-            self.I_other = (_split_float(moments[2]), _split_float(moments[0]))
+            self.I_other = (_presplit(moments[2]), _presplit(moments[0]))
             self.I_d = ((I_diff[0][0], I_diff[1][0]), (I_diff[0][2], I_diff[1][2]))
-            self.I_d_split = (_split_float(I_diff[0][0]), _split_float(I_diff[0][2]))
+            self.I_d_split = (_presplit(I_diff[0][0]), _presplit(I_diff[0][2]))
 
 
 def _select(case_i: Any, when_i: tuple, when_ii: tuple) -> tuple:
@@ -197,47 +142,43 @@ def _double_double(m1: Any, m2: Any, m3: Any, c: MomentConstants):
     representable = (m == 0.0) | (np.abs(m) >= _SMALLEST_SCALED)
     valid = representable.all(axis=0) & c.valid
 
-    sq = _two_prod_split(m, _split_float(m))  # m_k², exact (m split once)
+    sq = dd.two_prod_presplit(m, *_presplit(m))  # m_k², exact (m split once)
     # The six terms m_k² I_kj I_l: m1² I21 I3 and m3² I32 I1 (Δ2), m1² I31 I2 and
     # m2² I32 I1 (−Δ3), m2² I21 I3 and m3² I31 I2 (Δ1), all scaled.
     k = [0, 2, 0, 1, 1, 2]
-    t = _dd_times_float_split(
-        _dd_times_dd_split((sq[0][k], sq[1][k]), c.t_diff, c.t_diff_split), c.t_other
-    )
+    t = _times_float(_times_dd((sq[0][k], sq[1][k]), c.t_diff, c.t_diff_split), c.t_other)
     # I1 I3 Δ2 = t3 − t1, I1 I2 (−Δ3) and I2 I3 Δ1: sums of two terms (of one sign for
     # the last two).
-    sums = _dd_plus_dd(
+    sums = _plus(
         (t[0][[1, 2, 4]], t[1][[1, 2, 4]]),
         (t[0][[0, 3, 5]] * [[-1.0], [1.0], [1.0]], t[1][[0, 3, 5]] * [[-1.0], [1.0], [1.0]]),
     )
     N2, P3, N1 = (sums[0][0], sums[1][0]), (sums[0][1], sums[1][1]), (sums[0][2], sums[1][2])
     N2_error = _BOUND * (np.abs(t[0][0]) + np.abs(t[0][1]))
     sign_certain = np.abs(N2[0]) > 2.0 * N2_error
-    G2 = _dd_plus_dd(_dd_plus_dd((sq[0][0], sq[1][0]), (sq[0][1], sq[1][1])), (sq[0][2], sq[1][2]))
+    G2 = _plus(_plus((sq[0][0], sq[1][0]), (sq[0][1], sq[1][1])), (sq[0][2], sq[1][2]))
     case_i = N2[0] < 0.0
     sign = np.where(case_i, -1.0, 1.0)
     with np.errstate(divide="ignore", invalid="ignore"):
         # δ1 = Δ1/G² = N1/(I2 I3 G²), δ3 = −P3/(I1 I2 G²): faithful, nearly always the
         # correctly rounded values of the exact path (a few ulps off would be amplified
         # next to the separatrix, where the batch must agree with one state alone).
-        G2_I = _dd_times_float_split(
-            _dd_times_float_split(
-                (np.stack([G2[0], G2[0]]), np.stack([G2[1], G2[1]])), c.G2_factors[0]
-            ),
+        G2_I = _times_float(
+            _times_float((np.stack([G2[0], G2[0]]), np.stack([G2[1], G2[1]])), c.G2_factors[0]),
             c.G2_factors[1],
         )
-        δ = _dd_over_dd((np.stack([N1[0], P3[0]]), np.stack([N1[1], P3[1]])), G2_I)[0]
+        δ = _over((np.stack([N1[0], P3[0]]), np.stack([N1[1], P3[1]])), G2_I)[0]
         δ1, δ3 = δ[0], -δ[1]
     # mc = |N2| I2 I31 / (I3 P3 I21) in case (i), |N2| I2 I31 / (I1 N1 I32) in case (ii).
     N2_abs = (np.abs(N2[0]), np.copysign(1.0, N2[0]) * N2[1])
-    numerator = _dd_times_dd_split(_dd_times_float_split(N2_abs, c.I2), c.I31, c.I31_split)
+    numerator = _times_dd(_times_float(N2_abs, c.I2), c.I31, c.I31_split)
     D = (np.where(case_i, P3[0], N1[0]), np.where(case_i, P3[1], N1[1]))
     I_other = _select(case_i, *c.I_other)
     I_d = _select(case_i, *c.I_d)
     I_d_split = _select(case_i, *c.I_d_split)
-    denominator = _dd_times_dd_split(_dd_times_float_split(D, I_other), I_d, I_d_split)
+    denominator = _times_dd(_times_float(D, I_other), I_d, I_d_split)
     with np.errstate(divide="ignore", invalid="ignore"):
-        mc, mc_low = _dd_over_dd(numerator, denominator)
+        mc, mc_low = _over(numerator, denominator)
         # Relative error: that of N2 plus the chains' (four products, a sum, a quotient).
         error = mc * (N2_error / np.abs(N2[0]) + 4.0 * _BOUND)
         spacing = np.spacing(mc)

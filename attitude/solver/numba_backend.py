@@ -1,34 +1,38 @@
-"""The exact free flow of one state in compiled code (numba): the elliptic cases.
+"""The numba backend: the free flow of the elliptic cases, compiled, one state at a time.
 
 ``flow_one`` advances one state (moments, body momentum, unit quaternion) by dt, and
-``flow_many`` a batch, state by state in a compiled loop.  They evaluate the formulas
-of attitude.solver.closed_form and attitude.solver.free_flow for cases (i) and (ii) away from m = 1,
-operation for operation on floats, with the elliptic kernels of
-attitude.elliptic.compiled:
+``flow_many`` a batch, state by state in a compiled loop.  They are a compiled copy of
+the formulas of attitude.solver.closed_form for cases (i) and (ii) away from m = 1
+(``Elliptic`` and ``step``), operation for operation on floats, with the elliptic
+kernels of attitude.elliptic.compiled:
 
-1. the moments sorted and the momentum permuted alike (``closed_form.SortedMoments``);
+1. the moments sorted and the momentum permuted alike (``numpy_backend.SortedMoments``);
 2. the exact case test in double-double with its error bound
    (``invariants._double_double``; Joldes, Muller, Popescu, ACM TOMS 44(2), 2017);
 3. the preferred flips, the constants of ``closed_form.Elliptic`` (B13, B31, B2, K,
    λ, n, κ, C, ν, Π − K);
 4. m and ψ at τ = 0 and τ = dt from the same formula ([Leroy] "Integrals"), then
    q(t0 + dt) = q(t0) ⊗ S⁻¹ ⊗ P(m(0))⁻¹ ⊗ Y(ψ(dt) − ψ(0)) ⊗ P(m(dt)) ⊗ S
-   (``free_flow``'s module docstring).
+   (``closed_form.step``).
 
-A state that is not of these cases, or whose case or mc the double-double leaves
-uncertain (within |δ2| ~ 1e-13 of the separatrix), or with mc < 2^-128, or whose
-result is not finite, is returned *unhandled* (``ok`` False): attitude.solver.free_flow
-sends it down the numpy path, which covers every case exactly (the separatrix, the
-sphere and the bodies whose rate underflows, rest, the exact integers).  Symmetric
-bodies (two equal moments) are case (ii) with n = 0, and are taken here.  So this
+Takes the elliptic states whose double-double case test is certain, with mc ≥ 2^-128
+and moments and momentum components within 2^±60 (SI values of any spacecraft):
+nearly every state of a real one, symmetric bodies included (case ii with n = 0).
+Leaves, returned *unhandled* (``ok`` False), the separatrix and its |δ2| ~ 1e-13
+neighbourhood (where the case or mc needs the exact integers), the sphere, bodies
+whose rate underflows, rest, mc < 2^-128, magnitudes beyond 2^±60, and any result
+that is not finite: attitude.solver.free_flow sends those to the float or numpy
+backend (attitude.solver.backends.select), which cover every case exactly.  So this
 module is a faster road to the same numbers, never a second definition of them: the
-results agree with the numpy path to a few ulps
+results agree with the numpy backend to a few ulps
 (tests/test_compiled_flow_against_numpy_flow.py).
 
 Why compiled: on a batch of 1000 spacecraft, the numpy flow cost 2.2 µs a state per
 step, nearly all of it the fixed cost of a few hundred numpy calls over arrays of 1000,
 and one state on Python floats 23 µs; compiled, 0.87 and 1.7 µs (docs/benchmarks.md,
 "The free flow compiled").  The torque splitting calls the flow about ten times a step.
+Importing this module imports numba and loads the compiled code (~0.6 s): only a
+process that flows imports it (attitude.solver.free_flow imports it on first use).
 
 [Leroy] P. Leroy, "On an Article by Celledoni et al." (2020), in Principia's
     documentation: https://github.com/mockingbirdnest/Principia/blob/master/documentation/Celledoni.pdf
@@ -40,6 +44,7 @@ import math
 
 import numpy as np
 
+from attitude.base import double_double
 from attitude.base.double_double import (
     dd_over_dd,
     dd_plus_dd,
@@ -48,7 +53,7 @@ from attitude.base.double_double import (
     two_prod,
     two_sum,
 )
-from attitude.base.jit import jit
+from attitude.base.jit import inline, jit
 from attitude.elliptic.compiled import (
     AGM_LEVELS,
     agm,
@@ -61,6 +66,8 @@ from attitude.elliptic.compiled import (
 
 __all__ = ["flow_many", "flow_one"]
 
+inline(double_double.FUNCTIONS)
+
 
 # As attitude.solver.invariants: the double-double error allowed per chain (64 u²).
 _BOUND = 64.0 * 2.0**-106
@@ -70,7 +77,7 @@ _BOUND = 64.0 * 2.0**-106
 # 2^-300 and 2^300, with their errors far from underflow.
 _SMALLEST = 2.0**-60
 _LARGEST = 2.0**60
-# As attitude.elliptic.functions.NEAR_ONE_MC: below, the kernels work from ln mc (numpy path).
+# As attitude.elliptic.functions.NEAR_ONE_MC: below, the kernels work from ln mc (left).
 _NEAR_ONE_MC = 2.0**-128
 
 
@@ -92,7 +99,7 @@ def _case_test(I1, I2, I3, m1, m2, m3):
     # no term of the double-double underflows or overflows; within these bounds none
     # can, and scaling by a power of two changes no bit of the results (every
     # operation commutes with it), so the values are used as they are.  A state
-    # outside them is left to the numpy path.
+    # outside them is left to the other backends.
     largest = max(abs(m1), abs(m2), abs(m3))
     valid = _SMALLEST <= I1 and I3 <= _LARGEST and largest <= _LARGEST
     for M in (m1, m2, m3):
@@ -214,7 +221,7 @@ def _flow(I_a, I_b, I_c, m_a, m_b, m_c, qw, qx, qy, qz, dt, a_seq, b_seq):
     """``flow_one`` with scratch arrays of ``AGM_LEVELS`` floats for the AGM."""
     nothing = (False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
     # 1. Sorted, stably, by three compare-exchanges; the middle axis reversed for an
-    #    odd permutation (SortedMoments).
+    #    odd permutation (numpy_backend.SortedMoments).
     I1, I2, I3 = I_a, I_b, I_c
     o0, o1, o2 = 0, 1, 2
     odd = False
@@ -268,7 +275,7 @@ def _flow(I_a, I_b, I_c, m_a, m_b, m_c, qw, qx, qy, qz, dt, a_seq, b_seq):
     K = complete_first_kind(c_agm)
     λ = -(G / I3) * math.sqrt(numerator / I3 / ((I1 / I3) * (I2 / I3)))  # closed_form.rate
     if λ == 0.0:
-        return nothing  # Steady (closed_form): the numpy path
+        return nothing  # Steady (closed_form): left to the other backends
     C = (G / λ) * C_factor
     # ν ([Leroy] "Phase and initial value", closed_form.Elliptic._phase away from m = 1).
     # sn ν = a/|A_s| and cn ν = b/A_c, with (a, b) = (m2, −m1) in case ii, (m2, m3) in i.
@@ -282,7 +289,7 @@ def _flow(I_a, I_b, I_c, m_a, m_b, m_c, qw, qx, qy, qz, dt, a_seq, b_seq):
     f = sin_φ * carlson_rf(c2, c2 + mc * sin_φ * sin_φ, 1.0)  # F(φ|m), [OLBC10] 19.25.5
     ν = f if cos_φ >= 0.0 else math.copysign(2.0 * K, sin_φ) - f
     Π_minus_K = cel_pi_minus_k(math.sqrt(mc), n)
-    # 4. Both ends from the same formula (free_flow._step_in_formula_frame).
+    # 4. Both ends from the same formula (closed_form.step).
     formula = (λ, ν, K, mc, levels, c_agm, A_s, A_c, A_d, n, C, κ, κ_sign, ψ_rate, Π_minus_K)
     a0, b0, c0, ψ0 = _momentum_and_angle(0.0, formula, a_seq, b_seq)
     a1, b1, c1, ψ1 = _momentum_and_angle(dt, formula, a_seq, b_seq)
