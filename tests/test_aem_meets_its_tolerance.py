@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from aem_read_back import interpolate_as_declared, read_back, rotation_angle
+from cli_lines import said
 
 from attitude.cli.main import main
 from attitude.environment.timescales import tt_seconds
@@ -172,5 +173,5 @@ def test_a_bad_tolerance_is_refused_in_one_line(tmp_path, capsys, option, messag
             argv += ["--out", str(tmp_path / "out")]
         assert main(argv) == 2
         err = capsys.readouterr().err
-        assert len(err.splitlines()) == 1 and re.search(message, err), err
+        assert len(said(err)) == 1 and re.search(message, err), err
     assert not (tmp_path / "out").exists()

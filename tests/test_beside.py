@@ -17,6 +17,7 @@ import time
 from pathlib import Path
 
 import pytest
+from signal_dispositions import defaults
 
 import attitude.report.beside
 from attitude.files.scenario_reader import load_scenario
@@ -115,6 +116,7 @@ def test_a_signal_while_the_horizon_runs_leaves_one_line_and_no_process(
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,
+        preexec_fn=defaults,  # not the ignored SIGINT of a `pytest &`
     )
     for line in process.stderr:
         if "sampling" in line:

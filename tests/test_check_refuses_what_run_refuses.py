@@ -11,8 +11,10 @@ check with the folder, `check --out DIR`: those cases are run that way.
 
 import json
 import re
+from pathlib import Path
 
 import pytest
+from cli_lines import said
 
 from attitude.cli.main import main
 
@@ -117,16 +119,18 @@ BAD = {
     ),
     "burn: a torque that spins the body beyond what TT seconds follow": (
         _torques("step = 1.0", BURN.replace("[0.0, 0.0, 0.01]", "[1e150, 0.0, 0.0]")),
-        r"initial_state: the body turns in .* too fast for TT seconds",
+        r"torques\.burns\[0\]\.torque: spun up by the burns: the body turns in .* too fast "
+        r"for TT seconds",
     ),
     "burn: the same with the step chosen for an accuracy": (
         _torques("", BURN.replace("[0.0, 0.0, 0.01]", "[1e150, 0.0, 0.0]")),
-        r"initial_state: torques\.accuracy: choosing the step over 5 s would start with "
-        r"1\.91e\+150 steps of 3\.93e-150 s \(more than 1e\+07\)",
+        r"torques\.burns\[0\]\.torque: the burns spin the body up to 2e\+149 rad/s \(this one "
+        r"adds 2e\+150 N m s\): choosing the step for torques\.accuracy over 5 s would start "
+        r"with 1\.91e\+150 steps of 3\.93e-150 s \(more than 1e\+07\)",
     ),
     "burn: after the span": (
         _torques("", BURN.replace("offset = 1.0", "offset = 10.0")),
-        r"torques\.burns\[0\]\.epoch: the burn starts at 2027-06-21T00:00:10\.000000000 UTC, "
+        r"torques\.burns\[0\]\.offset: the burn starts at 2027-06-21T00:00:10\.000000000 UTC, "
         r"outside the span",
     ),
     "burn: a string torque": (
@@ -147,7 +151,7 @@ BAD = {
     ),
     "torques: unknown key": (
         _torques("gravity_gradiant = true", BURN),
-        r"torques: unknown key 'gravity_gradiant'",
+        r"torques\.gravity_gradiant: unknown key; expected one of: gravity_gradient, ",
     ),
     "torques: gravity gradient without an orbit": (
         _torques("gravity_gradient = true", orbit=False),
@@ -186,8 +190,7 @@ BAD = {
             'accuracy = { value = 1e-6, unit = "rad" }',
             BURN.replace("duration = 2.0", "duration = 1e10"),
         ).replace("duration = 10.0", "duration = 1e10"),
-        r"the state after events\[0\] .*: torques\.accuracy: choosing the step over "
-        r"1e\+10 s would start with "
+        r"torques\.accuracy: choosing the step over 1e\+10 s would start with "
         r"[\d.e+]+ steps of [\d.e+-]+ s \(more than 1e\+07\): give torques\.step",
     ),
     "torques: an accuracy for a burn that spins the body up to 1e8 rad/s": (
@@ -195,8 +198,9 @@ BAD = {
             'accuracy = { value = 1e-6, unit = "rad" }',
             BURN.replace("[0.0, 0.0, 0.01]", "[1e9, 0.0, 0.0]"),
         ),
-        r"initial_state: torques\.accuracy: choosing the step over 5 s would start with "
-        r"[\d.e+]+ steps of [\d.e+-]+ s \(more than 1e\+07\): give torques\.step",
+        r"torques\.burns\[0\]\.torque: the burns spin the body up to 2e\+08 rad/s .*: choosing "
+        r"the step for torques\.accuracy over 5 s would start with [\d.e+]+ steps of "
+        r"[\d.e+-]+ s \(more than 1e\+07\): give a smaller torque",
     ),
     "torques: negative step": (
         _torques("step = -1.0", BURN),
@@ -226,24 +230,24 @@ BAD = {
     # The Sun ephemeris, DE421: 1899-07-29 to 2053-10-09 TDB.
     "epoch 1850": (
         _with_tle(text=_epoch("1850-01-01T00:00:00")),
-        r"output: the span .* outside the span of the DE421 ephemeris",
+        r"scenario\.epoch: the span .* outside the span of the DE421 ephemeris",
     ),
     "epoch 2060": (
         _with_tle(text=_epoch("2060-01-01T00:00:00")),
-        r"output: the span .* outside the span of the DE421 ephemeris",
+        r"scenario\.epoch: the span .* outside the span of the DE421 ephemeris",
     ),
     "span across 2053-10-09": (
         _with_tle(text=_epoch("2053-10-08T12:00:00", 2 * 86400.0)),
-        r"output: the span .* outside the span of the DE421 ephemeris",
+        r"output\.duration: the span .* outside the span of the DE421 ephemeris",
     ),
     # The epoch and the end are inside; the interpolation's nodes 10 min beyond are not.
     "ephemeris start within the margin": (
         _epoch("1899-07-29T00:15:00") + EARTH_CENTRE,
-        r"output: the span with its 600 s margins",
+        r"scenario\.epoch: the span with its 600 s margins",
     ),
     "ephemeris end within the margin": (
         _epoch("2053-10-08T23:59:00", 50.0) + EARTH_CENTRE,
-        r"output: the span with its 600 s margins",
+        r"output\.duration: the span with its 600 s margins",
     ),
     "year 10000": (
         _replace('epoch = "2027-06-21T00:00:00"', 'epoch = "9999-12-31T23:59:55"'),
@@ -271,24 +275,25 @@ BAD = {
     # (hundreds of terabytes: no disk holds them).
     "1e12 output epochs": (
         _replace("step = 1.0", "step = 1e-3", _replace("duration = 10.0", "duration = 1e9")),
-        r"output: 1000000000002 samples would take about [\d.]+ TB \(timeseries\.csv .*\), "
+        r"output\.step: 1000000000002 samples would take about [\d.]+ TB \(timeseries\.csv .*\), "
         r"and the disk of .* has",
     ),
     "1e11 output epochs": (
         _replace("step = 1.0", "step = 1e-2", _replace("duration = 10.0", "duration = 1e9")),
-        r"output: 100000000001 samples would take about [\d.]+ TB",
+        r"output\.step: 100000000001 samples would take about [\d.]+ TB",
     ),
     "1e200 rad/s": (
         _replace("[0.01, 0.2, 0.01]", "[1e200, 1e200, 0]"),
-        r"initial_state: the body turns in .* too fast for TT seconds",
+        r"initial_state\.angular_velocity: the body turns in .* too fast for TT seconds",
     ),
     "1e200 rad/s after an event": (
         _replace("impulse = [0.1, 0.0, 0.0]", "impulse = [1e201, 0.0, 0.0]"),
-        r"the state after events\[0\] \(angular_impulse at .*\): the body turns in",
+        r"events\[0\]\.impulse: the state after the angular_impulse at .*: the body turns in",
     ),
 }
 
-# Refused by the disk, which `check` sees only with --out.
+# Refused by the disk: `check --out DIR` names DIR's, `check` alone the current folder's
+# (where a relative --out goes), which it used to leave unchecked and say OK.
 DISK = {"1e12 output epochs", "1e11 output epochs"}
 
 BIG = "1" + "0" * 400  # 10**400, a valid TOML integer
@@ -311,7 +316,7 @@ for _key, (_old, _new) in BIG_KEYS.items():
 def _lines(capsys) -> list[str]:
     err = capsys.readouterr().err
     assert "Traceback" not in err
-    return err.splitlines()
+    return said(err)
 
 
 @pytest.mark.parametrize("case", list(BAD))
@@ -320,17 +325,15 @@ def test_check_and_run_refuse_with_the_same_line(case, tmp_path, capsys):
     path = tmp_path / "bad.toml"
     path.write_text(text, encoding="utf-8")
     out = tmp_path / "out"
-    if case in DISK:
-        assert main(["check", str(path)]) == 0  # states the sizes; the disk needs --out
-        assert "disk        not checked" in capsys.readouterr().out
     for check in (["check", str(path)], ["check", str(path), "--out", str(out)]):
-        if case in DISK and "--out" not in check:
-            continue
         assert main(check) == 2
         checked = _lines(capsys)
         assert len(checked) == 1, checked
         assert re.search(rf"^attitude: error: bad\.toml: {message}", checked[0]), checked[0]
         assert checked[0].count("bad.toml") == 1  # the file named once, not `x: x: key`
+        if case in DISK:
+            where = f"{out}" if "--out" in check else f"the current folder ({Path.cwd()})"
+            assert f"and the disk of {where} has " in checked[0], checked[0]
     assert main(["run", str(path), "--out", str(out), "--quiet"]) == 2
     assert _lines(capsys) == checked
     assert not out.exists() and [p.name for p in tmp_path.iterdir()] == ["bad.toml"]
@@ -377,7 +380,7 @@ def test_a_precision_finer_than_time_resolves_is_clamped_and_said(tmp_path, caps
     assert re.search(r"note .*interval_precision 1e-13 s is finer than TT seconds resolve", out)
     assert main(["run", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
     err = capsys.readouterr().err
-    assert len(err.splitlines()) == 1 and "attitude: note: fine.toml: pointing." in err
+    assert len(said(err)) == 1 and "attitude: note: fine.toml: pointing." in err
     summary = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert summary["pointing"]["interval_precision_s"] == pytest.approx(2 * 1.1368683772161603e-13)
 
@@ -398,6 +401,8 @@ def test_check_states_the_samples_and_the_sizes(tmp_path, capsys):
     assert re.search(r"outputs +3601 samples; writes about [\d.]+ MB \(timeseries\.csv", out)
     assert "holds about" in out
     assert "Sun exclusion half angle 30 deg" in out  # angles echoed in degrees
+    # Without --out, the disk a run writes to without a path: said, and checked.
+    assert re.search(r"disk +[\d.]+ [kMGT]?B free on the current folder's disk", out), out
 
 
 def test_check_with_out_refuses_what_run_would(tmp_path, capsys):
@@ -416,4 +421,8 @@ def test_every_run_error_names_the_file_and_the_key(tmp_path, capsys):
         path.write_text(BAD[case][0], encoding="utf-8")
         assert main(["run", str(path), "--out", str(tmp_path / "o"), "--quiet"]) == 2
         line = capsys.readouterr().err
-        assert re.match(r"attitude: error: bad\.toml: (pointing\.tle|initial_state|output): ", line)
+        assert re.match(
+            r"attitude: error: bad\.toml: "
+            r"(pointing\.tle|initial_state\.angular_velocity|output\.step|scenario\.epoch): ",
+            line,
+        )

@@ -11,6 +11,7 @@ import re
 from pathlib import Path
 
 import pytest
+from cli_lines import said
 
 import attitude.outputs.csv
 import attitude.outputs.parquet
@@ -127,7 +128,7 @@ def test_garbage_formats_are_refused_in_one_line(tmp_path, capsys, argv, message
     for command in (["check", str(path)], ["run", str(path), "--out", str(out), "--quiet"]):
         assert main(command + argv) == 2
         err = capsys.readouterr().err
-        assert len(err.splitlines()) == 1 and re.search(message, err), err
+        assert len(said(err)) == 1 and re.search(message, said(err)[0]), err
     assert not out.exists()
 
 
@@ -145,7 +146,7 @@ def test_bad_formats_in_the_file_name_the_key(tmp_path, capsys, value, message):
     for command in (["check", str(path)], ["run", str(path), "--out", str(tmp_path / "o")]):
         assert main(command) == 2
         err = capsys.readouterr().err
-        assert len(err.splitlines()) == 1 and re.search(rf"s\.toml: {message}", err), err
+        assert len(said(err)) == 1 and re.search(rf"s\.toml: {message}", err), err
 
 
 @pytest.mark.parametrize("failing", ["csv", "parquet"])
@@ -177,6 +178,6 @@ def test_a_disk_full_in_the_middle_of_the_stream_leaves_nothing(
     argv = ["run", str(path), "--out", str(out), "--formats", failing, "--quiet"]
     assert main(argv) == 1
     err = capsys.readouterr().err
-    assert err.splitlines() == ["attitude: error: No space left on device"], err
+    assert said(err) == ["attitude: error: No space left on device"], err
     assert len(calls) == 3
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before

@@ -16,14 +16,18 @@ from __future__ import annotations
 import json
 import math
 import re
+import warnings
 
 import astropy.units as u
 import numpy as np
 import pytest
 from astropy.time import Time
+from cli_lines import said
 
-from attitude import KeplerianOrbit, SunLaw
+from attitude import InputError, KeplerianOrbit, SunLaw
 from attitude.cli.main import main
+from attitude.files.scenario_reader import load_scenario
+from attitude.report.plan import plan_run
 
 BASE = """
 [scenario]
@@ -97,6 +101,8 @@ def _apparent_sun_at(seconds: float) -> list[float]:
     return bound.state([seconds]).attitude[0].apply([0.0, 0.0, 1.0]).tolist()
 
 
+# Each case: the file, the key that holds the bad value (InputError.key, as data), and
+# the reason the line gives.
 REFUSED = {
     "parallel body vectors": (
         _replace(
@@ -104,7 +110,8 @@ REFUSED = {
             'law = { name = "align_constrain", primary_axis = "+x", primary = "sun", '
             'secondary_axis = "-x", secondary = "orbit_normal" }',
         ),
-        r"events\[0\]\.law: align_constrain: the primary and secondary body vectors are parallel",
+        "events[0].law",
+        r"align_constrain: the primary and secondary body vectors are parallel",
     ),
     "the same direction twice": (
         _replace(
@@ -112,7 +119,8 @@ REFUSED = {
             'law = { name = "align_constrain", primary_axis = "+x", primary = "nadir", '
             'secondary_axis = "+y", secondary = "-nadir" }',
         ),
-        r"events\[0\]\.law: .*cannot make a pair: they are opposite",
+        "events[0].law",
+        r"cannot make a pair: they are opposite",
     ),
     "directions parallel during the run": (
         _replace(
@@ -120,13 +128,15 @@ REFUSED = {
             'law = { name = "align_constrain", primary_axis = "+x", primary = "sun", '
             f'secondary_axis = "+y", secondary = {_apparent_sun_at(900.0)!r} }}',
         ),
-        r"events\[0\]\.law: the align_constrain law is undefined at 2025-05-01T10:1[45]:.* UTC "
-        r"\(t = 9\d\d\.\d* s\): .* come within .* rad of each other",
+        "events[0].law",
+        r"the align_constrain law is undefined at 2025-05-01T10:1[45]:.* UTC \(t = 9\d\d\.\d* s\): "
+        r".* come within .* rad of each other",
     ),
     "a slew that cannot end before the next event": (
         _replace("offset = 1200.0", "offset = 650.0"),
-        r"events\[0\]\.slew: the slew of 1\d\d\.\d deg from .* takes \d+\.?\d* s .* after the next "
-        r"event, events\[1\] at 2025-05-01T10:10:50",
+        "events[0].slew",
+        r"the slew of 1\d\d\.\d deg from .* takes \d+\.?\d* s .* after the next event, "
+        r"events\[1\] at 2025-05-01T10:10:50",
     ),
     "a resume onto a law faster than the slew's limit": (
         _replace(
@@ -135,8 +145,9 @@ REFUSED = {
             'slew = { max_rate = { value = 0.01, unit = "deg/s" }, max_acceleration = '
             '{ value = 0.05, unit = "deg/s2" } }\n\n[output]',
         ),
-        r"events\[2\]\.slew: the target law itself turns at up to 0\.06\d* deg/s, beyond "
-        r"max_rate 0\.01 deg/s: no slew within it can join the law; give a larger max_rate",
+        "events[2].slew.max_rate",
+        r"the target law itself turns at up to 0\.06\d* deg/s, beyond max_rate 0\.01 deg/s: "
+        r"no slew within it can join the law; give a larger max_rate",
     ),
     "a resume from a tumble too fast to capture": (
         _replace(
@@ -149,37 +160,41 @@ REFUSED = {
                 'case = "locked", momentum = [0.5, 2.0, 1.0]',
             ),
         ),
-        r"events\[2\]\.slew: the body turns at 0\.1\d* deg/s relative to the target law, which "
-        r"turns at up to 0\.06\d* deg/s: max_rate 0\.15 deg/s cannot capture it; give a "
-        r"larger max_rate",
+        "events[2].slew.max_rate",
+        r"the body turns at 0\.1\d* deg/s relative to the target law, which turns at up to "
+        r"0\.06\d* deg/s: max_rate 0\.15 deg/s cannot capture it; give a larger max_rate",
     ),
     "absurd wheel momentum": (
         _replace("momentum = [0.0, 2.0, 0.0]", "momentum = [0.0, 2.0e7, 0.0]"),
-        r"events\[1\]\.wheels\.momentum: \[0\.0, 20000000\.0, 0\.0\] N m s would turn the body "
-        r"at 1\.92e\+04 rad/s .*no reaction wheel holds that much",
+        "events[1].wheels.momentum",
+        r"\[0\.0, 20000000\.0, 0\.0\] N m s would turn the body at 1\.92e\+04 rad/s .*no "
+        r"reaction wheel holds that much",
     ),
     "wheel momentum beyond floats": (
         _replace("momentum = [0.0, 2.0, 0.0]", "momentum = [0.0, 1e400, 0.0]"),
-        r"events\[1\]\.wheels\.momentum: expected finite numbers, got \[0\.0, inf, 0\.0\]",
+        "events[1].wheels.momentum",
+        r"expected finite numbers, got \[0\.0, inf, 0\.0\]",
     ),
     "a law that needs an orbit without one": (
         re.sub(r"(?s)\[pointing\.keplerian\].*?j2 = true\n", "", BASE),
-        r"initial_state\.law: the nadir law \(\+z on geodetic nadir, zero-Doppler yaw "
-        r"steering\) needs an orbit .* and the scenario has none",
+        "initial_state.law",
+        r"the nadir law \(\+z on geodetic nadir, zero-Doppler yaw steering\) needs an orbit .* "
+        r"and the scenario has none",
     ),
     "a mode change while control is lost": (
         _replace(
             "[output]",
             f'[[events]]\ntype = "mode_change"\noffset = 1500.0\n{SUN_LAW}\n\n[output]',
         ),
-        r"events\[2\] \(mode_change at .*\): control is lost at that epoch .*: use "
-        r"control_resume to return to a law",
+        "events[2]",
+        r"the mode_change at .*: control is lost there .*: use control_resume to return to a law",
     ),
     "a resume under a law": (
         _replace(
             'type = "control_loss"', 'type = "control_resume"\nlaw = { name = "nadir" }'
         ).replace('wheels = { case = "spinning", momentum = [0.0, 2.0, 0.0] }\n', ""),
-        r"events\[1\] \(control_resume at .*\): control is not lost at that epoch",
+        "events[1]",
+        r"the control_resume at .*: control is not lost there",
     ),
     "an impulse under a law": (
         _replace(
@@ -187,71 +202,97 @@ REFUSED = {
             '[[events]]\ntype = "angular_impulse"\noffset = 300.0\nimpulse = [0.1, 0.0, 0.0]'
             "\n\n[output]",
         ),
-        r"events\[2\] \(angular_impulse at .*\): an angular_impulse needs a free body, and a "
-        r"law holds the attitude",
+        "events[2]",
+        r"the angular_impulse at .*: an angular_impulse needs a free body, and a law holds the "
+        r"attitude there",
     ),
     "an unknown law": (
         _replace('name = "nadir"\nyaw', 'name = "nadirr"\nyaw'),
-        r"initial_state\.law\.name: expected one of inertial, orbit_frame, nadir, sun, target, "
-        r"align_constrain, got 'nadirr'",
+        "initial_state.law.name",
+        r"expected one of inertial, orbit_frame, nadir, sun, target, align_constrain, got 'nadirr'",
     ),
     "an unknown site": (
         _replace(SUN_LAW, 'law = { name = "target", target = "kourou" }'),
-        r"events\[0\]\.law\.target: unknown direction 'kourou'",
+        "events[0].law.target",
+        r"unknown direction 'kourou'",
     ),
     "a key of another law": (
         _replace('yaw_steering = "zero_doppler"', 'yaw_steering = "zero_doppler"\naxis = "+x"'),
-        r"initial_state\.law: unknown key 'axis'; expected one of: name, yaw_steering, vertical, "
-        r"phasing_axis",
+        "initial_state.law.axis",
+        r"unknown key; expected one of: name, yaw_steering, vertical, phasing_axis",
     ),
     "a law beside an attitude": (
         _replace(
             "[initial_state.law]",
             "[initial_state]\nquaternion = [1.0, 0.0, 0.0, 0.0]\n[initial_state.law]",
         ),
-        r"initial_state: give \[initial_state\.law\] alone",
+        "initial_state",
+        r"give \[initial_state\.law\] alone",
     ),
     "a slew without its acceleration": (
         _replace('max_acceleration = { value = 0.05, unit = "deg/s2" }\n', ""),
-        r"events\[0\]\.slew\.max_acceleration: missing key",
+        "events[0].slew.max_acceleration",
+        r"missing key",
     ),
     "a slew acceleration in deg/s": (
         _replace('unit = "deg/s2"', 'unit = "deg/s"'),
-        r"events\[0\]\.slew\.max_acceleration: unit 'deg / s' cannot be converted",
+        "events[0].slew.max_acceleration",
+        r"unit 'deg / s' cannot be converted",
     ),
     "a negative slew rate": (
         _replace('value = 1.0, unit = "deg/s" }', 'value = -1.0, unit = "deg/s" }'),
-        r"events\[0\]\.slew\.max_rate: must be positive",
+        "events[0].slew.max_rate",
+        r"must be positive",
     ),
     "wheels of no known case": (
         _replace('case = "spinning"', 'case = "coasting"'),
-        r"events\[1\]\.wheels\.case: expected one of locked, spinning, got 'coasting'",
+        "events[1].wheels.case",
+        r"expected one of locked, spinning, got 'coasting'",
     ),
     "a site named like a direction": (
         _replace('name = "kiruna"', 'name = "sun"'),
-        r"sites\[0\]\.name: expected a name that is not a direction's",
+        "sites[0].name",
+        r"expected a name that is not a direction's",
     ),
     "a site beyond the pole": (
         _replace("value = 67.857", "value = 97.857"),
-        r"sites\[0\]: latitude must be between -90 and 90 deg",
+        "sites[0].latitude",
+        r"must be between -90 and 90 deg, got 97\.857 deg",
     ),
 }
 
 
+def _library_error(path, monkeypatch) -> InputError | None:
+    """The error the library raises on the path check and run take, with every
+    InputError's text unreadable meanwhile: a key parsed out of a message would show."""
+    with warnings.catch_warnings(), monkeypatch.context() as patch:
+        warnings.simplefilter("ignore")
+        patch.setattr(InputError, "__str__", lambda self: "UNREAD")
+        try:
+            loaded = load_scenario(path)
+            plan_run(loaded.scenario, loaded.pointing, loaded.outputs, horizon=False)
+        except InputError as exc:
+            return exc
+    return None
+
+
 @pytest.mark.parametrize("case", sorted(REFUSED))
-def test_refused_in_one_line_by_check_and_run(case, tmp_path, capsys):
-    text, message = REFUSED[case]
+def test_refused_in_one_line_by_check_and_run(case, tmp_path, capsys, monkeypatch):
+    text, key, reason = REFUSED[case]
     path = tmp_path / "guided.toml"
     path.write_text(text)
     out = tmp_path / "out"
     for command in ("check", "run"):
         argv = [command, str(path)] + (["--out", str(out)] if command == "run" else [])
         assert main(argv) == 2, case
-        err = capsys.readouterr().err
-        assert len(err.strip().splitlines()) == 1, err
-        assert err.startswith("attitude: error: guided.toml: "), err
-        assert re.search(message, err), err
+        lines = said(capsys.readouterr().err)
+        assert len(lines) == 1, lines
+        assert lines[0].startswith(f"attitude: error: guided.toml: {key}: "), lines
+        assert re.search(reason, lines[0]), lines
     assert not out.exists()
+    error = _library_error(path, monkeypatch)
+    assert error is not None and error.key == key, (error and error.key, key)
+    assert "UNREAD" not in error.reason, error.reason
 
 
 def test_a_site_at_the_pole_is_tracked(tmp_path, capsys):

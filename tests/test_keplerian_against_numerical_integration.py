@@ -108,11 +108,11 @@ def test_eme2000_elements_are_rotated_by_the_frame_bias():
 @pytest.mark.parametrize(
     "change, message",
     [
-        (dict(eccentricity=1.0), r"eccentricity must be in \[0, 1\)"),
+        (dict(eccentricity=1.0), r"eccentricity: must be in \[0, 1\)"),
         (dict(semi_major_axis_m=6_000_000.0), r"the perigee, .* is inside the Earth"),
-        (dict(inclination=4.0), r"inclination must be between 0 and 180 deg"),
+        (dict(inclination=4.0), r"inclination: must be between 0 and 180 deg"),
         (dict(inclination=30.0 * u.s), r"inclination has unit s"),
-        (dict(frame="ITRF"), r"frame must be one of ICRF, EME2000"),
+        (dict(frame="ITRF"), r"frame: must be one of ICRF, EME2000"),
     ],
 )
 def test_bad_elements(change, message):

@@ -18,6 +18,7 @@ import time
 
 import psutil
 from montecarlo_scenarios import write_spinner
+from signal_dispositions import defaults
 
 from attitude.montecarlo.cluster import connect
 
@@ -103,6 +104,7 @@ def test_ctrl_c_closes_the_cluster_and_leaves_nothing(tmp_path):
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,  # its own process group, as a terminal's foreground job
+        preexec_fn=defaults,  # not the ignored SIGINT of a `pytest &`
     )
     lines = []
     try:
@@ -121,6 +123,44 @@ def test_ctrl_c_closes_the_cluster_and_leaves_nothing(tmp_path):
     after = [line for line in rest if "samples" not in line]  # the bar may print once more
     assert after == ["attitude: error: interrupted; nothing of this run was left behind"], rest
     assert not any("Traceback" in line for line in lines + rest)
+    deadline = time.monotonic() + 10
+    while _session(run.pid) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert _session(run.pid) == []
+    assert not out.exists()
+    assert sorted(p.name for p in user.iterdir()) == ["spinner.toml"]
+
+
+def test_ctrl_c_while_the_cluster_starts_stops_the_job(tmp_path):
+    """A Ctrl-C during the local cluster's start used to be lost (SIGINT was ignored
+    meanwhile, so that the workers would inherit it ignored) and the job ran to its
+    end: it is delivered once the cluster exists, which is closed."""
+    user = tmp_path / "user"
+    user.mkdir()
+    scenario = write_spinner(user, samples=40)
+    out = user / "results"
+    options = ["--out", str(out), "--workers", "2", "--batch-size", "2"]
+    run = subprocess.Popen(
+        [sys.executable, "-m", "attitude", "montecarlo", str(scenario), *options],
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+        preexec_fn=defaults,
+    )
+    lines = []
+    try:
+        for line in run.stderr:
+            lines.append(line)
+            if "starting a local Dask cluster" in line:
+                break
+        os.killpg(run.pid, signal.SIGINT)  # as a terminal sends it: the whole group
+        rest = run.stderr.read().splitlines()
+        assert run.wait(timeout=120) == 130, lines + rest
+    finally:
+        if run.poll() is None:
+            os.killpg(run.pid, signal.SIGKILL)
+    assert rest == ["attitude: error: interrupted; nothing of this run was left behind"], rest
+    assert not any("samples" in line for line in lines)  # no sample ran
     deadline = time.monotonic() + 10
     while _session(run.pid) and time.monotonic() < deadline:
         time.sleep(0.2)

@@ -31,7 +31,7 @@ def test_failed_samples_are_rows_with_parameters_and_error(tmp_path, capsys):
     assert (failed == (shift < -60.0)).all()  # exactly the samples that fire before the epoch
     assert table.loc[~failed, "error"].eq("").all()
     for error in table.loc[failed, "error"]:
-        assert error.startswith("spinner.toml: events[0] (angular_impulse at 2027-06-20T23:5")
+        assert error.startswith("spinner.toml: events[0].offset: the angular_impulse at 2027-06-20")
         assert error.endswith("is before the scenario epoch 2027-06-21T00:00:00.000000000 UTC")
     # Their parameters are drawn and recorded; their metrics are empty.
     assert table.loc[failed, "initial_state.attitude_error_deg"].notna().all()

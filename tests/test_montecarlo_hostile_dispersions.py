@@ -6,6 +6,7 @@ and the value, the same from `check`, `run` and `montecarlo`, before anything ru
 """
 
 import pytest
+from cli_lines import said
 from montecarlo_scenarios import SPINNER
 
 from attitude.cli.main import main
@@ -42,11 +43,11 @@ CASES = {
     "uniform_with_sigma": (
         '[dispersions.spacecraft]\nprincipal_moments = { distribution = "uniform", '
         "relative_sigma = 0.1 }",
-        "dispersions.spacecraft.principal_moments: unknown key 'relative_sigma'",
+        "dispersions.spacecraft.principal_moments.relative_sigma: unknown key; expected one of",
     ),
     "absolute_moments": (
         '[dispersions.spacecraft]\nprincipal_moments = { distribution = "normal", sigma = 5 }',
-        "dispersions.spacecraft.principal_moments: unknown key 'sigma'",
+        "dispersions.spacecraft.principal_moments.sigma: unknown key; expected one of",
     ),
     "truncation_zero": (
         '[dispersions.initial_state]\nattitude = { distribution = "truncated_normal", '
@@ -92,7 +93,10 @@ CASES = {
         '[dispersions.pointing]\ntle_epoch = { distribution = "normal", sigma = 1.0 }',
         "dispersions.pointing.tle_epoch: the scenario has no [pointing] tle",
     ),
-    "misspelt_key": ("sample = 3", "dispersions: unknown key 'sample'"),
+    "misspelt_key": (
+        "sample = 3",
+        "dispersions.sample: unknown key; expected one of: seed, samples",
+    ),
 }
 CASES["nan_sigma"] = (
     '[[dispersions.events]]\nevent = 0\ntime = { distribution = "normal", sigma = nan }',
@@ -126,7 +130,7 @@ TABLES = {
 
 def _refused(capsys, argv) -> list[str]:
     code = main(argv)
-    err = capsys.readouterr().err.splitlines()
+    err = said(capsys.readouterr().err)
     assert code == 2, err
     assert len(err) == 1, err
     return err
@@ -154,12 +158,16 @@ def test_bad_dispersions_exit_2_with_one_line_from_every_command(case, tmp_path,
 @pytest.mark.parametrize(
     ("options", "expected"),
     [
-        (["--samples", "0"], "--samples: expected 1 to 10,000,000, got 0"),
-        (["--seed", "-3"], "--seed: expected a whole number ≥ 0, got -3"),
+        (["--samples", "0"], "--samples: must be between 1 and 10,000,000, got 0"),
+        (["--seed", "-3"], "--seed: must be between 0 and 9,223,372,036,854,775,807, got -3"),
+        (
+            ["--seed", str(2**70)],
+            f"--seed: must be between 0 and 9,223,372,036,854,775,807, got {2**70}",
+        ),
         (["--workers", "0"], "spinner.toml: --workers: expected 1 to"),
         (["--batch-size", "0"], "spinner.toml: --batch-size: expected 1 to 10, got 0"),
         (["--sample", "10", "--emit-scenario", "{tmp}/e"], "spinner.toml: --sample: expected"),
-        (["--sample", "1"], "spinner.toml: --sample K and --emit-scenario DIR go together"),
+        (["--sample", "1"], "spinner.toml: --sample: K goes with --emit-scenario DIR"),
         (["--scheduler", "tcp://localhost"], "spinner.toml: --scheduler 'tcp://localhost': not a"),
         (["--scheduler", "nonsense://x:1"], "spinner.toml: --scheduler 'nonsense://x:1': not a"),
     ],
@@ -182,7 +190,7 @@ def test_a_scenario_without_dispersions_is_refused_by_montecarlo(tmp_path, capsy
     path = tmp_path / "spinner.toml"
     path.write_text(SPINNER)
     err = _refused(capsys, ["montecarlo", str(path), "--out", str(tmp_path / "o")])
-    assert err[0].startswith("attitude: error: spinner.toml: no [dispersions] table")
+    assert err[0].startswith("attitude: error: spinner.toml: dispersions: missing table: add one")
 
 
 def test_the_users_folder_is_refused_for_the_report_and_for_emitted_samples(tmp_path, capsys):
@@ -195,4 +203,21 @@ def test_the_users_folder_is_refused_for_the_report_and_for_emitted_samples(tmp_
     for options in (["--out", str(user)], ["--sample", "1", "--emit-scenario", str(user)]):
         err = _refused(capsys, ["montecarlo", str(path), "--quiet", *options])
         assert "the folder holds files that attitude did not write" in err[0], err
+        # The option that named the folder, not --out for both.
+        assert err[0].startswith(f"attitude: error: {options[-2]} {user}: "), err
     assert {p.name: p.read_bytes() for p in user.iterdir()} == before
+
+
+@pytest.mark.parametrize("seed", [-1, 2**63, 2**70])
+def test_the_seed_has_one_rule_in_the_file_and_on_the_command_line(seed, tmp_path, capsys):
+    """--seed 2**70 was accepted while the file's seed refused it."""
+    path = tmp_path / "spinner.toml"
+    path.write_text(SPINNER + GOOD.replace("seed = 7", f"seed = {seed}"))
+    from_file = _refused(capsys, ["montecarlo", str(path), "--out", str(tmp_path / "o")])
+    path.write_text(SPINNER + GOOD)
+    options = ["--out", str(tmp_path / "o"), "--seed", str(seed)]
+    from_option = _refused(capsys, ["montecarlo", str(path), *options])
+    reason = f"must be between 0 and 9,223,372,036,854,775,807, got {seed}"
+    assert from_file == [f"attitude: error: spinner.toml: dispersions.seed: {reason}"]
+    assert from_option == [f"attitude: error: --seed: {reason}"]
+    assert not (tmp_path / "o").exists()

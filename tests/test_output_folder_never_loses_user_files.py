@@ -18,6 +18,8 @@ import sys
 from pathlib import Path
 
 import pytest
+from cli_lines import said
+from signal_dispositions import defaults
 
 import attitude.outputs.folder
 import attitude.report.run
@@ -62,8 +64,8 @@ def _leftovers(folder: Path) -> list[str]:
 def _refused(capsys, argv) -> str:
     assert main(argv) == 2
     err = capsys.readouterr().err
-    assert len(err.splitlines()) == 1 and "Traceback" not in err, err
-    return err
+    assert len(said(err)) == 1 and "Traceback" not in err, err
+    return said(err)[0]
 
 
 @pytest.fixture
@@ -227,6 +229,7 @@ def _cli(*args, cwd=None, **kwargs) -> subprocess.Popen:
     """The installed `attitude` command (or `python -m attitude` where there is none)."""
     script = Path(sys.executable).parent / "attitude"
     command = [str(script)] if script.is_file() else [sys.executable, "-m", "attitude"]
+    kwargs.setdefault("preexec_fn", defaults)  # not the ignored SIGINT of a `pytest &`
     return subprocess.Popen(
         [*command, *args],
         cwd=cwd,
@@ -247,6 +250,7 @@ def test_a_full_disk_leaves_nothing(user_folder, formats):
     before = _snapshot(folder)
 
     def limit():
+        defaults()
         resource.setrlimit(resource.RLIMIT_FSIZE, (200_000, 200_000))
 
     process = _cli(

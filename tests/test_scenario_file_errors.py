@@ -43,7 +43,7 @@ def _replace(old, new):
 BAD = {
     "missing table": (
         VALID.replace('[spacecraft]\nname = "sat"\nprincipal_moments = [10.0, 20.0, 25.0]\n', ""),
-        r"bad\.toml: missing table \[spacecraft\]",
+        r"bad\.toml: spacecraft: missing table$",
     ),
     "missing key": (
         _replace('epoch = "2027-03-01T12:00:00"\n', ""),
@@ -51,7 +51,7 @@ BAD = {
     ),
     "unknown key": (
         _replace("angular_velocity =", "angualr_velocity ="),
-        r"bad\.toml: initial_state: unknown key 'angualr_velocity'; expected one of: quaternion",
+        r"bad\.toml: initial_state\.angualr_velocity: unknown key; expected one of: quaternion",
     ),
     "wrong unit": (
         _replace(
@@ -90,13 +90,13 @@ BAD = {
     ),
     "event out of span": (
         _replace("offset = 30.0", "offset = 500.0"),
-        r"bad\.toml: events\[0\] \(angular_impulse at 2027-03-01T12:08:20\.000000000 UTC\) "
-        r"is after the end of the propagation span 2027-03-01T12:01:40\.000000000 UTC",
+        r"bad\.toml: events\[0\]\.offset: the angular_impulse at 2027-03-01T12:08:20\.000000000 "
+        r"UTC is after the end of the propagation span 2027-03-01T12:01:40\.000000000 UTC",
     ),
     "event before the epoch": (
         _replace("offset = 30.0", 'epoch = "2027-03-01T11:00:00"'),
-        r"bad\.toml: events\[0\] \(angular_impulse at 2027-03-01T11:00:00\.000000000 UTC\) "
-        r"is before the scenario epoch",
+        r"bad\.toml: events\[0\]\.epoch: the angular_impulse at 2027-03-01T11:00:00\.000000000 "
+        r"UTC is before the scenario epoch",
     ),
     "bad epoch": (
         _replace('epoch = "2027-03-01T12:00:00"', 'epoch = "2027-13-45T12:00:00"'),
@@ -184,3 +184,34 @@ def test_a_failed_run_leaves_no_output_and_keeps_the_old_one(tmp_path, monkeypat
     # And into a new folder: nothing at all.
     assert main(["run", str(path), "--out", str(tmp_path / "new"), "--quiet"]) == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "valid.toml"]
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "key", "value"),
+    [
+        ("duration = 100.0", "duration = -5.0", "output.duration", -5.0),
+        ('name = "sat"', 'name = " "', "spacecraft.name", " "),
+        ("impulse = [0.0, 0.0, 1.0]", 'impulse = "1"', "events[0].impulse", "1"),
+        ('epoch = "2027-03-01T12:00:00"', 'epoch = "2027-03-01T12:00:60"', "scenario.epoch", None),
+    ],
+    ids=["duration", "name", "impulse", "epoch"],
+)
+def test_the_error_carries_its_key_file_and_value_as_data(tmp_path, old, new, key, value):
+    """The line a user reads is the data joined, ``file: key: reason``; the data is kept
+    across pickling, as Dask and the process beside a run send an error."""
+    import pickle
+
+    from attitude.files.scenario_reader import ScenarioFileError, load_scenario
+
+    path = tmp_path / "bad.toml"
+    path.write_text(_replace(old, new))
+    with pytest.raises(ScenarioFileError) as caught:
+        load_scenario(path)
+    error = caught.value
+    assert (error.file, error.key) == ("bad.toml", key)
+    if value is not None:
+        assert error.value == value
+    assert str(error) == f"bad.toml: {key}: {error.reason}"
+    again = pickle.loads(pickle.dumps(error))
+    assert type(again) is ScenarioFileError and str(again) == str(error)
+    assert (again.file, again.key, again.reason) == (error.file, error.key, error.reason)

@@ -156,7 +156,7 @@ def test_a_step_search_that_would_run_away_is_refused(monkeypatch):
     monkeypatch.setattr(torqued_solver, "_SEARCH_MAX_STEPS", 2e3)
     spin_up = ConstantTorque([0.0, 0.0, 1e4], 0.0, math.inf)
     message = (
-        r"tolerance 1e-06 rad over 100 s would need a step below [\d.e-]+ s, more than "
+        r"tolerance: 1e-06 rad over 100 s would need a step below [\d.e-]+ s, more than "
         r"2000 steps; the estimate was [\d.e+-]+ rad at [\d.e-]+ s: give a step"
     )
     with pytest.raises(InputError, match=message):

@@ -17,6 +17,7 @@ import re
 import numpy as np
 import pytest
 from astropy import units as u
+from cli_lines import said
 
 from attitude import EulerSolver, InputError
 from attitude.cli.main import main
@@ -58,7 +59,7 @@ def _refused(tmp_path, capsys, text, message):
     for argv in (["check", str(path)], ["run", str(path), "--out", str(tmp_path / "o")]):
         assert main(argv) == 2
         err = capsys.readouterr().err
-        assert len(err.splitlines()) == 1 and "Traceback" not in err, err
+        assert len(said(err)) == 1 and "Traceback" not in err, err
         assert re.search(message, err), err
     assert not (tmp_path / "o").exists()
 
@@ -167,4 +168,4 @@ def test_a_triangle_warning_is_one_line_naming_the_file_and_the_key(tmp_path, ca
         "attitude: warning: s.toml: spacecraft.principal_moments: principal moments "
         "[1.0, 2.0, 25.0] kg m² break the triangle inequality"
     )
-    assert len(err.splitlines()) == 1 and ".py" not in err
+    assert len(said(err)) == 1 and ".py" not in err

@@ -58,8 +58,10 @@ def convert_unit(value: Any, unit: Any, kind: str, name: str, to: str | None = N
         unit = u.Unit(unit)
     except (ValueError, TypeError):
         raise InputError(
-            f"{name}: unit {unit!r} cannot be converted to {shown} ({_kind_text(kind)}): "
-            "astropy does not know it"
+            f"unit {unit!r} cannot be converted to {shown} ({_kind_text(kind)}): "
+            "astropy does not know it",
+            key=name,
+            value=unit,
         ) from None
     try:
         return u.Quantity(value, unit).to_value(target)
@@ -69,7 +71,9 @@ def convert_unit(value: Any, unit: Any, kind: str, name: str, to: str | None = N
         raise InputError(f"{name} must be numeric, got {value!r}") from None
     _refuse_ambiguous(unit, kind, name)
     raise InputError(
-        f"{name}: unit {unit.to_string()!r} cannot be converted to {shown} ({_kind_text(kind)})"
+        f"unit {unit.to_string()!r} cannot be converted to {shown} ({_kind_text(kind)})",
+        key=name,
+        value=unit.to_string(),
     )
 
 
@@ -90,8 +94,10 @@ def _refuse_ambiguous(unit: Any, kind: str, name: str) -> None:
     else:
         hint = f"write it in {SI_UNITS[kind] or 'a pure number'}"
     raise InputError(
-        f"{name}: unit {u.Unit(unit).to_string()!r} is ambiguous for {_kind_text(kind)} "
-        f"(cycles or radians?): {hint}"
+        f"unit {u.Unit(unit).to_string()!r} is ambiguous for {_kind_text(kind)} "
+        f"(cycles or radians?): {hint}",
+        key=name,
+        value=u.Unit(unit).to_string(),
     )
 
 

@@ -73,14 +73,16 @@ def _quantity(text: str | None, kind: str, option: str):
     number = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
     found = re.fullmatch(rf"\s*({number}(?:\s*,\s*{number})*)\s*(\S.*)?", text)
     if not found or not found.group(2):
-        raise InputError(f'{option}: {text!r} needs a value with its unit, e.g. "1e-4 rad/s"')
+        raise InputError(
+            f'{text!r} needs a value with its unit, e.g. "1e-4 rad/s"', key=option, value=text
+        )
     try:
         values = [float(v) for v in found.group(1).split(",")]
     except ValueError:
-        raise InputError(f"{option}: {text!r}: not a number") from None
+        raise InputError(f"{text!r}: not a number", key=option, value=text) from None
     converted = [float(convert_unit(v, found.group(2).strip(), kind, option)) for v in values]
     if not all(v > 0.0 for v in converted):
-        raise InputError(f"{option}: must be positive, got {text!r}")
+        raise InputError(f"must be positive, got {text!r}", key=option, value=text)
     return converted[0] if len(converted) == 1 else converted
 
 
@@ -103,8 +105,10 @@ def _context(path: Path):
     for (offset, event), index in zip(scenario.events, indices, strict=True):
         if event.kind != "angular_impulse":
             raise InputError(
-                f"{path.name}: events[{index}]: a {event.kind} cannot be fitted through (the "
-                "fit uses known angular impulses only)"
+                f"a {event.kind} cannot be fitted through (the fit uses known angular "
+                "impulses only)",
+                file=path.name,
+                key=f"events[{index}]",
             )
         epoch = scenario.times(offset)
         impulses.append(dataclasses.replace(event, epoch=epoch))
@@ -152,8 +156,9 @@ def command(args: argparse.Namespace) -> int:
         telemetry = read_telemetry(args.telemetry, args.time_scale, args.epoch)
         if not hasattr(telemetry.times, "jd1"):
             raise InputError(
-                f"{args.telemetry.name}: the times are relative seconds (t_s with no epoch): "
-                "give --epoch, so that the fitted scenario has one"
+                "the times are relative seconds (t_s with no epoch): give --epoch, so that "
+                "the fitted scenario has one",
+                file=args.telemetry.name,
             )
         say(f"attitude fit: {args.telemetry.name}: {len(telemetry.times)} rows read; fitting")
         fit = fit_spin_state(
@@ -179,10 +184,14 @@ def command(args: argparse.Namespace) -> int:
         print(f"attitude: error: {exc}", file=sys.stderr, flush=True)
         return 2
     except InputError as exc:
-        text = str(exc)
-        name = args.telemetry.name
-        shown = text if text.startswith((name, "--", str(args.telemetry))) else f"{name}: {text}"
-        print(f"attitude: error: {' / '.join(shown.splitlines())}", file=sys.stderr, flush=True)
+        # Errors that name no file (an option, a fit's refusal) are the telemetry's.
+        located = (
+            exc
+            if exc.file or (exc.key or "").startswith("--")
+            else exc.located(file=args.telemetry.name)
+        )
+        text = " / ".join(str(located).splitlines())
+        print(f"attitude: error: {text}", file=sys.stderr, flush=True)
         return 2
     except MemoryError:
         print(f"attitude: error: {args.telemetry.name}: out of memory", file=sys.stderr)

@@ -11,7 +11,9 @@ unit).  ``montecarlo`` writes its own outputs (``docs/montecarlo.md``).
 ``check`` goes through the same checks as ``run`` up to the sampling
 (``attitude.report.plan``): what ``check`` accepts, ``run`` computes, and it states the
 size of each chosen output.  ``--out`` given to ``check`` also checks the folder and
-its free space, which is the one thing ``check`` cannot know without it.
+its disk's free space; without it, the disk of the current folder (where a relative
+``--out`` goes) is checked, and said.  Both commands say on stderr what they are doing
+from their first second, on a clock from the process's start (``--quiet``: nothing).
 
 The output folder (``attitude.outputs.folder``): ``run`` writes into a new or empty
 folder, or one it wrote before, where it replaces only its own previous outputs; it
@@ -21,7 +23,9 @@ Exit status, with one line on stderr and never a traceback:
 0 success; 2 a bad scenario file, a run that cannot fit, or an output folder that is
 not ours (the line names the file, the key and the value); 1 the outputs cannot be
 written (a full disk, a folder we may not write); 130 interrupted (Ctrl-C), 143
-terminated (SIGTERM), 129 hung up (SIGHUP), and nothing of the run is left behind;
+terminated (SIGTERM), 129 hung up (SIGHUP), 128 + N for a process of the run that
+another signal N killed, and nothing of the run is left behind (a signal the caller
+ignores, as ``nohup`` does SIGHUP, stays ignored: ``attitude.base.signals``);
 3 a bug (an exception this tool did not expect; ``ATTITUDE_TRACEBACK=1`` shows its
 traceback).  Warnings are one line each, ``attitude: warning: FILE: KEY: ...``, and so
 are notes (``attitude: note: ...``: a clamped precision, a far TLE epoch).
@@ -42,22 +46,11 @@ from pathlib import Path
 
 __all__ = ["main"]
 
-_SIGNAL_EXIT = {signal.SIGINT: 130, signal.SIGTERM: 143}
-if hasattr(signal, "SIGHUP"):
-    _SIGNAL_EXIT[signal.SIGHUP] = 129
-_SIGNAL_TEXT = {130: "interrupted", 143: "terminated", 129: "hung up"}
-
-
-class _Stopped(BaseException):
-    """A signal asked the run to stop (raised by the handler, like KeyboardInterrupt)."""
-
-    def __init__(self, number: int) -> None:
-        super().__init__(number)
-        self.number = number
-
 
 def _raise_stopped(number: int, frame) -> None:
-    raise _Stopped(number)
+    from attitude.base.signals import Stopped
+
+    raise Stopped(number)
 
 
 def _one_line(text: str) -> str:
@@ -86,7 +79,13 @@ def _parser() -> argparse.ArgumentParser:
     run.add_argument("--quiet", action="store_true", help="no progress messages")
     check = commands.add_parser("check", help="validate a scenario file and describe the run")
     check.add_argument("scenario", type=Path, help="scenario file (TOML)")
-    check.add_argument("--out", type=Path, help="also check this output folder and its free space")
+    check.add_argument(
+        "--out",
+        type=Path,
+        help="also check this output folder, and its disk's free space (default: the "
+        "current folder's disk, where a relative --out goes)",
+    )
+    check.add_argument("--quiet", action="store_true", help="no progress messages")
     for command in (run, check):
         command.add_argument(
             "--formats",
@@ -224,11 +223,15 @@ def _describe(loaded, plan, out: Path | None = None) -> str:
             f"{plan.aem.tolerance_rad:g} rad of the "
             f"{'propagated' if scenario.torques.any else 'exact'} attitude"
         )
-    if out is None:
-        lines.append("  disk        not checked: `check --out DIR` checks the free space of DIR")
-    else:
-        from attitude.outputs.budget import free_disk_bytes, size_text
+    from attitude.outputs.budget import free_disk_bytes, size_text
 
+    if out is None:
+        lines.append(
+            f"  disk        {size_text(free_disk_bytes(Path.cwd()))} free on the current "
+            "folder's disk, where `run --out DIR` writes a relative DIR: enough "
+            "(`check --out DIR` checks another)"
+        )
+    else:
         lines.append(f"  disk        {size_text(free_disk_bytes(out))} free for {out}: enough")
     lines += [f"  note        {note}" for note in plan.notes]
     return "\n".join(lines)
@@ -255,6 +258,17 @@ def _run(args, state: dict) -> int:
 
 
 def _checked_run(args, state: dict) -> int:
+    # What is being done, from the first second (before numpy and astropy load), on a
+    # clock that counts from the process's start: `done` states the whole wait.
+    from attitude.base.progress import Progress, process_started_at
+
+    progress = Progress(
+        None if args.quiet else lambda line: print(line, file=sys.stderr, flush=True),
+        # The command line's clock starts with its process; main([...]) called from a
+        # Python session that has run for hours starts its own.
+        start=process_started_at() if state.get("argv") is None else None,
+    )
+    progress(f"reading {args.scenario}")
     from attitude.base.errors import InputError
     from attitude.files.scenario_reader import ScenarioFileError, load_scenario
     from attitude.outputs.budget import check_fits
@@ -275,10 +289,16 @@ def _checked_run(args, state: dict) -> int:
         if args.command == "montecarlo":
             from attitude.cli.montecarlo import command
 
-            return command(args, loaded)
+            return command(args, loaded, progress)
         outputs = _outputs(args, loaded.outputs)
         # A run computes the validity horizon beside its outputs (attitude.report.run).
-        plan = plan_run(loaded.scenario, loaded.pointing, outputs, horizon=args.command == "check")
+        plan = plan_run(
+            loaded.scenario,
+            loaded.pointing,
+            outputs,
+            horizon=args.command == "check",
+            progress=progress,
+        )
         montecarlo = None
         if "dispersions" in loaded.document:  # checked by run too: one reading of the file
             from attitude.montecarlo.plan import plan_montecarlo
@@ -288,6 +308,8 @@ def _checked_run(args, state: dict) -> int:
             if args.out is not None:
                 check_fits(plan.budget, args.out)
                 claim(args.out, OUTPUT_NAMES, dry_run=True)
+            else:  # the disk a run writes to without a path: the current folder's
+                check_fits(plan.budget, Path.cwd(), shown=f"the current folder ({Path.cwd()})")
             print(_describe(loaded, plan, args.out), flush=True)
             if montecarlo is not None:
                 print("\n".join(montecarlo.describe()), flush=True)
@@ -297,9 +319,8 @@ def _checked_run(args, state: dict) -> int:
             print(f"attitude: note: {loaded.path.name}: {note}", file=sys.stderr, flush=True)
         # The horizon starts beside the run before the writers and plots are imported.
         with horizon_beside(plan) or contextlib.nullcontext() as horizon:
-            from attitude.report.run import Progress, write_report
+            from attitude.report.run import write_report
 
-            progress = Progress(None if args.quiet else lambda line: print(line, file=sys.stderr))
             write_report(
                 loaded.scenario,
                 args.out,
@@ -313,9 +334,8 @@ def _checked_run(args, state: dict) -> int:
     except (ScenarioFileError, OutputFolderError) as exc:
         _error(str(exc))
         return 2
-    except InputError as exc:
-        name = state.get("file") or args.scenario.name
-        _error(f"{name}: {exc}")
+    except InputError as exc:  # from the file's values: named after the file, unless it names one
+        _error(str(exc if exc.file else exc.located(file=state.get("file") or args.scenario.name)))
         return 2
     except MemoryError:
         _error(f"{args.scenario.name}: out of memory: use a longer output.step or a shorter span")
@@ -329,23 +349,30 @@ def _checked_run(args, state: dict) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
+    try:  # a few small modules, no numpy: the handlers go in right after
+        from attitude.base.signals import STOPPING, Stopped, caller_ignores
+    except KeyboardInterrupt:
+        _error("interrupted; nothing of this run was left behind")
+        return 130
     state: dict = {}
     previous = {}
     in_main_thread = threading.current_thread() is threading.main_thread()
     try:
         if in_main_thread:
-            for number in _SIGNAL_EXIT:
-                if number != signal.SIGINT:
+            # SIGINT is Python's KeyboardInterrupt; a signal the caller ignores
+            # (nohup's SIGHUP, a background job's SIGINT) stays ignored.
+            for number in STOPPING:
+                if number != signal.SIGINT and not caller_ignores(number):
                     previous[number] = signal.signal(number, _raise_stopped)
         args = _parser().parse_args(argv)
+        state["argv"] = argv
         return _run(args, state)
     except KeyboardInterrupt:
         _error("interrupted; nothing of this run was left behind")
         return 130
-    except _Stopped as stop:
-        code = _SIGNAL_EXIT[stop.number]
-        _error(f"{_SIGNAL_TEXT[code]}; nothing of this run was left behind")
-        return code
+    except Stopped as stop:
+        _error(f"{stop.text}; nothing of this run was left behind")
+        return stop.exit_status
     except BrokenPipeError:  # `attitude check x | head -1`
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())

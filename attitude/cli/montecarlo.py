@@ -8,33 +8,43 @@ import time
 from pathlib import Path
 
 from attitude.base.errors import InputError
+from attitude.base.progress import Progress
 from attitude.files.scenario_reader import ScenarioFile
+from attitude.montecarlo.cluster import check_where
 from attitude.montecarlo.plan import emit_samples, plan_montecarlo
 from attitude.montecarlo.report import check_folder, write_report
 from attitude.montecarlo.simulation import simulate
-from attitude.report.run import Progress
 
 __all__ = ["ProgressBar", "command"]
 
 
-def command(args, loaded: ScenarioFile) -> int:
+def command(args, loaded: ScenarioFile, stage: Progress | None = None) -> int:
     """``attitude montecarlo`` (the command line's options in ``args``): run the job into
-    ``--out``, or write samples ``--sample`` into ``--emit-scenario``."""
+    ``--out``, or write samples ``--sample`` into ``--emit-scenario``; ``stage``: the
+    command's progress messages (none when None)."""
+    emit = args.emit_scenario is not None or args.sample is not None
+    stage = stage or Progress()
+    if not emit:  # where the job runs, checked first: an address tried takes seconds
+        if args.scheduler is not None:
+            stage(f"trying the Dask scheduler at {args.scheduler}")
+        check_where(args.scheduler, args.workers)
+    stage("checking the nominal scenario and the [dispersions] table")
     mc = plan_montecarlo(loaded, None, args.samples, args.seed)
-    if args.emit_scenario is not None or args.sample is not None:
+    if emit:
         if args.emit_scenario is None or args.sample is None:
-            raise InputError("--sample K and --emit-scenario DIR go together")
+            raise InputError(
+                "K goes with --emit-scenario DIR: give both or neither", key="--sample"
+            )
         if args.out is not None:
-            raise InputError("--out: runs the job; --emit-scenario writes samples instead")
+            raise InputError("runs the job; --emit-scenario writes samples instead", key="--out")
         for path in emit_samples(mc, args.sample, args.emit_scenario):
             print(path, flush=True)
         return 0
     if args.out is None:
-        raise InputError("--out: the output folder is required (or --emit-scenario)")
+        raise InputError("the output folder is required (or --emit-scenario)", key="--out")
     check_folder(mc, args.out)
-    stage = Progress(None if args.quiet else lambda line: print(line, file=sys.stderr))
     bar = None if args.quiet else ProgressBar(sys.stderr)
-    result = simulate(mc, args.scheduler, args.workers, args.batch_size, bar, stage)
+    result = simulate(mc, args.scheduler, args.workers, args.batch_size, bar, stage, probed=True)
     failed = result.failed
     if len(failed) == mc.samples:
         first = failed.iloc[0]

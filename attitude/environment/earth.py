@@ -21,6 +21,8 @@ Angles, from a spacecraft at ``position_m`` (GCRS, from the Earth's centre):
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -29,7 +31,9 @@ from attitude.base.vectors import angle_between
 __all__ = [
     "EARTH_EQUATORIAL_RADIUS_M",
     "GM_EARTH_M3_S2",
+    "HILL_RADIUS_M",
     "J2_EARTH",
+    "MAX_ENCOUNTER_SPEED_M_S",
     "angular_radius",
     "limb_angle",
     "nadir_angle",
@@ -43,6 +47,21 @@ EARTH_EQUATORIAL_RADIUS_M = 6_378_137.0
 # al., J. Geophys. Res. 117, B04406, 2012, doi:10.1029/2011JB008916).
 GM_EARTH_M3_S2 = 3.986004418e14
 J2_EARTH = 1.0826261738522227e-3
+
+# The Sun's gravitational parameter (IAU 2015 Resolution B3, nominal GM☉) and the
+# astronomical unit (IAU 2012 Resolution B2).
+_GM_SUN_M3_S2 = 1.3271244e20
+_AU_M = 1.495978707e11
+# The Earth's Hill radius, a (m/3M)^(1/3) (Murray & Dermott, *Solar System Dynamics*,
+# 1999, eq. 3.75): about 1.5 million km.  Beyond it the Sun's pull, not the Earth's,
+# holds a body: no orbit about the Earth reaches there, so an orbit source whose
+# apogee or states lie beyond it is refused (a semi-major axis of 1e30 m is a typo).
+HILL_RADIUS_M = _AU_M * (GM_EARTH_M3_S2 / (3.0 * _GM_SUN_M3_S2)) ** (1.0 / 3.0)
+# The fastest a body that circles the Sun passes the Earth, far from it: the Earth's
+# orbital speed plus the Sun's escape speed at 1 au, √(GM☉/au) (1 + √2), 71.9 km/s.
+# A state of an orbit file faster than this plus the escape speed where it is (the
+# Earth's pull adds that much, √(v∞² + 2GM/r)) is not a body near the Earth.
+MAX_ENCOUNTER_SPEED_M_S = math.sqrt(_GM_SUN_M3_S2 / _AU_M) * (1.0 + math.sqrt(2.0))
 
 
 def angular_radius(position_m: ArrayLike, height_m: float = 0.0) -> NDArray[np.float64]:

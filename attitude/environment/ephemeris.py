@@ -147,8 +147,10 @@ def skyfield_times(times: Any, name: str = "times"):
             shown = f"{epoch.isot} {epoch.scale.upper()}"
         where = f" (index {index}, {int(outside.sum())} of {outside.size} outside)"
         raise EphemerisRangeError(
-            f"{name}: epoch {shown} is outside the span of the DE421 ephemeris, "
-            f"{_span_text()} (TDB){where if times.ndim else ''}"
+            f"epoch {shown} is outside the span of the DE421 ephemeris, "
+            f"{_span_text()} (TDB){where if times.ndim else ''}",
+            key=name,
+            value=shown,
         )
     return t, times.shape
 

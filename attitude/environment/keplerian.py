@@ -48,7 +48,12 @@ from numpy.typing import NDArray
 from attitude.base.errors import InputError
 from attitude.base.jets import Jet, sin_cos
 from attitude.base.quantities import as_si_scalar
-from attitude.environment.earth import EARTH_EQUATORIAL_RADIUS_M, GM_EARTH_M3_S2, J2_EARTH
+from attitude.environment.earth import (
+    EARTH_EQUATORIAL_RADIUS_M,
+    GM_EARTH_M3_S2,
+    HILL_RADIUS_M,
+    J2_EARTH,
+)
 from attitude.environment.frames import eme2000_to_icrf
 from attitude.environment.orbit import Orbit, tt_jd
 from attitude.environment.timescales import SECONDS_PER_DAY, as_time, offline_time
@@ -72,6 +77,22 @@ def solve_kepler(mean_anomaly: NDArray[np.float64], e: float) -> NDArray[np.floa
         if np.all(np.abs(step) <= 4e-16 * (1.0 + np.abs(E))):
             break
     return E
+
+
+def _within_a_turn(angle_rad: float, key: str) -> float:
+    """``angle_rad`` if it lies within one turn either way, else :class:`InputError`.
+
+    An orientation angle of 1e20° is no orientation: floats that large are 16384°
+    apart, so nothing of the angle the user meant is left; within ±360° an angle is
+    held to 1e-15 rad, and every orientation can be written."""
+    if not abs(angle_rad) <= 2.0 * math.pi * (1.0 + 1e-15):
+        raise InputError(
+            f"{math.degrees(angle_rad):.6g} deg is more than a turn: give the angle "
+            "within -360 to 360 deg",
+            key=key,
+            value=math.degrees(angle_rad),
+        )
+    return angle_rad
 
 
 class KeplerianOrbit(Orbit):
@@ -103,36 +124,60 @@ class KeplerianOrbit(Orbit):
     ) -> None:
         self.epoch = as_time(epoch, name="epoch")
         if not self.epoch.isscalar:
-            raise InputError("epoch: one epoch, got an array")
+            raise InputError("one epoch, got an array", key="epoch")
         self.a = as_si_scalar(semi_major_axis_m, "length", "semi_major_axis")
         self.e = as_si_scalar(eccentricity, "dimensionless", "eccentricity")
         if not 0.0 <= self.e < 1.0:
-            raise InputError(f"eccentricity must be in [0, 1) (a closed orbit), got {self.e!r}")
+            raise InputError(
+                f"must be in [0, 1) (a closed orbit), got {self.e!r}",
+                key="eccentricity",
+                value=self.e,
+            )
         perigee = self.a * (1.0 - self.e)
         if not perigee > EARTH_EQUATORIAL_RADIUS_M:
             raise InputError(
-                f"semi_major_axis: the perigee, a (1 - e) = {perigee / 1e3:.1f} km from the "
-                f"Earth's centre, is inside the Earth ({EARTH_EQUATORIAL_RADIUS_M / 1e3:g} km)"
+                f"the perigee, a (1 - e) = {perigee / 1e3:.1f} km from the "
+                f"Earth's centre, is inside the Earth ({EARTH_EQUATORIAL_RADIUS_M / 1e3:g} km)",
+                key="semi_major_axis",
+                value=self.a,
+            )
+        apogee = self.a * (1.0 + self.e)
+        if not apogee < HILL_RADIUS_M:
+            raise InputError(
+                f"the apogee, a (1 + e) = {apogee / 1e3:.4g} km from the Earth's centre, is "
+                f"beyond the Earth's Hill sphere ({HILL_RADIUS_M / 1e3:.3g} km), where the "
+                "Sun's pull dominates: no orbit about the Earth reaches there",
+                key="semi_major_axis",
+                value=self.a,
             )
         self.i = as_si_scalar(inclination, "angle", "inclination")
         if not 0.0 <= self.i <= math.pi:
             raise InputError(
-                f"inclination must be between 0 and 180 deg, got {math.degrees(self.i):g} deg"
+                f"must be between 0 and 180 deg, got {math.degrees(self.i):g} deg",
+                key="inclination",
+                value=math.degrees(self.i),
             )
-        self.raan = as_si_scalar(raan, "angle", "raan")
-        self.argp = as_si_scalar(argument_of_perigee, "angle", "argument_of_perigee")
+        self.raan = _within_a_turn(as_si_scalar(raan, "angle", "raan"), "raan")
+        self.argp = _within_a_turn(
+            as_si_scalar(argument_of_perigee, "angle", "argument_of_perigee"),
+            "argument_of_perigee",
+        )
         if (mean_anomaly is None) == (true_anomaly is None):
             raise InputError("give exactly one of mean_anomaly and true_anomaly")
         if mean_anomaly is not None:
-            self.m0 = as_si_scalar(mean_anomaly, "angle", "mean_anomaly")
+            self.m0 = _within_a_turn(
+                as_si_scalar(mean_anomaly, "angle", "mean_anomaly"), "mean_anomaly"
+            )
         else:
-            ν = as_si_scalar(true_anomaly, "angle", "true_anomaly")
+            ν = _within_a_turn(as_si_scalar(true_anomaly, "angle", "true_anomaly"), "true_anomaly")
             E = 2.0 * math.atan2(
                 math.sqrt(1.0 - self.e) * math.sin(ν / 2), math.sqrt(1.0 + self.e) * math.cos(ν / 2)
             )
             self.m0 = E - self.e * math.sin(E)
         if frame not in FRAMES:
-            raise InputError(f"frame must be one of {', '.join(FRAMES)}, got {frame!r}")
+            raise InputError(
+                f"must be one of {', '.join(FRAMES)}, got {frame!r}", key="frame", value=frame
+            )
         self.frame = frame
         self.j2 = bool(j2)
         self.name = name

@@ -31,6 +31,7 @@ from numpy.typing import NDArray
 
 from attitude.base.errors import InputError
 from attitude.environment.ccsds import MAX_DEGREE, interpolate, parse_epochs, read_message, scale_of
+from attitude.environment.earth import GM_EARTH_M3_S2, HILL_RADIUS_M, MAX_ENCOUNTER_SPEED_M_S
 from attitude.environment.frames import eme2000_to_icrf
 from attitude.environment.orbit import Orbit, tt_jd
 from attitude.environment.timescales import SECONDS_PER_DAY, offline_time
@@ -113,6 +114,7 @@ class OemOrbit(Orbit):
             if not np.all(np.isfinite(states[:, :6])):
                 row = int(np.argwhere(~np.isfinite(states[:, :6]))[0, 0])
                 raise InputError(f"{where}: state {row} is not finite: {states[row, :6].tolist()}")
+            _check_near_the_earth(states, where)
             jd1, jd2 = tt_jd(epochs)
             if self._day is None:
                 self._day = float(np.floor(jd1[0] + jd2[0]))
@@ -181,7 +183,9 @@ class OemOrbit(Orbit):
             with offline_time():
                 when = Time(self._day, bad / SECONDS_PER_DAY, format="jd", scale="tt").utc.isot
             raise InputError(
-                f"{self.path.name}: {when} UTC is outside the file's segments ({self._span_text()})"
+                f"{self.path.name}: {when} UTC is outside the file's segments "
+                f"({self._span_text()})",
+                key=self.key,
             )
         position_m = np.empty((seconds.size, 3))
         velocity_m_s = np.empty((seconds.size, 3))
@@ -214,8 +218,9 @@ class OemOrbit(Orbit):
         covered = self._segment_of(ends) >= 0
         if not np.all(covered):
             raise InputError(
-                f"{self.key}: {self.path.name} covers {self._span_text()}, not the span's "
-                f"{'start' if not covered[0] else 'end'}"
+                f"{self.path.name} covers {self._span_text()}, not the span's "
+                f"{'start' if not covered[0] else 'end'}",
+                key=self.key,
             )
         gaps = [
             (a.stop_s, b.start_s)
@@ -224,10 +229,37 @@ class OemOrbit(Orbit):
         ]
         if gaps:
             raise InputError(
-                f"{self.key}: {self.path.name} has a gap between segments inside the span "
-                f"({gaps[0][1] - gaps[0][0]:.6g} s)"
+                f"{self.path.name} has a gap between segments inside the span "
+                f"({gaps[0][1] - gaps[0][0]:.6g} s)",
+                key=self.key,
             )
         return [f"{self.key}: {note}" for note in self.notes]
+
+
+def _check_near_the_earth(states: NDArray[np.float64], where: str) -> None:
+    """Refuse states (km, km/s) that no body near the Earth has: beyond the Earth's Hill
+    sphere, or faster than the fastest body circling the Sun passes the Earth plus the
+    speed the Earth's pull adds where the state is (:mod:`attitude.environment.earth`)."""
+    radius_m = np.linalg.norm(states[:, :3], axis=1) * 1e3
+    speed_m_s = np.linalg.norm(states[:, 3:6], axis=1) * 1e3
+    far = np.flatnonzero(~(radius_m < HILL_RADIUS_M))
+    if far.size:
+        row = int(far[0])
+        raise InputError(
+            f"{where}: state {row} is {radius_m[row] / 1e3:.4g} km from the Earth's centre, "
+            f"beyond the Earth's Hill sphere ({HILL_RADIUS_M / 1e3:.3g} km), where the Sun's "
+            "pull dominates: not an orbit about the Earth (positions are in km)"
+        )
+    with np.errstate(divide="ignore"):
+        limit = np.sqrt(MAX_ENCOUNTER_SPEED_M_S**2 + 2.0 * GM_EARTH_M3_S2 / radius_m)
+    fast = np.flatnonzero(~(speed_m_s <= limit))
+    if fast.size:
+        row = int(fast[0])
+        raise InputError(
+            f"{where}: state {row} moves at {speed_m_s[row] / 1e3:.4g} km/s, faster than any "
+            f"body near the Earth ({limit[row] / 1e3:.3g} km/s at "
+            f"{radius_m[row] / 1e3:.4g} km from its centre; velocities are in km/s)"
+        )
 
 
 def _check_data_lines(text: str, file: str) -> None:

@@ -47,6 +47,7 @@ from numpy.typing import NDArray
 
 from attitude.base.errors import InputError
 from attitude.base.quantities import as_si_scalar
+from attitude.environment.earth import HILL_RADIUS_M
 from attitude.environment.ephemeris import timescale
 from attitude.environment.timescales import SECONDS_PER_DAY, as_time, offline_time
 
@@ -149,12 +150,20 @@ class TleOrbit(Orbit):
         self._rotation_nodes: dict[float, NDArray[np.float64]] = {}
         self.name = name
         self.satellite = EarthSatellite(line1, line2, name, timescale())
-        error = self.satellite.model.error
-        if error:
-            model = self.satellite.model
+        model = self.satellite.model
+        if model.error:
             raise InputError(
-                f"line2: SGP4 rejects the elements: {SGP4_ERRORS[error]} (eccentricity "
+                f"line2: SGP4 rejects the elements: {SGP4_ERRORS[model.error]} (eccentricity "
                 f"{model.ecco}, mean motion {model.no_kozai * 1440 / (2 * np.pi)} rev/day)"
+            )
+        # SGP4's semi-major axis, in Earth radii (of its own WGS 72 Earth).
+        apogee_m = model.a * (1.0 + model.ecco) * model.radiusearthkm * 1e3
+        if not apogee_m < HILL_RADIUS_M:
+            raise InputError(
+                f"line2: mean motion {line2[52:63].strip()} rev/day and eccentricity "
+                f"0.{line2[26:33]} put the apogee {apogee_m / 1e3:.4g} km from the Earth's "
+                f"centre, beyond the Earth's Hill sphere ({HILL_RADIUS_M / 1e3:.3g} km), "
+                "where the Sun's pull dominates: no orbit about the Earth reaches there"
             )
 
     def __reduce__(self):
@@ -284,10 +293,11 @@ class TleOrbit(Orbit):
             epoch = self.epoch.isot
         if days > TLE_REFUSED_AFTER_DAYS:
             raise InputError(
-                f"{self.key}: the span reaches {days:.0f} days from the TLE's epoch "
+                f"the span reaches {days:.0f} days from the TLE's epoch "
                 f"{epoch} UTC: SGP4 elements describe an orbit for days to weeks "
                 f"around their epoch (this tool refuses beyond {TLE_REFUSED_AFTER_DAYS:g} "
-                "days): use elements from near the span"
+                "days): use elements from near the span",
+                key=self.key,
             )
         notes = []
         if days > TLE_NOTED_AFTER_DAYS:
@@ -298,7 +308,7 @@ class TleOrbit(Orbit):
             )
         failure = self.sgp4_failure(start, stop)
         if failure:
-            raise InputError(f"{self.key}: {failure}")
+            raise InputError(failure, key=self.key)
         return notes
 
     def sgp4_failure(self, start: Any, stop: Any, step_s: float = 60.0) -> str | None:

@@ -87,7 +87,9 @@ def as_time(value: Any, scale: str | None = None, name: str = "epoch"):
         return value
     scale = "utc" if scale is None else str(scale).lower()
     if scale not in SCALES:
-        raise InputError(f"{name}: time scale must be one of {', '.join(SCALES)}, got {scale!r}")
+        raise InputError(
+            f"time scale must be one of {', '.join(SCALES)}, got {scale!r}", key=name, value=scale
+        )
     import erfa
 
     try:
@@ -98,11 +100,15 @@ def as_time(value: Any, scale: str | None = None, name: str = "epoch"):
             return Time(value, scale=scale, precision=9)
     except erfa.ErfaWarning:
         raise InputError(
-            f"{name}: {value!r} names a second that does not exist: :60 is a leap second, "
-            f"which only UTC has, and only at the end of the days that IERS announced"
+            f"{value!r} names a second that does not exist: :60 is a leap second, "
+            f"which only UTC has, and only at the end of the days that IERS announced",
+            key=name,
+            value=value,
         ) from None
     except (ValueError, TypeError, OverflowError) as exc:
-        raise InputError(f"{name}: not an ISO 8601 epoch: {value!r}{_reason(str(exc))}") from None
+        raise InputError(
+            f"not an ISO 8601 epoch: {value!r}{_reason(str(exc))}", key=name, value=value
+        ) from None
 
 
 def _reason(text: str) -> str:
@@ -133,7 +139,9 @@ def check_year_range(times, name: str) -> None:
         except (ValueError, OverflowError):
             shown = f"Julian date {float(jd[outside][0]):.1f}"
         raise InputError(
-            f"{name}: epochs must lie in the years 0001-9999, got {shown} {times.scale.upper()}"
+            f"epochs must lie in the years 0001-9999, got {shown} {times.scale.upper()}",
+            key=name,
+            value=f"{shown} {times.scale.upper()}",
         )
 
 

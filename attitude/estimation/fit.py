@@ -330,8 +330,9 @@ def fit_spin_state(
         fastest = float(np.max(np.abs(telemetry.gyro.values)))
         if fastest > MAX_RATE:
             raise InputError(
-                f"{source}: angular_velocity reaches {fastest:.3g} rad/s: beyond what a fit "
-                f"can handle (up to {MAX_RATE:g} rad/s: Euler's equations square the rates)"
+                f"angular_velocity reaches {fastest:.3g} rad/s: beyond what a fit "
+                f"can handle (up to {MAX_RATE:g} rad/s: Euler's equations square the rates)",
+                file=source,
             )
     notes = list(telemetry.notes)
     data, noise = _data(telemetry, gyro_sigma, attitude_sigma)
@@ -339,7 +340,7 @@ def fit_spin_state(
     impulse_list = _impulses(impulses, telemetry)
     has_burns = torques is not None and bool(getattr(torques, "burns", ()))
     if gyro_bias and telemetry.gyro is None:
-        raise InputError(f"{source}: gyro_bias needs gyro rates")
+        raise InputError("gyro_bias needs gyro rates", file=source)
     layout = Layout(
         attitude=telemetry.attitude is not None,
         scale=bool(impulse_list) or has_burns,
@@ -348,15 +349,17 @@ def fit_spin_state(
     )
     if any(i.frame != "body" for i in impulse_list) and not layout.attitude:
         raise InputError(
-            f"{source}: an impulse in inertial axes needs the attitude: give quaternions, or "
-            "the impulse in body axes"
+            "an impulse in inertial axes needs the attitude: give quaternions, or "
+            "the impulse in body axes",
+            file=source,
         )
     if torques is not None and not layout.attitude:
         inertial_burns = any(b.frame != "body" for b in getattr(torques, "burns", ()))
         if getattr(torques, "gravity_gradient", None) is not None or inertial_burns:
             raise InputError(
-                f"{source}: a fit under gravity gradient (or an inertial burn) needs attitude "
-                "fixes: the torque depends on the attitude, which rates alone barely show"
+                "a fit under gravity gradient (or an inertial burn) needs attitude "
+                "fixes: the torque depends on the attitude, which rates alone barely show",
+                file=source,
             )
     model = _model(layout, impulse_list, torques, telemetry, orbit)
     starts, guess_text = _starts(model, telemetry, guess, principal_axes, data)

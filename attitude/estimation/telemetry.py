@@ -79,9 +79,9 @@ def _times(times: Any, source: str) -> tuple[NDArray[np.float64], Any]:
 
     if hasattr(times, "jd1") and hasattr(times, "scale"):  # astropy Time
         if times.ndim != 1:
-            raise InputError(f"{source}: times must be a 1-D array, got shape {times.shape}")
+            raise InputError(f"times must be a 1-D array, got shape {times.shape}", file=source)
         if len(times) == 0:
-            raise InputError(f"{source}: no samples")
+            raise InputError("no samples", file=source)
         check_year_range(times, f"{source}: times")
         seconds = tt_seconds(times, times[0])
         first = int(np.argmin(seconds))
@@ -89,9 +89,9 @@ def _times(times: Any, source: str) -> tuple[NDArray[np.float64], Any]:
         return seconds - seconds[first], epoch
     seconds = as_si_array(times, "time", f"{source}: times")
     if seconds.ndim != 1:
-        raise InputError(f"{source}: times must be a 1-D array, got shape {seconds.shape}")
+        raise InputError(f"times must be a 1-D array, got shape {seconds.shape}", file=source)
     if seconds.size == 0:
-        raise InputError(f"{source}: no samples")
+        raise InputError("no samples", file=source)
     return np.array(seconds, dtype=np.float64), None
 
 
@@ -103,19 +103,23 @@ def _readings(
     array = as_si_array(values, kind, f"{source}: {name}", allow_nonfinite=True)
     if array.ndim != 2 or array.shape != (count, width):
         raise InputError(
-            f"{source}: {name} must have shape ({count}, {width}) to match the times, "
-            f"got {array.shape}"
+            f"{name} must have shape ({count}, {width}) to match the times, got {array.shape}",
+            file=source,
         )
     missing = np.isnan(array)
     present = ~missing.any(axis=1)
     partial = missing.any(axis=1) & ~missing.all(axis=1)
     if np.any(partial):
         row = int(np.flatnonzero(partial)[0])
-        raise InputError(f"{source}: row {row}: {name} {array[row].tolist()} is partly missing")
+        raise InputError(
+            f"{name} {array[row].tolist()} is partly missing", file=source, key=f"row {row}"
+        )
     infinite = present & ~np.isfinite(array).all(axis=1)
     if np.any(infinite):
         row = int(np.flatnonzero(infinite)[0])
-        raise InputError(f"{source}: row {row}: {name} {array[row].tolist()} is not finite")
+        raise InputError(
+            f"{name} {array[row].tolist()} is not finite", file=source, key=f"row {row}"
+        )
     return array, present
 
 
@@ -140,9 +144,10 @@ def _sensor(
         if not np.all(equal):
             k = int(same[~equal][0])
             raise InputError(
-                f"{source}: rows {int(order[k])} and {int(order[k + 1])} give {name} at the same "
+                f"rows {int(order[k])} and {int(order[k + 1])} give {name} at the same "
                 f"time ({float(ts[k])!r} s) with different values, {vs[k].tolist()} and "
-                f"{vs[k + 1].tolist()}: a stuck clock? Remove one of them"
+                f"{vs[k + 1].tolist()}: a stuck clock? Remove one of them",
+                file=source,
             )
         keep = np.ones(ts.size, dtype=bool)
         keep[same + 1] = False
@@ -189,11 +194,11 @@ def prepare_telemetry(
     (w, x, y, z).  Rows of NaN are missing readings of that kind.
     """
     if angular_velocity is None and quaternions is None:
-        raise InputError(f"{source}: give angular_velocity, quaternions or both")
+        raise InputError("give angular_velocity, quaternions or both", file=source)
     t, epoch = _times(times, source)
     if not np.all(np.isfinite(t)):
         row = int(np.flatnonzero(~np.isfinite(t))[0])
-        raise InputError(f"{source}: row {row}: time {t[row]!r} is not finite")
+        raise InputError(f"time {t[row]!r} is not finite", file=source, key=f"row {row}")
     notes: list[str] = []
     if np.any(np.diff(t) < 0.0):
         notes.append(f"rows not in time order ({int(np.sum(np.diff(t) < 0.0))} steps back): sorted")
@@ -210,13 +215,15 @@ def prepare_telemetry(
         if np.any(bad):
             row = int(np.flatnonzero(bad)[0])
             raise InputError(
-                f"{source}: row {row}: quaternion {q[row].tolist()} has norm {norm[row]:.9g}, "
-                "not 1 (body -> ICRF, scalar first (w, x, y, z))"
+                f"quaternion {q[row].tolist()} has norm {norm[row]:.9g}, "
+                "not 1 (body -> ICRF, scalar first (w, x, y, z))",
+                file=source,
+                key=f"row {row}",
             )
         q = np.where(present[:, None], q / norm[:, None], q)
         attitude = _sensor(t, q, present, "quaternions", source, notes)
     if gyro is None and attitude is None:
-        raise InputError(f"{source}: every reading is missing")
+        raise InputError("every reading is missing", file=source)
     telemetry = Telemetry(gyro, attitude, epoch, source, notes)
     for sensor, name in ((gyro, "angular_velocity"), (attitude, "quaternions")):
         if sensor is not None and len(sensor) > 2:

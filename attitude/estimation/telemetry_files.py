@@ -77,26 +77,24 @@ def read_telemetry(
     name = path.name
     try:
         if not path.is_file():
-            raise InputError(
-                f"{path}: no such file" if not path.exists() else f"{path}: not a file"
-            )
+            raise InputError("no such file" if not path.exists() else "not a file", file=str(path))
         with open(path, "rb") as stream:
             head = stream.read(1 << 16)
     except OSError as exc:
-        raise InputError(f"{path}: cannot read: {exc.strerror or exc}") from None
+        raise InputError(f"cannot read: {exc.strerror or exc}", file=str(path)) from None
     if head.startswith(b"PAR1"):
         return _parquet(path, time_scale, epoch)
     if head.lstrip().startswith(b"CCSDS_AEM_VERS"):
         return _aem(path)
     if b"\x00" in head:
-        raise InputError(f"{name}: a binary file, not telemetry (CSV, Parquet or CCSDS AEM)")
+        raise InputError("a binary file, not telemetry (CSV, Parquet or CCSDS AEM)", file=name)
     try:
         head.decode("utf-8")
     except UnicodeDecodeError as exc:
         if exc.start < len(head) - 4:  # not just a character cut by the 64 KiB window
             raise InputError(
-                f"{name}: not UTF-8 text (byte {exc.start}): not telemetry (CSV, Parquet or "
-                "CCSDS AEM)"
+                f"not UTF-8 text (byte {exc.start}): not telemetry (CSV, Parquet or CCSDS AEM)",
+                file=name,
             ) from None
     return _csv(path, head, time_scale, epoch)
 
@@ -126,7 +124,7 @@ def _columns(names: list[str], file: str) -> dict[str, Any]:
         if any(present):
             if not all(present):
                 missing = columns[present.index(False)]
-                raise InputError(f"{file}: column {missing} is missing (the rates need x, y, z)")
+                raise InputError(f"column {missing} is missing (the rates need x, y, z)", file=file)
             found["rates"] = [lower[c] for c in columns]
             found["rate_unit"] = unit
             break
@@ -137,19 +135,21 @@ def _columns(names: list[str], file: str) -> dict[str, Any]:
             if not all(present):
                 missing = columns[present.index(False)]
                 raise InputError(
-                    f"{file}: column {missing} is missing (the quaternion needs w, x, y, z)"
+                    f"column {missing} is missing (the quaternion needs w, x, y, z)", file=file
                 )
             found["q"] = ([lower[c] for c in columns], inverse)
             break
     shown = ", ".join(names[:12]) + (", ..." if len(names) > 12 else "")
     if found["time"] is None:
         raise InputError(
-            f"{file}: no time column (time_utc, time_tt, ..., time, epoch or t_s); columns: {shown}"
+            f"no time column (time_utc, time_tt, ..., time, epoch or t_s); columns: {shown}",
+            file=file,
         )
     if found["rates"] is None and found["q"] is None:
         raise InputError(
-            f"{file}: no rate columns (omega_body_x_rad_s, ...) and no quaternion columns "
-            f"(q_body_to_icrf_w, ...); columns: {shown}"
+            f"no rate columns (omega_body_x_rad_s, ...) and no quaternion columns "
+            f"(q_body_to_icrf_w, ...); columns: {shown}",
+            file=file,
         )
     return found
 
@@ -171,7 +171,7 @@ def _numbers(table, column: str, file: str) -> NDArray[np.float64]:
                 float(text)
             except ValueError:
                 raise InputError(
-                    f"{file}: row {row}, column {column}: {text!r} is not a number"
+                    f"{text!r} is not a number", file=file, key=f"row {row}, column {column}"
                 ) from None
         values = pc.cast(texts, pa.float64())
     array = values.to_numpy(zero_copy_only=False).astype(np.float64)
@@ -184,9 +184,9 @@ def _assemble(
     """Times, rates and quaternions from a table with the ``columns`` found."""
     count = table.num_rows
     if count == 0:
-        raise InputError(f"{file}: no rows")
+        raise InputError("no rows", file=file)
     if count > MAX_ROWS:
-        raise InputError(f"{file}: {count} rows, more than {MAX_ROWS}: split the telemetry")
+        raise InputError(f"{count} rows, more than {MAX_ROWS}: split the telemetry", file=file)
     kind, column, scale = columns["time"]
     if kind == "iso":
         texts = table.column(column).cast("string").to_numpy(zero_copy_only=False)
@@ -197,7 +197,7 @@ def _assemble(
         if np.any(bad):
             row = int(np.flatnonzero(bad)[0])
             raise InputError(
-                f"{file}: row {row}, column {column}: time {seconds[row]!r} is not finite"
+                f"time {seconds[row]!r} is not finite", file=file, key=f"row {row}, column {column}"
             )
         if epoch is not None:
             from attitude.environment.timescales import time_from_tt_seconds
@@ -224,11 +224,13 @@ def _iso_times(texts: NDArray, scale: str, file: str, column: str):
     from astropy.time import Time
 
     if scale not in SCALES:
-        raise InputError(f"--time-scale: expected one of {', '.join(SCALES)}, got {scale!r}")
+        raise InputError(
+            f"expected one of {', '.join(SCALES)}, got {scale!r}", key="--time-scale", value=scale
+        )
     missing = np.array([t is None or str(t).strip() == "" for t in texts])
     if np.any(missing):
         row = int(np.flatnonzero(missing)[0])
-        raise InputError(f"{file}: row {row}, column {column}: no time")
+        raise InputError("no time", file=file, key=f"row {row}, column {column}")
     cleaned = np.char.rstrip(np.char.strip(texts.astype(str)), "Z")
     try:
         with offline_time():
@@ -240,7 +242,9 @@ def _iso_times(texts: NDArray, scale: str, file: str, column: str):
                     Time(text, format="isot", scale=scale)
             except (ValueError, TypeError):
                 raise InputError(
-                    f"{file}: row {row}, column {column}: {str(text)!r} is not an ISO 8601 epoch"
+                    f"{str(text)!r} is not an ISO 8601 epoch",
+                    file=file,
+                    key=f"row {row}, column {column}",
                 ) from None
         raise  # pragma: no cover (the vector failed and no element does)
 
@@ -278,9 +282,9 @@ def _csv(path: Path, head: bytes, time_scale, epoch) -> TelemetryFile:
             ),
         )
     except pa.ArrowInvalid as exc:
-        raise InputError(f"{file}: not a CSV table: {str(exc).splitlines()[0][:200]}") from None
+        raise InputError(f"not a CSV table: {str(exc).splitlines()[0][:200]}", file=file) from None
     except OSError as exc:
-        raise InputError(f"{path}: cannot read: {exc}") from None
+        raise InputError(f"cannot read: {exc}", file=str(path)) from None
     columns = _columns(table.column_names, file)
     return _assemble(table, columns, file, time_scale, epoch, notes)
 
@@ -294,7 +298,7 @@ def _parquet(path: Path, time_scale, epoch) -> TelemetryFile:
         table = pq.read_table(path)
     except (pa.ArrowInvalid, OSError) as exc:
         raise InputError(
-            f"{file}: not a readable Parquet file: {str(exc).splitlines()[0][:200]}"
+            f"not a readable Parquet file: {str(exc).splitlines()[0][:200]}", file=file
         ) from None
     metadata = table.schema.metadata or {}
     stated = metadata.get(b"attitude.epoch")
@@ -317,10 +321,10 @@ def _aem(path: Path) -> TelemetryFile:
     file = path.name
     message, _ = read_message(path, "Aem")
     if str(message.version).strip() not in ("2.0", "2"):
-        raise InputError(f"{file}: CCSDS_AEM_VERS = {message.version}: only AEM 2.0 is read")
+        raise InputError(f"CCSDS_AEM_VERS = {message.version}: only AEM 2.0 is read", file=file)
     times, quats, rates = [], [], []
     for number, segment in enumerate(message.segments):
-        where = f"{file}: segment {number}"
+        where = f"segment {number}"
         meta = segment.metadata
         scale, offset_s = scale_of(meta.time_system, where)
         frame_a = (meta.ref_frame_a or "").strip().upper()
@@ -331,22 +335,27 @@ def _aem(path: Path) -> TelemetryFile:
             inertial, body_first = frame_b, True
         else:
             raise InputError(
-                f"{where}: REF_FRAME_A = {meta.ref_frame_a!r}, REF_FRAME_B = {meta.ref_frame_b!r}: "
-                f"expected one of {', '.join(INERTIAL)} and a body frame (SC_BODY_1)"
+                f"REF_FRAME_A = {meta.ref_frame_a!r}, REF_FRAME_B = {meta.ref_frame_b!r}: "
+                f"expected one of {', '.join(INERTIAL)} and a body frame (SC_BODY_1)",
+                file=file,
+                key=where,
             )
         kind = (meta.attitude_type or "").strip().upper()
         if kind not in TYPES:
             raise InputError(
-                f"{where}: ATTITUDE_TYPE = {meta.attitude_type!r}: expected one of "
-                f"{', '.join(TYPES)}"
+                f"ATTITUDE_TYPE = {meta.attitude_type!r}: expected one of {', '.join(TYPES)}",
+                file=file,
+                key=where,
             )
         states = np.asarray(segment.data.attitude_states_numpy, dtype=np.float64)
         width = 4 if kind == "QUATERNION" else 7 if kind.endswith("ANGVEL") else 8
         if states.ndim != 2 or states.shape[1] != width:
-            raise InputError(f"{where}: expected {width} numbers a record for {kind}")
+            raise InputError(f"expected {width} numbers a record for {kind}", file=file, key=where)
         if not np.all(np.isfinite(states)):
             row = int(np.argwhere(~np.isfinite(states))[0, 0])
-            raise InputError(f"{where}: record {row} is not finite: {states[row].tolist()}")
+            raise InputError(
+                f"record {row} is not finite: {states[row].tolist()}", file=file, key=where
+            )
         epochs = _aem_epochs(
             segment.data.attitude_states_epochs, scale, offset_s, where, parse_epochs
         )
@@ -354,7 +363,7 @@ def _aem(path: Path) -> TelemetryFile:
         norm = np.linalg.norm(q, axis=1)
         if np.any(np.abs(norm - 1.0) > 1e-3):
             row = int(np.argmax(np.abs(norm - 1.0)))
-            raise InputError(f"{where}: record {row}: quaternion norm {norm[row]:.9g}, not 1")
+            raise InputError(f"quaternion norm {norm[row]:.9g}, not 1", file=file, key=where)
         q = q / norm[:, None]
         if body_first:
             q = q * np.array([1.0, -1.0, -1.0, -1.0])
@@ -368,7 +377,9 @@ def _aem(path: Path) -> TelemetryFile:
             if frame in INERTIAL:
                 ω = Rotation.from_quat(q, scalar_first=True).apply(ω, inverse=True)
             elif not frame.startswith("SC_BODY"):
-                raise InputError(f"{where}: ANGVEL_FRAME = {meta.angvel_frame!r}: not understood")
+                raise InputError(
+                    f"ANGVEL_FRAME = {meta.angvel_frame!r}: not understood", file=file, key=where
+                )
         times.append(epochs)
         quats.append(R.as_quat(scalar_first=True))
         rates.append(ω)

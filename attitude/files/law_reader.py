@@ -27,6 +27,7 @@ else in the file.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -61,12 +62,20 @@ LAW_KEYS: dict[str, tuple[str, ...]] = {
 LAW_NAMES = tuple(LAW_KEYS)
 
 
-def _call(table: Any, key: str | None, build: Any, *args: Any, **kwargs: Any) -> Any:
-    """``build(...)``, its InputError said at ``key`` of ``table``."""
+def _call(
+    table: Any,
+    key: str | None,
+    build: Any,
+    *args: Any,
+    keys: dict[str, str] | None = None,
+    **kwargs: Any,
+) -> Any:
+    """``build(...)``, its InputError said at the key of ``table`` it names (``keys`` maps
+    the builder's own names to the table's), else at ``key``."""
     try:
         return build(*args, **kwargs)
     except InputError as exc:
-        table.fail(str(exc), key)
+        table.refuse(exc, key, keys)
 
 
 def read_sites(root: Any) -> dict[str, GroundSite]:
@@ -83,11 +92,27 @@ def read_sites(root: Any) -> dict[str, GroundSite]:
             )
         if name in sites:
             table.fail(f"a site named {name!r} is already given", "name")
-        latitude = table.quantity("latitude", "angle", ())
-        longitude = table.quantity("longitude", "angle", ())
+        latitude = table.quantity("latitude", "angle", (), to="deg")
+        if not -90.0 <= latitude <= 90.0:
+            reason = f"must be between -90 and 90 deg, got {latitude!r} deg"
+            table.fail(reason, "latitude", latitude)
+        longitude = table.quantity("longitude", "angle", (), to="deg")
         height = table.quantity("height", "length", (), required=False)
+        if height is not None and not -1.2e4 <= height <= 1e5:
+            table.fail(
+                f"must be between -12 km and 100 km (a point on or near the Earth), got "
+                f"{height:g} m",
+                "height",
+                height,
+            )
         sites[name] = _call(
-            table, None, GroundSite, latitude, longitude, 0.0 if height is None else height, name
+            table,
+            None,
+            GroundSite,
+            math.radians(latitude),
+            math.radians(longitude),
+            0.0 if height is None else height,
+            name,
         )
     return sites
 
@@ -206,11 +231,8 @@ def read_slew(table: Any) -> SlewLimits:
     table.allow("max_rate", "max_acceleration")
     rate = table.positive("max_rate", "angular_velocity")
     acceleration = table.positive("max_acceleration", "angular_acceleration")
-    try:
-        return SlewLimits(rate, acceleration)
-    except InputError as exc:
-        key, _, message = str(exc).removeprefix("slew.").partition(": ")
-        table.fail(message, key)
+    keys = {"slew.max_rate": "max_rate", "slew.max_acceleration": "max_acceleration"}
+    return _call(table, None, SlewLimits, rate, acceleration, keys=keys)
 
 
 def read_wheels(table: Any) -> Wheels:
@@ -218,4 +240,4 @@ def read_wheels(table: Any) -> Wheels:
     table.allow("case", "momentum")
     case = table.choice("case", WHEEL_CASES)
     momentum = table.quantity("momentum", "angular_momentum", (3,))
-    return _call(table, None, Wheels, case, momentum)
+    return _call(table, None, Wheels, case, momentum, keys={"wheels.case": "case"})

@@ -27,12 +27,12 @@ import tomllib
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from attitude.base.errors import InertiaWarning, InputError
+from attitude.base.errors import NO_VALUE, InertiaWarning, InputError
 from attitude.base.quantities import convert_unit
 from attitude.environment.frames import ORBIT_FRAMES, orbit_frame_to_icrf
 from attitude.environment.keplerian import KeplerianOrbit
@@ -62,6 +62,10 @@ __all__ = [
 # A scenario is a few kilobytes; anything this large is not one (and reading a huge
 # or endless file, e.g. /dev/zero, must not exhaust the memory).
 MAX_FILE_BYTES = 1 << 20
+
+
+# attitude.scenario.events.InertiaChange's name for the inertia it checks.
+_INERTIA_CHANGE = "inertia_change.inertia"
 
 
 class ScenarioFileError(InputError):
@@ -97,16 +101,31 @@ class _Table:
     def where(self, key: str | None = None) -> str:
         return self.path if key is None else (f"{self.path}.{key}" if self.path else key)
 
-    def fail(self, message: str, key: str | None = None):
-        where = self.where(key)
+    def fail(self, message: str, key: str | None = None, value: Any = NO_VALUE) -> NoReturn:
+        """Raise the file's error: ``message`` about ``key`` of this table (the table
+        itself when None), holding ``value``."""
         raise ScenarioFileError(
-            f"{self.file.name}: {where}: {message}" if where else f"{self.file.name}: {message}"
+            message, key=self.where(key) or None, file=self.file.name, value=value
         )
+
+    def refuse(
+        self, exc: InputError, key: str | None = None, keys: dict[str, str] | None = None
+    ) -> NoReturn:
+        """Raise ``exc``, an error of a builder given this table's values, as the file's:
+        under the key it names (a key of this table, or mapped to one by ``keys``, from
+        the builder's own name for it), else under ``key``."""
+        if exc.key is None:
+            self.fail(exc.reason, key, exc.value)
+        self.fail(exc.reason, (keys or {}).get(exc.key, exc.key), exc.value)
 
     def allow(self, *keys: str) -> None:
         unknown = sorted(set(self.data) - set(keys))
         if unknown:
-            self.fail(f"unknown key {unknown[0]!r}; expected one of: {', '.join(keys)}")
+            self.fail(
+                f"unknown key; expected one of: {', '.join(keys)}",
+                unknown[0],
+                self.data[unknown[0]],
+            )
 
     def has(self, key: str) -> bool:
         return key in self.data
@@ -114,14 +133,14 @@ class _Table:
     def table(self, key: str, required: bool = True) -> _Table | None:
         if key not in self.data:
             if required:
-                self.fail(f"missing table [{self.where(key)}]")
+                self.fail("missing table", key)
             return None
         return _Table(self.file, self.where(key), self.data[key])
 
     def tables(self, key: str) -> list[_Table]:
         value = self.data.get(key, [])
         if not isinstance(value, list):
-            self.fail(f"expected an array of tables [[{key}]], got {value!r}", key)
+            self.fail(f"expected an array of tables [[{key}]], got {value!r}", key, value)
         return [_Table(self.file, f"{self.where(key)}[{i}]", item) for i, item in enumerate(value)]
 
     def raw(self, key: str, required: bool = True, default: Any = None) -> Any:
@@ -134,15 +153,15 @@ class _Table:
     def string(self, key: str, required: bool = True, default: str | None = None) -> str | None:
         value = self.raw(key, required, default)
         if value is not None and not isinstance(value, str):
-            self.fail(f"expected a string, got {_short(value)}", key)
+            self.fail(f"expected a string, got {_short(value)}", key, value)
         if value is not None and not value.isprintable():
-            self.fail(f"expected one line of printable text, got {_short(value)}", key)
+            self.fail(f"expected one line of printable text, got {_short(value)}", key, value)
         return value
 
     def choice(self, key: str, choices: tuple[str, ...], default: str | None = None) -> str:
         value = self.string(key, default is None, default)
         if value not in choices:
-            self.fail(f"expected one of {', '.join(choices)}, got {value!r}", key)
+            self.fail(f"expected one of {', '.join(choices)}, got {value!r}", key, value)
         return value
 
     def quantity(
@@ -169,45 +188,46 @@ class _Table:
             unit = sub.string("unit")
             value = sub.raw("value")
             if kind == "dimensionless":
-                self.fail(f"takes no unit (it is a pure number), got unit {unit!r}", key)
+                self.fail(f"takes no unit (it is a pure number), got unit {unit!r}", key, unit)
         elif kind == "angle":
             self.fail(
                 f'an angle needs its unit, e.g. {{ value = {value!r}, unit = "deg" }} '
                 "(a bare number would be read as radians)",
                 key,
+                value,
             )
         if not _is_numbers(value):
-            self.fail(f"expected {_describe(shape)}, got {_short(value)}", key)
+            self.fail(f"expected {_describe(shape)}, got {_short(value)}", key, value)
         try:
             array = np.array(value, dtype=float)
         except OverflowError:
-            self.fail(f"a number is beyond the float range (1.8e308): {_short(value)}", key)
+            self.fail(f"a number is beyond the float range (1.8e308): {_short(value)}", key, value)
         except (TypeError, ValueError):
-            self.fail(f"expected {_describe(shape)}, got {_short(value)}", key)
+            self.fail(f"expected {_describe(shape)}, got {_short(value)}", key, value)
         if array.shape != shape:
-            self.fail(f"expected {_describe(shape)}, got {_short(value)}", key)
+            self.fail(f"expected {_describe(shape)}, got {_short(value)}", key, value)
         if not np.all(np.isfinite(array)):
-            self.fail(f"expected finite numbers, got {_short(value)}", key)
+            self.fail(f"expected finite numbers, got {_short(value)}", key, value)
         if unit is not None:
             try:
                 array = np.asarray(convert_unit(array, unit, kind, "", to), dtype=float)
             except InputError as exc:
-                self.fail(str(exc).removeprefix(": "), key)
+                self.fail(exc.reason, key, exc.value)
             if not np.all(np.isfinite(array)):
-                self.fail(f"{value!r} {unit} is beyond the float range in SI units", key)
+                self.fail(f"{value!r} {unit} is beyond the float range in SI units", key, value)
         return array if shape else float(array)
 
     def boolean(self, key: str, default: bool) -> bool:
         value = self.raw(key, required=False, default=default)
         if not isinstance(value, bool):
-            self.fail(f"expected true or false, got {_short(value)}", key)
+            self.fail(f"expected true or false, got {_short(value)}", key, value)
         return value
 
     def file_path(self, key: str) -> Path:
         """A file named by a string key, relative to the scenario file's folder."""
         text = self.string(key)
         if not text:
-            self.fail("expected a file name, got an empty string", key)
+            self.fail("expected a file name, got an empty string", key, text)
         return self.file.parent / Path(text).expanduser()
 
     def epoch(self, key: str, scale: str, required: bool = True):
@@ -215,14 +235,14 @@ class _Table:
         if value is None:
             return None
         try:
-            return as_time(value, scale, name=self.where(key))
+            return as_time(value, scale, name=key)
         except InputError as exc:
-            self.fail(str(exc).removeprefix(f"{self.where(key)}: "), key)
+            self.fail(exc.reason, key, value)
 
     def positive(self, key: str, kind: str, required: bool = True):
         value = self.quantity(key, kind, (), required)
         if value is not None and not value > 0.0:
-            self.fail(f"must be positive, got {value!r}", key)
+            self.fail(f"must be positive, got {value!r}", key, value)
         return value
 
 
@@ -255,8 +275,17 @@ def _inertia(table: _Table) -> tuple[np.ndarray, str]:
     return table.quantity("inertia_tensor", "moment_of_inertia", (3, 3)), "inertia_tensor"
 
 
-def _checked(table: _Table, key: str | None, build, *args, **kwargs):
-    """``build(*args, **kwargs)``, its InputError and InertiaWarning named after the key."""
+def _checked(
+    table: _Table,
+    key: str | None,
+    build,
+    *args,
+    keys: dict[str, str] | None = None,
+    **kwargs,
+):
+    """``build(*args, **kwargs)``, its InputError and InertiaWarning as the file's: under
+    the key of ``table`` they name (``keys`` maps a builder's own name for a value to
+    the table's key), else under ``key``."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", InertiaWarning)
         try:
@@ -264,23 +293,16 @@ def _checked(table: _Table, key: str | None, build, *args, **kwargs):
         except ScenarioFileError:
             raise
         except InputError as exc:
-            table.fail(_without_inertia_name(str(exc)), key)
+            table.refuse(exc, key, keys)
     for warning in caught:
-        if issubclass(warning.category, InertiaWarning):
-            text = _without_inertia_name(str(warning.message))
-            where = table.where(key)
-            warnings.warn(f"{table.file.name}: {where}: {text}", ScenarioFileWarning, stacklevel=2)
+        message = warning.message
+        if isinstance(message, InertiaWarning):
+            named = (keys or {}).get(message.key, message.key) if message.key else key
+            text = f"{table.file.name}: {table.where(named)}: {message.reason}"
+            warnings.warn(text, ScenarioFileWarning, stacklevel=2)
         else:
-            warnings.warn_explicit(
-                warning.message, warning.category, warning.filename, warning.lineno
-            )
+            warnings.warn_explicit(message, warning.category, warning.filename, warning.lineno)
     return result
-
-
-def _without_inertia_name(message: str) -> str:
-    """A message of ``attitude.solver.inertia`` without its own name for the field: the file's
-    key path replaces it."""
-    return message.removeprefix("inertia_change.").removeprefix("inertia: ")
 
 
 def _attitude(table: _Table) -> Rotation | None:
@@ -312,12 +334,16 @@ def _attitude_in_icrf(table: _Table, orbit: Orbit | None, at) -> Rotation | None
         if attitude is not None:
             table.fail("give one of quaternion, matrix and aem, not two")
         if frame != "icrf":
-            table.fail("an AEM file states its own frame: frame applies to quaternion or matrix")
+            table.fail(
+                "an AEM file states its own frame: frame applies to quaternion or matrix",
+                "frame",
+                frame,
+            )
         path = table.file_path("aem")
         try:
             attitude, notes = attitude_from_aem(path, at)
         except InputError as exc:
-            table.fail(str(exc), "aem")
+            table.refuse(exc, "aem")
         for note in notes:
             warnings.warn(
                 f"{table.file.name}: {table.where('aem')}: {note}",
@@ -337,9 +363,15 @@ def _attitude_in_icrf(table: _Table, orbit: Orbit | None, at) -> Rotation | None
         )
     try:
         r, v = orbit.position_velocity(at)
-        return orbit_frame_to_icrf(frame, r, v) * attitude
-    except InputError as exc:
-        table.fail(f"the orbit at {at.isot} {at.scale.upper()}: {exc}", "frame")
+    except InputError as exc:  # the orbit's source cannot place the attitude: its key
+        raise ScenarioFileError(
+            f"{table.where('frame')} = {frame!r} needs the orbit at {at.isot} "
+            f"{at.scale.upper()}: {exc.reason}",
+            key=orbit.key,
+            file=table.file.name,
+            value=exc.value,
+        ) from None
+    return orbit_frame_to_icrf(frame, r, v) * attitude
 
 
 def _rate(table: _Table, required: bool) -> dict[str, np.ndarray]:
@@ -386,7 +418,9 @@ def _events(root: _Table, scale: str, epoch, orbit: Orbit | None, sites: dict) -
         elif kind == "inertia_change":
             table.allow(*common, "principal_moments", "inertia_tensor")
             inertia, key = _inertia(table)
-            events.append(_checked(table, key, InertiaChange, at, inertia, label))
+            events.append(
+                _checked(table, key, InertiaChange, at, inertia, label, keys={_INERTIA_CHANGE: key})
+            )
         else:
             table.allow(
                 *common,
@@ -502,6 +536,7 @@ def _keplerian(table: _Table, scale: str, epoch, name: str) -> KeplerianOrbit:
     }
     frame = table.choice("frame", ("ICRF", "EME2000"), default="ICRF")
     j2 = table.boolean("j2", default=False)
+    # KeplerianOrbit names each element by its key here (semi_major_axis, raan...).
     return _checked(table, None, KeplerianOrbit, at, frame=frame, j2=j2, name=name, **elements)
 
 
@@ -517,7 +552,7 @@ def _orbit(table: _Table, scale: str, epoch, name: str) -> Orbit | None:
         if not (
             isinstance(lines, list) and len(lines) == 2 and all(isinstance(s, str) for s in lines)
         ):
-            table.fail(f"expected the two lines of a TLE, got {_short(lines)}", "tle")
+            table.fail(f"expected the two lines of a TLE, got {_short(lines)}", "tle", lines)
         return _checked(table, "tle", TleOrbit, *lines, name)
     if given[0] == "oem":
         return _checked(table, "oem", OemOrbit, table.file_path("oem"), name)
@@ -540,7 +575,7 @@ def _pointing(root: _Table, scale: str, epoch, name: str) -> PointingSpec:
     vectors = [_body_vector(item) for item in table.tables("body_vectors")]
     names = [v.name for v in vectors]
     if len(set(names)) != len(names):
-        table.fail(f"body vector names must be unique, got {names}", "body_vectors")
+        table.fail(f"body vector names must be unique, got {names}", "body_vectors", names)
     orbit = _orbit(table, scale, epoch, name)
     options: dict[str, Any] = {}
     precision = table.positive("interval_precision", "time", required=False)
@@ -590,15 +625,19 @@ def _torques(root: _Table, scale: str, orbit: Orbit | None) -> ScenarioTorques |
     }
     order = table.raw("order", required=False, default=4)
     if isinstance(order, bool) or order not in (2, 4, 6) or not isinstance(order, int):
-        table.fail(f"expected 2, 4 or 6 (the splitting's order), got {_short(order)}", "order")
+        table.fail(
+            f"expected 2, 4 or 6 (the splitting's order), got {_short(order)}", "order", order
+        )
     threshold = table.quantity("horizon_threshold", "angle", (), required=False)
     if threshold is not None:
         options["horizon_threshold"] = threshold
     try:
         # True: the scenario's orbit, the one of [pointing] (given once, to the Scenario).
         return ScenarioTorques(gravity_gradient or None, tuple(burns), order=order, **options)
-    except InputError as exc:
-        raise ScenarioFileError(f"{table.file.name}: {exc}") from None
+    except InputError as exc:  # its keys are the file's, from the root (torques.step)
+        raise ScenarioFileError(
+            exc.reason, key=exc.key, file=table.file.name, value=exc.value
+        ) from None
 
 
 def read_document(path: Path) -> dict[str, Any]:
@@ -607,24 +646,25 @@ def read_document(path: Path) -> dict[str, Any]:
         with open(path, "rb") as stream:
             data = stream.read(MAX_FILE_BYTES + 1)
     except OSError as exc:
-        raise ScenarioFileError(f"{path}: cannot read: {exc.strerror or exc}") from None
+        raise ScenarioFileError(f"cannot read: {exc.strerror or exc}", file=str(path)) from None
     if len(data) > MAX_FILE_BYTES:
         raise ScenarioFileError(
-            f"{path.name}: larger than {MAX_FILE_BYTES // 1024} KiB: not a scenario file"
+            f"larger than {MAX_FILE_BYTES // 1024} KiB: not a scenario file", file=path.name
         )
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError as exc:
         kind = "UTF-16" if data[:2] in (b"\xff\xfe", b"\xfe\xff") else "binary or not UTF-8"
         raise ScenarioFileError(
-            f"{path.name}: not a TOML file: TOML is UTF-8 text, this is {kind} (byte {exc.start})"
+            f"not a TOML file: TOML is UTF-8 text, this is {kind} (byte {exc.start})",
+            file=path.name,
         ) from None
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise ScenarioFileError(f"{path.name}: not valid TOML: {exc}") from None
+        raise ScenarioFileError(f"not valid TOML: {exc}", file=path.name) from None
     except RecursionError:
-        raise ScenarioFileError(f"{path.name}: not valid TOML: nested too deeply") from None
+        raise ScenarioFileError("not valid TOML: nested too deeply", file=path.name) from None
 
 
 def load_scenario(path: str | Path) -> ScenarioFile:
@@ -670,7 +710,18 @@ def scenario_from_document(path: Path, document: dict[str, Any]) -> ScenarioFile
         )
     except InputError as exc:
         end = "stop" if span["stop"] is not None else "duration"
-        raise ScenarioFileError(f"{path.name}: {_scenario_key(str(exc), end)}") from None
+        # Scenario's own names for its arguments, as the file spells them; its other
+        # keys (events[0].offset, torques.step) are already the file's, from the root.
+        keys = {
+            "epoch": "scenario.epoch",
+            "start": "output.start",
+            "step": "output.step",
+            "stop": f"output.{end}",
+            "duration": "output.duration",
+        }
+        raise ScenarioFileError(
+            exc.reason, key=keys.get(exc.key or "", exc.key), file=path.name, value=exc.value
+        ) from None
     return ScenarioFile(path, scenario, pointing, _outputs(output), document)
 
 
@@ -689,7 +740,8 @@ def _spacecraft(root: _Table) -> Spacecraft:
     craft.allow("name", "principal_moments", "inertia_tensor")
     craft_name = craft.string("name")
     inertia, key = _inertia(craft)
-    return _checked(craft, key, Spacecraft, craft_name, inertia)
+    # Spacecraft names the name "name" and the inertia "inertia" (either key here).
+    return _checked(craft, key, Spacecraft, craft_name, inertia, keys={"inertia": key})
 
 
 def _initial_state(root: _Table, orbit: Orbit | None, epoch, sites: dict) -> InitialState:
@@ -734,28 +786,12 @@ def _outputs(output: _Table) -> OutputChoice:
     try:
         formats = parse_formats(formats, "formats")
     except InputError as exc:
-        output.fail(str(exc).removeprefix("formats: "), "formats")
+        output.refuse(exc, "formats")
     tolerance = output.quantity("aem_tolerance", "angle", (), required=False)
     if tolerance is None:
         return OutputChoice(formats)
     try:
         check_tolerance(tolerance, "aem_tolerance")
     except InputError as exc:
-        output.fail(str(exc).removeprefix("aem_tolerance: "), "aem_tolerance")
+        output.refuse(exc, "aem_tolerance")
     return OutputChoice(formats, tolerance)
-
-
-def _scenario_key(message: str, end: str) -> str:
-    """A Scenario's message with its key as the file spells it (``output.step: ...``).
-
-    ``end``: the key that gave the end of the span, ``stop`` or ``duration``.
-    """
-    head, _, rest = message.partition(" ")
-    key = head.removesuffix(":")
-    if key == "epoch":
-        return f"scenario.epoch: {rest}"
-    if key in ("start", "step", "duration", "stop"):
-        return f"output.{end if key == 'stop' else key}: {rest}"
-    if message.startswith("the span"):
-        return f"output.{end}: {message}"
-    return message

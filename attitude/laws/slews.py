@@ -116,10 +116,14 @@ class SlewLimits:
             ("max_acceleration", acceleration, "rad/s²"),
         ):
             if not value > 0.0:
-                raise InputError(f"slew.{name}: must be positive, got {value!r} {unit}")
+                raise InputError(
+                    f"must be positive, got {value!r} {unit}", key=f"slew.{name}", value=value
+                )
             if not value < 1e3:
                 raise InputError(
-                    f"slew.{name}: {value!r} {unit} is beyond any spacecraft (at most 1000)"
+                    f"{value!r} {unit} is beyond any spacecraft (at most 1000)",
+                    key=f"slew.{name}",
+                    value=value,
                 )
         object.__setattr__(self, "max_rate", rate)
         object.__setattr__(self, "max_acceleration", acceleration)
@@ -210,7 +214,7 @@ class Slew:
         θ = self.angle_rad
         if not deadline_s > self.start_s:
             raise InputError(
-                f"{self.key}: the slew has no time: {deadline_text} is at the same epoch"
+                f"the slew has no time: {deadline_text} is at the same epoch", key=self.key
             )
         # W_B and A_B are bounds over the slew itself: from the shortest duration the
         # limits allow, the window grows to the duration found until it covers it.
@@ -226,11 +230,12 @@ class Slew:
             duration, rate, acceleration, T_c = self._solve(θ, D, Ω, A, W_B, A_B)
         if self.start_s + duration > deadline_s:
             raise InputError(
-                f"{self.key}: the slew of {math.degrees(θ):.4g} deg from "
+                f"the slew of {math.degrees(θ):.4g} deg from "
                 f"{self._format(self.start_s)} takes {duration:.6g} s within "
                 f"{math.degrees(Ω):.6g} deg/s and {math.degrees(A):.6g} deg/s², and would end at "
                 f"{self._format(self.start_s + duration)}, after {deadline_text} at "
-                f"{self._format(deadline_s)}: give larger limits or more time"
+                f"{self._format(deadline_s)}: give larger limits or more time",
+                key=self.key,
             )
         self.duration_s = duration
         self.end_s = self.start_s + duration
@@ -266,15 +271,16 @@ class Slew:
                     f"turns at up to {fmt(W_B):.4g} deg/s: max_rate {fmt(Ω):.4g} deg/s cannot "
                     "capture it"
                 )
-            raise InputError(f"{self.key}: {why}; give a larger max_rate")
+            raise InputError(f"{why}; give a larger max_rate", key=f"{self.key}.max_rate")
         K = A_B + W_B * rate + (W_B + rate) * D
         available = A - K
         if not available > 0.0:
             raise InputError(
-                f"{self.key}: the target law's own acceleration and rate, and the start rate "
+                f"the target law's own acceleration and rate, and the start rate "
                 f"to absorb ({fmt(D):.4g} deg/s), take {fmt(K):.4g} deg/s² of max_acceleration "
                 f"{fmt(A):.4g} deg/s²: nothing is left for the slew; give a larger "
-                "max_acceleration"
+                "max_acceleration",
+                key=f"{self.key}.max_acceleration",
             )
         if D == 0.0:
             T = bang_coast_bang_duration(θ, rate, available)

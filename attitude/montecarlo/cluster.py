@@ -1,8 +1,12 @@
 """Where a Monte Carlo job runs: a ``distributed.Client`` to a local cluster or to a
 scheduler, its workers checked (the same versions) and its cost per task measured.
 
-Ctrl-C stops the job: the local cluster is closed (its worker processes ignore the
-terminal's SIGINT, which the client handles).
+Ctrl-C stops the job: the local cluster is closed (its worker processes never see the
+terminal's SIGINT, which the client handles), also when it comes while the cluster
+starts (:func:`_start_deferring_stops`).  A scheduler's address is tried first
+(:func:`probe_scheduler`), with a timeout: what answers there (nothing, a web server
+such as the Dask dashboard, another protocol) is said in one line, before any
+``distributed.Client`` exists (a half-made one hangs, or raises at exit).
 """
 
 from __future__ import annotations
@@ -10,6 +14,7 @@ from __future__ import annotations
 import contextlib
 import os
 import signal
+import socket
 import tempfile
 import threading
 import time
@@ -18,13 +23,19 @@ from typing import Any
 
 import numpy as np
 
-from attitude.base.errors import InputError
+from attitude.base.errors import InputError, OptionError
+from attitude.base.signals import STOPPING
 from attitude.base.version import __version__
 from attitude.outputs.folder import held_signals
 
-__all__ = ["check_where", "check_workers", "connect", "task_overhead_s"]
+__all__ = ["check_where", "check_workers", "connect", "probe_scheduler", "task_overhead_s"]
 
 _CONNECT_TIMEOUT_S = 10
+# A scheduler's address: the connection within this (s), and an answer within as much.
+_PROBE_TIMEOUT_S = 5.0
+# A Dask scheduler's handshake comes within milliseconds of the connection; after this
+# (s) of silence the server is asked as a web server is.
+_FIRST_WORDS_S = 2.0
 
 _OVERHEAD_PROBES = 40
 
@@ -43,19 +54,47 @@ def _worker_versions() -> tuple[str, str, str]:
 
 
 @contextlib.contextmanager
-def _workers_ignore_interrupts() -> Iterator[None]:
-    """SIGINT ignored while worker processes start: they inherit it (an ignored signal
-    stays ignored across exec), so the terminal's Ctrl-C, sent to every process of the
-    foreground group, reaches only the client, which closes the cluster.  A Ctrl-C in
-    this window (the cluster's start, about two seconds) is lost."""
+def _start_deferring_stops(received: list[int]) -> Iterator[None]:
+    """The local cluster's start, with the stopping signals deferred to its end.
+
+    SIGINT is blocked in this thread meanwhile, so that the threads the start creates
+    (Dask's event loop, the threads that spawn the workers) and the worker processes
+    they start inherit it blocked (a signal mask survives fork and exec): the
+    terminal's Ctrl-C, sent to every process of the foreground group, never reaches a
+    worker (no traceback of theirs), and the client, which handles it, closes the
+    cluster.  SIGINT, SIGTERM and SIGHUP received during the start are recorded in
+    ``received`` (a handler that raised here would leave a half-started cluster
+    behind) for the caller to deliver once the cluster exists and can be closed: a
+    Ctrl-C stops the job as the start ends, about two seconds.  A signal the caller
+    ignores stays ignored (attitude.base.signals).
+    """
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    # multiprocessing's resource tracker, started by the first worker's spawn, unblocks
+    # SIGINT in the thread that starts it (its own guard, CPython bpo-33613): started
+    # here first, it leaves Dask's threads as they are made.
+    from multiprocessing import resource_tracker
+
+    resource_tracker.ensure_running()
+    previous = {}
+    for number in STOPPING:
+        handler = signal.getsignal(number)
+        if handler is not None and handler is not signal.SIG_IGN:
+            previous[number] = signal.signal(number, lambda n, frame: received.append(n))
+    blocked = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, previous)
+        signal.pthread_sigmask(signal.SIG_SETMASK, blocked)  # a pending one is recorded now
+        for number, handler in previous.items():
+            signal.signal(number, handler)
+
+
+def _deliver(received: list[int]) -> None:
+    """Deliver the signals deferred during the start, to the handlers now in place."""
+    for number in dict.fromkeys(received):
+        signal.raise_signal(number)
 
 
 def _ignore_interrupts_plugin():
@@ -72,41 +111,152 @@ def _ignore_interrupts_plugin():
     return IgnoreInterrupts()
 
 
-def check_where(scheduler: str | None, workers: int | None) -> int:
+def check_where(scheduler: str | None, workers: int | None, probe: bool = True) -> int:
     """The local cluster's worker count (0 with a scheduler), after checking the options;
-    a malformed address is refused before a Client exists (a half-made one hangs at exit)."""
+    a malformed address, or one where no Dask scheduler answers (``probe``:
+    :func:`probe_scheduler`), is refused before a Client exists (a half-made one hangs
+    at exit)."""
     if scheduler is not None:
         if workers is not None:
-            raise InputError("--workers: sets the size of the local cluster; not with --scheduler")
+            raise InputError(
+                "sets the size of the local cluster; not with --scheduler", key="--workers"
+            )
         from distributed.comm.addressing import get_address_host_port
 
         try:
             get_address_host_port(scheduler)
         except (ValueError, TypeError) as exc:
-            raise InputError(f"--scheduler {scheduler!r}: not a scheduler address: {exc}") from None
+            hint = (
+                " (http:// is the dashboard's web page; the scheduler's address is "
+                "tcp://HOST:PORT, 8786 by default)"
+                if scheduler.lower().startswith(("http://", "https://"))
+                else ""
+            )
+            raise InputError(
+                f"--scheduler {scheduler!r}: not a scheduler address: {exc}{hint}"
+            ) from None
+        if probe:
+            probe_scheduler(scheduler)
         return 0
     count = workers if workers is not None else len(os.sched_getaffinity(0))
     if not 1 <= count <= 4 * (os.cpu_count() or 1):
-        raise InputError(f"--workers: expected 1 to {4 * (os.cpu_count() or 1)}, got {count}")
+        raise InputError(
+            f"expected 1 to {4 * (os.cpu_count() or 1)}, got {count}", key="--workers", value=count
+        )
     return count
 
 
+def probe_scheduler(address: str, timeout_s: float = _PROBE_TIMEOUT_S) -> None:
+    """Refuse (:class:`OptionError`, one line naming the address and what answered) an
+    address where no Dask scheduler listens, within ``timeout_s`` for the connection
+    and as much for its first words.
+
+    A Dask scheduler speaks first: on a TCP connection it sends its handshake (msgpack:
+    ``compression``, ``python``, ``pickle-protocol``) before it reads anything.  A web
+    server (the Dask dashboard, the address users see in their browser) waits for a
+    request: it is asked ``HEAD /`` and named by its status line.  Anything else is
+    another protocol.  TLS and the other transports are only checked for a connection.
+    """
+    from distributed.comm.addressing import get_address_host_port, parse_address
+
+    scheme, _ = parse_address(address)
+    if scheme not in ("tcp", "tls"):
+        return
+    host, port = get_address_host_port(address)
+
+    def refused(reason: str) -> OptionError:
+        return OptionError(reason, key="--scheduler", value=address)
+
+    try:
+        connection = socket.create_connection((host, port), timeout=timeout_s)
+    except TimeoutError:
+        raise refused(
+            f"nothing answered within {timeout_s:g} s (no route to the host, or a firewall "
+            "drops the connection)"
+        ) from None
+    except ConnectionRefusedError:
+        raise refused(
+            "connection refused: nothing listens on that port (`dask scheduler` prints its "
+            "address as 'Scheduler at: tcp://HOST:PORT')"
+        ) from None
+    except OSError as exc:
+        raise refused(f"cannot connect: {exc.strerror or exc}") from None
+    with connection:
+        if scheme == "tls":
+            return
+        # A scheduler handshakes at once; a busy one that is late is recognized after
+        # the request below all the same (its handshake comes first).
+        first = _read_some(connection, _FIRST_WORDS_S)
+        if not first:  # silent: a server that waits for a request, perhaps a web server
+            with contextlib.suppress(OSError):
+                connection.sendall(f"HEAD / HTTP/1.0\r\nHost: {host}\r\n\r\n".encode())
+            first = _read_some(connection, timeout_s)
+            if not first:
+                raise refused(
+                    "something listens there but said nothing a Dask scheduler says within "
+                    f"{_FIRST_WORDS_S + timeout_s:g} s"
+                )
+        if b"compression" in first and b"pickle-protocol" in first:
+            return  # a Dask handshake
+        status = first.split(b"\r\n", 1)[0].split(b"\n", 1)[0][:80]
+        if status.startswith(b"HTTP/"):
+            raise refused(
+                f"a web server answered ({status.decode('ascii', 'replace')}), not a Dask "
+                "scheduler: is it the dashboard's port?  The scheduler's address is "
+                "tcp://HOST:PORT (8786 by default), as `dask scheduler` prints it after "
+                "'Scheduler at:'"
+            )
+        shown = status.decode("ascii", "replace") if status.isascii() and status.strip() else ""
+        raise refused(
+            "another protocol answered, not a Dask scheduler"
+            + (f": {shown.strip()!r}" if shown.isprintable() and shown.strip() else "")
+        )
+
+
+def _read_some(connection: socket.socket, timeout_s: float, enough: int = 256) -> bytes:
+    """What the peer sends within ``timeout_s`` (up to ``enough`` bytes; b"" if nothing)."""
+    connection.settimeout(timeout_s)
+    data = b""
+    deadline = time.monotonic() + timeout_s
+    while len(data) < enough:
+        left = deadline - time.monotonic()
+        if left <= 0.0:
+            break
+        connection.settimeout(left)
+        try:
+            chunk = connection.recv(enough - len(data))
+        except (TimeoutError, OSError):
+            break
+        if not chunk:
+            break
+        data += chunk
+        if b"pickle-protocol" in data or b"\r\n" in data:
+            break
+    return data
+
+
 @contextlib.contextmanager
-def connect(scheduler: str | None = None, workers: int | None = None) -> Iterator[Any]:
+def connect(
+    scheduler: str | None = None, workers: int | None = None, probed: bool = False
+) -> Iterator[Any]:
     """A ``distributed.Client``: to the scheduler at ``scheduler``, or to a local cluster
     of ``workers`` processes (default: every core), one thread each, on 127.0.0.1,
-    closed on exit (with its processes and ports) whatever ends the block."""
+    closed on exit (with its processes and ports) whatever ends the block.
+    ``probed``: the caller has already checked the options and the scheduler's address
+    (:func:`check_where`)."""
     import logging
 
     from distributed import Client, LocalCluster
 
-    count = check_where(scheduler, workers)
+    count = check_where(scheduler, workers, probe=not probed)
     if scheduler is not None:
         try:
             client = Client(scheduler, timeout=_CONNECT_TIMEOUT_S, set_as_default=False)
         except (OSError, TimeoutError, ValueError, TypeError) as exc:
             text = " ".join(str(exc).split())
-            raise InputError(f"--scheduler {scheduler}: cannot connect: {text}") from None
+            raise OptionError(
+                f"cannot connect: {text}", key="--scheduler", value=scheduler
+            ) from None
         try:
             yield client
         finally:
@@ -114,7 +264,8 @@ def connect(scheduler: str | None = None, workers: int | None = None) -> Iterato
                 client.close()
         return
     with tempfile.TemporaryDirectory(prefix="attitude-dask-") as scratch:
-        with _workers_ignore_interrupts():
+        received: list[int] = []
+        with _start_deferring_stops(received):
             cluster = LocalCluster(
                 n_workers=count,
                 threads_per_worker=1,
@@ -125,6 +276,7 @@ def connect(scheduler: str | None = None, workers: int | None = None) -> Iterato
                 local_directory=scratch,  # workers' spill files: removed with it
             )
         try:
+            _deliver(received)  # a Ctrl-C during the start: the cluster is closed below
             client = Client(cluster, set_as_default=False)
             try:
                 client.register_plugin(_ignore_interrupts_plugin())
@@ -151,14 +303,15 @@ def check_workers(client) -> int:
         versions = client.run(_worker_versions)
     except Exception as exc:  # a worker without attitude, say
         text = " ".join(f"{type(exc).__name__}: {exc}".split())
-        raise InputError(f"--scheduler: the workers cannot run attitude ({text})") from None
+        raise InputError(f"the workers cannot run attitude ({text})", key="--scheduler") from None
     if not versions:
-        raise InputError("--scheduler: the cluster has no workers")
+        raise InputError("the cluster has no workers", key="--scheduler")
     for address, theirs in versions.items():
         if tuple(theirs) != here:
             raise InputError(
-                f"--scheduler: worker {address} runs attitude {theirs[0]} with numpy "
+                f"worker {address} runs attitude {theirs[0]} with numpy "
                 f"{theirs[1]} and scipy {theirs[2]}; this is attitude {here[0]} with numpy "
-                f"{here[1]} and scipy {here[2]}: install the same versions on every worker"
+                f"{here[1]} and scipy {here[2]}: install the same versions on every worker",
+                key="--scheduler",
             )
     return sum(w["nthreads"] for w in client.scheduler_info()["workers"].values())

@@ -101,6 +101,10 @@ MAX_DRAWS = 100
 # The largest sample count a table may ask for (the per-sample table of 1e7 rows and a
 # hundred columns is already several GB).
 MAX_SAMPLES = 10_000_000
+# The largest seed: a TOML integer is 64-bit signed (TOML 1.0), so the file's seed
+# cannot be larger, and --seed, which replaces it, follows the same rule (numpy would
+# take any; statistics.json then holds a seed that int64 readers take too).
+MAX_SEED = 2**63 - 1
 # Rotation and cone scales beyond this are not "small": the rotation vector wraps.
 _MAX_ANGLE_RAD = math.pi
 _AXES = "xyz"
@@ -256,12 +260,29 @@ def _angle_text(distribution: Distribution) -> str:
 # ---------------------------------------------------------------------------- reading
 
 
+def _integer_error(value: Any, low: int, high: int) -> str | None:
+    """Why ``value`` is not a whole number in [low, high] (one rule for the file's keys
+    and the command line's options), or None."""
+    if not isinstance(value, int) or isinstance(value, bool):
+        return f"expected a whole number, got {value!r}"
+    if not low <= value <= high:
+        return f"must be between {low} and {high:,}, got {value!r}"
+    return None
+
+
 def _integer(table: Table, key: str, low: int, high: int) -> int:
     value = table.raw(key)
-    if not isinstance(value, int) or isinstance(value, bool):
-        table.fail(f"expected a whole number, got {value!r}", key)
-    if not low <= value <= high:
-        table.fail(f"must be between {low} and {high:,}, got {value!r}", key)
+    error = _integer_error(value, low, high)
+    if error:
+        table.fail(error, key, value)
+    return value
+
+
+def _option(value: Any, option: str, low: int, high: int) -> int:
+    """A command-line option's whole number, by the rule of the file's key it replaces."""
+    error = _integer_error(value, low, high)
+    if error:
+        raise ScenarioFileError(error, key=option, value=value)
     return value
 
 
@@ -322,8 +343,10 @@ def read_dispersions(
     table = root.table("dispersions", required=False)
     if table is None:
         raise ScenarioFileError(
-            f"{loaded.path.name}: no [dispersions] table: add one with the seed, the sample "
-            "count and what to disperse (docs/scenarios.md)"
+            "missing table: add one with the seed, the sample "
+            "count and what to disperse (docs/scenarios.md)",
+            key="dispersions",
+            file=loaded.path.name,
         )
     table.allow("seed", "samples", "spacecraft", "initial_state", "events", "pointing")
     seed, samples = _seed_and_samples(table, seed, samples)
@@ -348,12 +371,14 @@ def read_dispersions(
 
 def _seed_and_samples(table: Table, seed: int | None, samples: int | None) -> tuple[int, int]:
     """The seed and the sample count: the command line's if given, else the table's."""
-    seed = _integer(table, "seed", 0, 2**63 - 1) if seed is None else seed
-    samples = _integer(table, "samples", 1, MAX_SAMPLES) if samples is None else samples
-    if not (isinstance(seed, int) and seed >= 0):
-        raise ScenarioFileError(f"--seed: expected a whole number ≥ 0, got {seed!r}")
-    if not (isinstance(samples, int) and 1 <= samples <= MAX_SAMPLES):
-        raise ScenarioFileError(f"--samples: expected 1 to {MAX_SAMPLES:,}, got {samples!r}")
+    if seed is None:
+        seed = _integer(table, "seed", 0, MAX_SEED)
+    else:
+        seed = _option(seed, "--seed", 0, MAX_SEED)
+    if samples is None:
+        samples = _integer(table, "samples", 1, MAX_SAMPLES)
+    else:
+        samples = _option(samples, "--samples", 1, MAX_SAMPLES)
     return seed, samples
 
 
@@ -686,8 +711,10 @@ def shifted_tle_epoch(line1: str, shift_s: float) -> tuple[str, float]:
         new_year += 1  # rounded up onto the next year's first instant
     if not 1957 <= new_year <= 2056:
         raise InputError(
-            f"pointing.tle_epoch: a shift of {shift_s:g} s moves the TLE epoch to {new_year}, "
-            "which a TLE cannot write (1957-2056)"
+            f"a shift of {shift_s:g} s moves the TLE epoch to {new_year}, "
+            "which a TLE cannot write (1957-2056)",
+            key="dispersions.pointing.tle_epoch",
+            value=shift_s,
         )
     text = f"{line1[:18]}{new_year % 100:02d}{new_days:012.8f}{line1[32:68]}"
     applied = (_days_before(new_year) + new_days - start) * 86400.0

@@ -107,9 +107,11 @@ def plan_montecarlo(
     available = available_memory_bytes()
     if need > 0.8 * available:
         raise ResourceError(
-            f"dispersions.samples: {mc.samples:,} samples of {len(mc.columns)} columns "
+            f"{mc.samples:,} samples of {len(mc.columns)} columns "
             f"need about {need / 1e9:.3g} GB of memory for the table, and "
-            f"{available / 1e9:.3g} GB is available: run fewer samples"
+            f"{available / 1e9:.3g} GB is available: run fewer samples",
+            key="dispersions.samples" if samples is None else "--samples",
+            value=mc.samples,
         )
     return mc
 
@@ -226,9 +228,11 @@ def emit_samples(mc: MonteCarloPlan, indices: list[int], out_dir: str | Path) ->
 
     for index in indices:
         if not 0 <= index < mc.samples:
-            raise InputError(f"--sample: expected 0 to {mc.samples - 1}, got {index}")
+            raise InputError(
+                f"expected 0 to {mc.samples - 1}, got {index}", key="--sample", value=index
+            )
     names = {index: f"sample_{index}.toml" for index in indices}
-    folder = claim(out_dir, names.values())
+    folder = claim(out_dir, names.values(), option="--emit-scenario")
     source = mc.loaded.path.name
     d = mc.dispersions
 

@@ -80,9 +80,11 @@ def check_folder(mc: MonteCarloPlan, out_dir: str | Path) -> None:
     free = shutil.disk_usage(where).free
     if need > DISK_SHARE * free:
         raise ResourceError(
-            f"--out {out_dir}: the table of {mc.samples:,} samples would take about "
+            f"{out_dir}: the table of {mc.samples:,} samples would take about "
             f"{need / 1e9:.3g} GB, and its disk has {free / 1e9:.3g} GB free: run fewer "
-            "samples or use another disk"
+            "samples or use another disk",
+            key="--out",
+            value=str(out_dir),
         )
 
 

@@ -157,23 +157,32 @@ def simulate(
     batch_size: int | None = None,
     progress: Callable[[int, int, int], None] | None = None,
     stage: Callable[[str], None] | None = None,
+    probed: bool = False,
 ) -> MonteCarloResult:
     """Run the samples of ``mc`` on Dask (see the module docstring).
 
     ``progress(done, total, failed)`` is called as batches finish; ``stage(text)``
-    says what is happening (the command line prints both to stderr).
+    says what is happening (the command line prints both to stderr); ``probed``: the
+    caller has checked ``scheduler`` and ``workers`` already
+    (:func:`attitude.montecarlo.cluster.check_where`).
     """
     import pandas
 
     stage = stage or (lambda text: None)
     if batch_size is not None and not 1 <= batch_size <= mc.samples:
-        raise InputError(f"--batch-size: expected 1 to {mc.samples}, got {batch_size}")
-    check_where(scheduler, workers)
+        raise InputError(
+            f"expected 1 to {mc.samples}, got {batch_size}", key="--batch-size", value=batch_size
+        )
+    if scheduler is not None and not probed:
+        stage(f"trying the Dask scheduler at {scheduler}")
+    count = check_where(scheduler, workers, probe=not probed)
     started = time.perf_counter()
     nominal, sample_s = _nominal(mc)
     stage(f"nominal run: {sample_s:.3g} s a sample")
     job = Job.of(mc)
-    with connect(scheduler, workers) as client:
+    if scheduler is None:
+        stage(f"starting a local Dask cluster of {count} worker processes")
+    with connect(scheduler, workers, probed=True) as client:
         threads = check_workers(client)
         overhead = task_overhead_s(client)
         size = batch_size or choose_batch_size(mc.samples, threads, sample_s, overhead)

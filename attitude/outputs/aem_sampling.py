@@ -124,9 +124,11 @@ def check_tolerance(tolerance_rad: float, name: str = "aem_tolerance") -> float:
     """``tolerance_rad`` if it is a usable AEM tolerance, else :class:`InputError`."""
     if not (MIN_TOLERANCE_RAD <= tolerance_rad <= MAX_TOLERANCE_RAD):
         raise InputError(
-            f"{name}: {tolerance_rad:g} rad is outside [{MIN_TOLERANCE_RAD:g}, "
+            f"{tolerance_rad:g} rad is outside [{MIN_TOLERANCE_RAD:g}, "
             f"{MAX_TOLERANCE_RAD:g}] rad (16-digit records hold 1e-15; beyond 0.1 rad an "
-            "interpolated attitude means little)"
+            "interpolated attitude means little)",
+            key=name,
+            value=tolerance_rad,
         )
     return float(tolerance_rad)
 
@@ -265,6 +267,16 @@ def _plan_segment(
         return AemSegmentPlan(index, start_s, end_s, 2, 1, 0.0)  # at rest: constant
     time_tags = rate * (_TIME_TAG_S + float(np.spacing(max(abs(end_s), 1.0))))
     if time_tags >= 0.5 * tolerance_rad:
+        # The rate's fault, and the key that set it (a runaway burn, a state's absurd
+        # rate), when even the default tolerance cannot be met; else the tolerance's
+        # (no key here: the caller's name for it).
+        if time_tags >= 0.5 * DEFAULT_TOLERANCE_RAD:
+            raise InputError(
+                f"segment {index} turns at up to {rate:.3g} rad/s: {time_tags:.2g} rad in the "
+                f"rounding of an AEM's 1 ns time tag, more than its {tolerance_rad:g} rad "
+                "tolerance allows: give a slower motion",
+                key=segment.rate_key,
+            )
         raise InputError(
             f"{tolerance_rad:g} rad is finer than 1 ns time tags allow for "
             f"segment {index}, which turns at up to {rate:.3g} rad/s ({time_tags:.2g} rad in "
@@ -327,8 +339,8 @@ def plan_aem(
         for a, b in zip([start, *cuts], [*cuts, end], strict=True):
             try:
                 plans.append(_plan_segment(index, segment, item, a, b, tolerance_rad))
-            except InputError as exc:
-                raise InputError(f"{name}: {exc}") from None
+            except InputError as exc:  # the tolerance's, unless it names the rate's key
+                raise (exc if exc.key else exc.located(key=name)) from None
     return AemPlan(tolerance_rad, plans)
 
 

@@ -180,23 +180,27 @@ def size_text(count: float) -> str:
     return _size(count)
 
 
-def check_fits(budget: OutputBudget, out_dir: str | Path | None = None) -> None:
+def check_fits(
+    budget: OutputBudget, out_dir: str | Path | None = None, shown: str | None = None
+) -> None:
     """Refuse (:class:`ResourceError`) a run whose pointing search is beyond
     :data:`MAX_SEARCH_GRID_POINTS`, that would not fit in :data:`MEMORY_SHARE` of the
     memory available, or in :data:`DISK_SHARE` of the free space of the disk that
-    holds ``out_dir`` (not checked when None)."""
+    holds ``out_dir`` (not checked when None; named ``shown`` in the error if given)."""
     grid = budget.search_grid_points
     if grid > MAX_SEARCH_GRID_POINTS:
         raise ResourceError(
-            f"output: the pointing's interval search would take {grid} samples (64 a turn "
+            f"the pointing's interval search would take {grid} samples (64 a turn "
             f"of the fastest rotation over the span; at most {MAX_SEARCH_GRID_POINTS} are "
-            "searched: hours of computing, and an interval a turn): use a shorter span"
+            "searched: hours of computing, and an interval a turn): use a shorter span",
+            key="output",
         )
     memory = available_memory_bytes()
     if budget.memory_bytes > MEMORY_SHARE * memory:
         raise ResourceError(
-            f"output: a run holds about {_size(budget.memory_bytes)} of memory whatever its "
-            f"span, and {_size(memory)} is available: free some memory"
+            f"a run holds about {_size(budget.memory_bytes)} of memory whatever its "
+            f"span, and {_size(memory)} is available: free some memory",
+            key="output",
         )
     if out_dir is None:
         return
@@ -204,8 +208,10 @@ def check_fits(budget: OutputBudget, out_dir: str | Path | None = None) -> None:
     if budget.disk_bytes > DISK_SHARE * free:
         largest = max(budget.files, key=budget.files.get)
         raise ResourceError(
-            f"output: {budget.samples} samples would take about {_size(budget.disk_bytes)} "
-            f"({largest} {_size(budget.files[largest])}), and the disk of {out_dir} has "
+            f"{budget.samples} samples would take about {_size(budget.disk_bytes)} "
+            f"({largest} {_size(budget.files[largest])}), and the disk of "
+            f"{shown or out_dir} has "
             f"{_size(free)} free: use a longer output.step, a shorter span, fewer --formats "
-            "(parquet is smaller than csv) or another disk"
+            "(parquet is smaller than csv) or another disk",
+            key="output.step",
         )

@@ -38,7 +38,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from attitude.base.errors import InputError
+from attitude.base.errors import OptionError
+from attitude.base.signals import STOPPING
 
 __all__ = ["MANIFEST_NAME", "OutputFolder", "OutputFolderError", "claim", "held_signals"]
 
@@ -47,11 +48,14 @@ _FORMAT = "attitude output manifest"
 _FORMAT_VERSION = 1
 _PARTIAL_PREFIX = ".attitude-partial-"
 _PARTIAL = re.compile(re.escape(_PARTIAL_PREFIX) + r"\d+")
-_HELD = (signal.SIGINT, signal.SIGTERM) + ((signal.SIGHUP,) if hasattr(signal, "SIGHUP") else ())
+_HELD = STOPPING
 
 
-class OutputFolderError(InputError):
-    """The output folder cannot be used without touching files that are not ours."""
+class OutputFolderError(OptionError):
+    """The output folder cannot be used without touching files that are not ours.
+
+    ``key`` is the command-line option that named the folder (``--out``,
+    ``--emit-scenario``) and ``value`` the folder as given: ``--out results: reason``."""
 
 
 @contextlib.contextmanager
@@ -67,7 +71,9 @@ def held_signals() -> Iterator[None]:
     previous = {}
     for number in _HELD:
         handler = signal.getsignal(number)
-        if handler is not None:  # None: set outside Python, and could not be restored
+        # None: set outside Python, and could not be restored; SIG_IGN: the caller's
+        # wish (nohup's SIGHUP), nothing to hold (attitude.base.signals).
+        if handler is not None and handler is not signal.SIG_IGN:
             previous[number] = signal.signal(number, lambda n, frame: received.append(n))
     try:
         yield
@@ -247,21 +253,27 @@ def _remove_partial(partial: Path, names: Collection[str]) -> None:
         partial.rmdir()
 
 
-def claim(out_dir: str | Path, names: Collection[str], dry_run: bool = False) -> OutputFolder:
+def claim(
+    out_dir: str | Path, names: Collection[str], dry_run: bool = False, option: str = "--out"
+) -> OutputFolder:
     """Check that ``out_dir`` can take a run's outputs without touching the user's files.
 
     ``names``: every file name the run may write.  Creates the folder if it does not
     exist (unless ``dry_run``: then nothing is created or cleaned, only checked).
-    Raises :class:`OutputFolderError` (one line, naming the path and the reason) if
-    the folder is not ours, and ``OSError`` if it cannot be created.
+    Raises :class:`OutputFolderError` (one line, naming ``option``, the path and the
+    reason) if the folder is not ours, and ``OSError`` if it cannot be created.
     """
     names = frozenset(names) | {MANIFEST_NAME}
     path = Path(out_dir).expanduser()
     shown = str(out_dir)
+
+    def refused(reason: str) -> OutputFolderError:
+        return OutputFolderError(reason, key=option, value=shown)
+
     if path.is_symlink() and not path.exists():
-        raise OutputFolderError(f"--out {shown}: a broken symbolic link")
+        raise refused("a broken symbolic link")
     if path.exists() and not path.is_dir():
-        raise OutputFolderError(f"--out {shown}: is a file, not a folder; attitude leaves it alone")
+        raise refused("is a file, not a folder; attitude leaves it alone")
     path = path.resolve()
     created: list[Path] = []
     if not path.exists() and dry_run:
@@ -286,8 +298,8 @@ def claim(out_dir: str | Path, names: Collection[str], dry_run: bool = False) ->
     if manifest is None:
         if entries:
             listed = ", ".join(entries[:3]) + (", ..." if len(entries) > 3 else "")
-            raise OutputFolderError(
-                f"--out {shown}: the folder holds files that attitude did not write "
+            raise refused(
+                "the folder holds files that attitude did not write "
                 f"({listed}); attitude writes only into a new or empty folder, or one it "
                 f"wrote before (with {MANIFEST_NAME}): choose another folder"
             )
@@ -304,14 +316,14 @@ def claim(out_dir: str | Path, names: Collection[str], dry_run: bool = False) ->
         if not os.path.lexists(file):
             continue
         if name not in accepted:
-            raise OutputFolderError(
-                f"--out {shown}: {name} is not listed in {MANIFEST_NAME}, so it is not "
+            raise refused(
+                f"{name} is not listed in {MANIFEST_NAME}, so it is not "
                 "attitude's: attitude will not replace it; move it or choose another folder"
             )
         digest = None if file.is_symlink() or not file.is_file() else _digest(file)
         if digest not in accepted[name]:
-            raise OutputFolderError(
-                f"--out {shown}: {name} was changed after attitude wrote it: attitude will "
+            raise refused(
+                f"{name} was changed after attitude wrote it: attitude will "
                 "not replace it; move it or choose another folder"
             )
         owned[name] = {"bytes": digest[0], "sha256": digest[1]}

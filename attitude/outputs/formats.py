@@ -55,17 +55,19 @@ def parse_formats(text: str | list | tuple, name: str = "--formats") -> tuple[st
     elif isinstance(text, list | tuple) and all(isinstance(item, str) for item in text):
         items = [item.strip().lower() for item in text]
     else:
-        raise InputError(f"{name}: expected format names, got {text!r}")
+        raise InputError(f"expected format names, got {text!r}", key=name, value=text)
     items = [item for item in items if item]
     if not items:
-        raise InputError(f"{name}: give one or more of {', '.join(FORMATS)}")
+        raise InputError(f"give one or more of {', '.join(FORMATS)}", key=name, value=text)
     unknown = [item for item in items if item not in FILES]
     if unknown:
         shown = repr(unknown[0])
         shown = shown if len(shown) <= 42 else shown[:40] + "...'"
         raise InputError(
-            f"{name}: unknown format {shown}: choose from {', '.join(FORMATS)} "
-            f"(comma-separated, e.g. {','.join(DEFAULT_FORMATS)})"
+            f"unknown format {shown}: choose from {', '.join(FORMATS)} "
+            f"(comma-separated, e.g. {','.join(DEFAULT_FORMATS)})",
+            key=name,
+            value=unknown[0],
         )
     return tuple(f for f in FORMATS if f in items)
 

@@ -84,9 +84,10 @@ def check_span(start_s: float, stop_s: float, name: str = "parquet") -> None:
     """Refuse a span that int64 TT nanoseconds since the epoch cannot count."""
     if max(abs(start_s), abs(stop_s)) >= MAX_SPAN_S:
         raise InputError(
-            f"{name}: the span reaches {stop_s / (365.25 * 86400):.0f} years from the epoch; "
+            f"the span reaches {stop_s / (365.25 * 86400):.0f} years from the epoch; "
             "the tt_ns column (int64 nanoseconds) counts 292: choose other --formats "
-            "or a shorter span"
+            "or a shorter span",
+            key=name,
         )
 
 

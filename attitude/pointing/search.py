@@ -279,8 +279,8 @@ def check_pointing(
     The orbit over the span (the source covers it, and stays above the ground: see
     each source's ``check_span``; a TLE far from its epoch is noted with its age),
     and the Sun and Moon ephemeris over the span with the margins the interpolation
-    adds.  Raises :class:`InputError` whose message starts with the key
-    (``pointing.tle: ...``, ``output: ...``); returns notes for the user and the
+    adds.  Raises :class:`InputError` whose ``key`` names the scenario key
+    (``pointing.tle``, ``output.duration``); returns notes for the user and the
     search grid of :func:`pointing_analysis` (None without pointing).
     """
     scenario = trajectory.scenario
@@ -293,36 +293,41 @@ def check_pointing(
         notes.append(f"pointing.interval_precision: {note}")
     margin = 600.0  # one node of the Sun and Moon ephemeris
     ends = np.array([scenario.start_s - margin, scenario.stop_s + margin])
-    try:
-        skyfield_times(scenario.times(ends), name="span")
-    except InputError as exc:
-        raise InputError(
-            f"output: the span with its {margin:g} s margins needs the Sun and the Moon over "
-            f"{scenario.format_epoch(ends[0])} to {scenario.format_epoch(ends[1])}: "
-            f"{str(exc).removeprefix('span: ')}"
-        ) from None
+    # The start of the span is placed by the scenario's epoch, its end by its length.
+    for end, key in zip(ends, ("scenario.epoch", scenario.end_key), strict=True):
+        try:
+            skyfield_times(scenario.times(end), name="span")
+        except InputError as exc:
+            raise InputError(
+                f"the span with its {margin:g} s margins needs the Sun and the Moon over "
+                f"{scenario.format_epoch(ends[0])} to {scenario.format_epoch(ends[1])}: "
+                f"{exc.reason}",
+                key=key,
+            ) from None
     orbit = spec.orbit
     if orbit is not None:
         notes += orbit.check_span(scenario.times(scenario.start_s), scenario.times(scenario.stop_s))
         try:
             τ, r, _ = _orbit_samples(trajectory, orbit, scenario.start_s, scenario.stop_s)
-        except InputError as exc:
-            raise InputError(f"{orbit.key}: {exc}") from None
+        except InputError as exc:  # the source's own key when it names one
+            raise (exc if exc.key else exc.located(key=orbit.key)) from None
         distance = np.linalg.norm(r, axis=-1)
         low = distance <= EARTH_EQUATORIAL_RADIUS_M
         if np.any(low):
             when = scenario.format_epoch(float(τ[np.argmax(low)]))
             raise InputError(
-                f"{orbit.key}: the orbit is inside the Earth at {when} "
+                f"the orbit is inside the Earth at {when} "
                 f"({float(distance[np.argmax(low)]) / 1e3:.1f} km from its centre, less than "
-                f"its {EARTH_EQUATORIAL_RADIUS_M / 1e3:g} km radius)"
+                f"its {EARTH_EQUATORIAL_RADIUS_M / 1e3:g} km radius)",
+                key=orbit.key,
             )
     grid = search_grid(trajectory, spec)
     if grid.count > MAX_SEARCH_POINTS:
         raise InputError(
-            f"output: the pointing's search needs {grid.count:.3g} points over the span "
+            f"the pointing's search needs {grid.count:.3g} points over the span "
             f"(every {grid.step_s:.3g} s: 64 a turn of the fastest rotation), more than the "
-            f"{MAX_SEARCH_POINTS:.0e} one run searches (about 20 µs a point): use a shorter span"
+            f"{MAX_SEARCH_POINTS:.0e} one run searches (about 20 µs a point): use a shorter span",
+            key=scenario.end_key,
         )
     return notes, grid
 

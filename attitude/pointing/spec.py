@@ -99,16 +99,24 @@ class BodyVector:
         if not isinstance(self.name, str) or not re.fullmatch(r"[A-Za-z][A-Za-z0-9_]*", self.name):
             raise InputError(
                 f"body vector name must be letters, digits and _ (it names CSV columns), "
-                f"got {self.name!r}"
+                f"got {self.name!r}",
+                key="name",
+                value=self.name,
             )
         vector = as_vector3(self.vector, "dimensionless", f"body vector {self.name!r}")
         norm = np.linalg.norm(vector)
         if not norm > 0.0:
-            raise InputError(f"body vector {self.name!r} must be non-zero, got {vector.tolist()}")
+            raise InputError(
+                f"body vector {self.name!r} must be non-zero, got {vector.tolist()}",
+                key="vector",
+                value=vector.tolist(),
+            )
         object.__setattr__(self, "vector", vector / norm)
         if self.kind not in KINDS:
             raise InputError(
-                f"body vector {self.name!r}: kind must be one of {KINDS}, got {self.kind!r}"
+                f"body vector {self.name!r}: kind must be one of {KINDS}, got {self.kind!r}",
+                key="kind",
+                value=self.kind,
             )
         for prefix, what, low in (
             ("sun_exclusion_half_angle", "sun exclusion half angle", 0.0),
@@ -183,12 +191,16 @@ class PointingSpec:
             )
         if not self.interval_precision_s > 0.0:
             raise InputError(
-                f"interval_precision must be positive, got {self.interval_precision_s!r} s"
+                f"must be positive, got {self.interval_precision_s!r} s",
+                key="interval_precision",
+                value=self.interval_precision_s,
             )
         height = as_si_scalar(self.earth_limb_atmosphere_height_m, "length", "atmosphere height")
         if not 0.0 <= height <= 1e6:
             raise InputError(
-                f"earth_limb_atmosphere_height must be between 0 and 1000 km, got {height:g} m"
+                f"must be between 0 and 1000 km, got {height:g} m",
+                key="earth_limb_atmosphere_height",
+                value=height,
             )
         object.__setattr__(self, "earth_limb_atmosphere_height_m", height)
         sequence = self.lvlh_euler_sequence
@@ -199,8 +211,10 @@ class PointingSpec:
             or sequence[1] == sequence[2]
         ):
             raise InputError(
-                "lvlh_euler_sequence must be three axes, all upper case (intrinsic) or all "
-                f"lower case (extrinsic), no axis twice in a row (ZYX, zxz...), got {sequence!r}"
+                "must be three axes, all upper case (intrinsic) or all "
+                f"lower case (extrinsic), no axis twice in a row (ZYX, zxz...), got {sequence!r}",
+                key="lvlh_euler_sequence",
+                value=sequence,
             )
 
     def check_orbit(self) -> None:
@@ -209,14 +223,25 @@ class PointingSpec:
         (:func:`for_scenario`), whose orbit it takes when it has none of its own."""
         if self.orbit is not None:
             return
-        needs = [v.name for v in self.body_vectors if v.earth_limb_exclusion_angle_rad]
+        needs = [
+            (index, v)
+            for index, v in enumerate(self.body_vectors)
+            if v.earth_limb_exclusion_angle_rad
+        ]
         if needs:
+            index, vector = needs[0]
             raise InputError(
-                f"body vector {needs[0]!r}: an earth limb exclusion needs an orbit "
-                "(a TLE, an OEM file or Keplerian elements)"
+                f"body vector {vector.name!r}: an earth limb exclusion needs an orbit "
+                "(a TLE, an OEM file or Keplerian elements)",
+                key=f"body_vectors[{index}].earth_limb_exclusion_angle",
+                value=vector.earth_limb_exclusion_angle_deg,
             )
         if self.lvlh_euler_sequence is not None:
-            raise InputError("lvlh_euler_sequence needs an orbit (LVLH is the orbit's frame)")
+            raise InputError(
+                "needs an orbit (LVLH is the orbit's frame)",
+                key="lvlh_euler_sequence",
+                value=self.lvlh_euler_sequence,
+            )
 
     @property
     def is_empty(self) -> bool:
@@ -244,11 +269,15 @@ def for_scenario(spec: PointingSpec, scenario: Scenario) -> PointingSpec:
             disagreement = orbit_disagreement(scenario.orbit, spec.orbit, scenario)
             if disagreement:
                 raise InputError(
-                    f"pointing.orbit: the PointingSpec's orbit is not the scenario's: "
+                    f"the PointingSpec's orbit is not the scenario's: "
                     f"{disagreement}; give the orbit once, Scenario(..., orbit=...), and "
-                    "leave it out of the PointingSpec"
+                    "leave it out of the PointingSpec",
+                    key="pointing.orbit",
                 )
-    spec.check_orbit()
+    try:
+        spec.check_orbit()
+    except InputError as exc:  # its keys are the [pointing] table's
+        raise exc.under("pointing") from None
     return spec
 
 

@@ -8,10 +8,14 @@ process made by ``fork`` (nothing to import again, nothing to send but the resul
 while the parent streams the outputs, and hands the result, or the exception the
 function raised, back through a pipe (pickled) when it is asked for.
 
-The child leaves nothing behind: it ignores nothing and handles no signal itself
-(SIGINT, SIGTERM and SIGHUP are back to their default action, so a Ctrl-C to the
-terminal's process group ends it silently, and the parent prints the run's one
-line), it is killed with its parent on Linux (``PR_SET_PDEATHSIG``), it never runs
+The child leaves nothing behind: it handles no signal itself (SIGINT, SIGTERM and
+SIGHUP are back to their default action, so a Ctrl-C to the terminal's process group
+ends it silently, and the parent prints the run's one line), except that it keeps
+ignoring what the caller had the run ignore (``nohup``'s SIGHUP, a background job's
+SIGINT: :func:`attitude.base.signals.keep_caller_dispositions`); a child a signal kills
+is reported by :meth:`Beside.result` as the run stopped by that signal
+(:class:`attitude.base.signals.Stopped`), not as an error of the function; it is
+killed with its parent on Linux (``PR_SET_PDEATHSIG``), it never runs
 the parent's exit handlers or flushes the parent's buffers (``os._exit``), and
 leaving the ``with`` block kills and reaps it if it is still running: an
 interrupted run has no child process left.  The function's result is the same bits
@@ -29,14 +33,12 @@ import sys
 from collections.abc import Callable
 from typing import Any, Generic, TypeVar, cast
 
+from attitude.base.signals import STOPPING, Stopped, keep_caller_dispositions
+
 __all__ = ["Beside"]
 
 T = TypeVar("T")
 
-# The signals the command line turns into "interrupted"/"terminated" (attitude.cli.main).
-_STOPPING = tuple(
-    getattr(signal, name) for name in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, name)
-)
 _PR_SET_PDEATHSIG = 1  # linux/prctl.h
 
 
@@ -60,7 +62,7 @@ class Beside(Generic[T]):
         sys.stdout.flush()
         sys.stderr.flush()
         # No signal between the fork and the child's default handlers: blocked meanwhile.
-        blocked = signal.pthread_sigmask(signal.SIG_BLOCK, _STOPPING)
+        blocked = signal.pthread_sigmask(signal.SIG_BLOCK, STOPPING)
         try:
             pid = os.fork()
         except OSError:
@@ -71,8 +73,7 @@ class Beside(Generic[T]):
         if pid == 0:  # the child
             try:
                 os.close(read)
-                for number in _STOPPING:
-                    signal.signal(number, signal.SIG_DFL)
+                keep_caller_dispositions()
                 _die_with(parent)
                 signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
                 _send(write, _outcome(self._function, self._args))
@@ -90,7 +91,11 @@ class Beside(Generic[T]):
             else:
                 assert self._read is not None  # open until the child is reaped
                 data = _receive(self._read)
-                self._reap(kill=False)
+                status = self._reap(kill=False)
+                if status is not None and os.WIFSIGNALED(status):
+                    # A signal the run did not get (sent to the child alone, or the
+                    # kernel's SIGKILL when memory runs out): the run is stopped by it.
+                    raise Stopped(os.WTERMSIG(status), "the process computing beside the run")
                 self._value = (
                     pickle.loads(data)
                     if data
@@ -105,7 +110,9 @@ class Beside(Generic[T]):
         """Kill and reap the child if it is still there."""
         self._reap(kill=True)
 
-    def _reap(self, kill: bool) -> None:
+    def _reap(self, kill: bool) -> int | None:
+        """Close the pipe, wait for the child (killed first if ``kill``); its wait
+        status, or None if it was reaped before."""
         if self._read is not None:
             os.close(self._read)
             self._read = None
@@ -113,8 +120,10 @@ class Beside(Generic[T]):
             if kill:
                 with contextlib.suppress(ProcessLookupError):
                     os.kill(self._pid, signal.SIGKILL)
-            os.waitpid(self._pid, 0)
+            _, status = os.waitpid(self._pid, 0)
             self._done = True
+            return status
+        return None
 
     def __enter__(self) -> Beside[T]:
         return self

@@ -12,12 +12,14 @@ error estimate of their step); a scenario with an orbit that leaves the gravity
 gradient out (torque-free, or burns alone) gets its validity horizon
 (``attitude.trajectory.horizon.validity_horizon``).  What it refuses, a run would have refused
 later, after computing; what it returns is what the run uses.  Errors are
-``attitude.base.errors.InputError`` whose message starts with the scenario key.
+``attitude.base.errors.InputError`` whose ``key`` is the scenario key that holds the
+bad value.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from attitude.base.errors import InputError
@@ -61,19 +63,24 @@ def plan_run(
     pointing: PointingSpec | None = None,
     outputs: OutputChoice | None = None,
     horizon: bool = True,
+    progress: Callable[[str], None] | None = None,
 ) -> RunPlan:
     """Check ``scenario`` (``pointing``, ``outputs``) as a run would, up to the sampling.
 
     ``horizon=False``: the validity horizon, when there is one, is not computed here
     (``horizon_deferred`` says it is wanted): a run computes it beside its outputs
     (``attitude.report.run``), since it checks nothing and takes as long as a day's outputs.
+    ``progress(text)`` is told each stage as it starts (the command line's stderr).
     """
+    say = progress or (lambda text: None)
     # The scenario's orbit, when the pointing gives none (the orbit is given once).
     pointing = for_scenario(pointing or PointingSpec(), scenario)
     outputs = outputs or OutputChoice()
     samples = scenario.output_count()
     if "parquet" in outputs:
         check_span(scenario.start_s, scenario.stop_s, "--formats parquet")
+    _check_gravity_gradient_orbit(scenario)
+    say(_propagating(scenario))
     trajectory = propagate(scenario)
     # The size and memory checks come before the analysis and the pointing checks,
     # which do not depend on the output grid but can take a while on a long span.
@@ -83,7 +90,10 @@ def plan_run(
         samples, 0, vectors, on_orbit, outputs.formats, aem_records=0, pointing_columns=columns
     )
     check_fits(budget)
+    say("analysing the motion (flips, nutation, spin, precession)")
     motion = analyze(trajectory)
+    if not pointing.is_empty:
+        say("checking the pointing: the orbit, the Sun and the Moon over the span")
     notes, search = check_pointing(trajectory, pointing)
     # Attitude laws: ground sites never seen, the Earth orientation table's coverage.
     guided = [n for s in trajectory.segments for n in getattr(s.solver, "notes", ())]
@@ -93,11 +103,14 @@ def plan_run(
         notes.append(undersampled)
     # The error estimates the summary states (each segment's, and the run's), checked here.
     errors = [getattr(s.solver, "error_estimate", 0.0) for s in trajectory.segments]
+    if scenario.torques.any:
+        say("estimating the propagation's error: the run again at twice each step")
     errors.append(trajectory.error_estimate)
     if not all(math.isfinite(error) for error in errors):
         raise InputError(
-            f"torques: the propagation has no finite error estimate ({errors}): "
-            "give a smaller step or an accuracy"
+            f"the propagation has no finite error estimate ({errors}): "
+            "give a smaller step or an accuracy",
+            key="torques",
         )
     found = None
     # On an orbit, unless the gravity gradient is modelled: a torque-free run, or burns
@@ -106,9 +119,11 @@ def plan_run(
     # Under a law the controller holds the attitude: only free segments neglect anything.
     wanted = wanted and any(s.solver.formula not in GUIDED for s in trajectory.segments)
     if wanted and horizon:
+        say("the validity horizon: the run again under the gravity gradient it leaves out")
         found = validity_horizon(trajectory, pointing.orbit)
     aem = None
     if "aem" in outputs:
+        say(f"choosing the AEM's records for {outputs.aem_tolerance_rad:g} rad")
         aem = plan_aem(
             trajectory,
             motion,
@@ -139,6 +154,27 @@ def plan_run(
         found,
         horizon_deferred=wanted and not horizon,
     )
+
+
+def _propagating(scenario: Scenario) -> str:
+    """The propagation stage in words: the segments, and how many are under torques."""
+    segments = len(scenario.events) + 1
+    text = f"propagating {segments} segment{'s' if segments > 1 else ''}"
+    what = []
+    if scenario.torques.gravity_gradient is not None:
+        what.append("gravity gradient")
+    if scenario.burns:
+        what.append(f"{len(scenario.burns)} burn{'s' if len(scenario.burns) > 1 else ''}")
+    return text + (f" under {' and '.join(what)} (splitting)" if what else "")
+
+
+def _check_gravity_gradient_orbit(scenario: Scenario) -> None:
+    """The orbit the gravity gradient is computed on covers the span (an OEM file that
+    ends early is refused here, naming its key, before the torqued propagation would
+    stop at the first step outside it); its notes are the pointing's to give."""
+    orbit = scenario.torques.gravity_gradient
+    if orbit is not None and hasattr(orbit, "check_span"):
+        orbit.check_span(scenario.times(scenario.start_s), scenario.times(scenario.stop_s))
 
 
 def horizon_beside(plan: RunPlan) -> Beside[ValidityHorizon] | None:

@@ -34,13 +34,13 @@ from __future__ import annotations
 import contextlib
 import math
 import time
-from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from attitude.base.progress import Progress
 from attitude.base.version import __version__
 from attitude.environment.epoch_texts import EpochTexts
 from attitude.environment.orbit import TleOrbit
@@ -97,18 +97,6 @@ __all__ = ["CHUNK_SAMPLES", "OUTPUT_NAMES", "Progress", "output_grid", "write_re
 CHUNK_SAMPLES = 16384
 # A progress line at most this often during the stream (seconds).
 _PROGRESS_EVERY_S = 2.0
-
-
-class Progress:
-    """Stage messages with the elapsed time, to a callable (stderr for the command line)."""
-
-    def __init__(self, write: Callable[[str], None] | None = None) -> None:
-        self._write = write
-        self._start = time.perf_counter()
-
-    def __call__(self, message: str) -> None:
-        if self._write is not None:
-            self._write(f"[{time.perf_counter() - self._start:7.1f} s] {message}")
 
 
 def output_grid(scenario: Scenario, first: int, stop: int) -> np.ndarray:

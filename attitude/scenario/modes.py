@@ -79,7 +79,9 @@ class Wheels:
     def __post_init__(self) -> None:
         if self.case not in WHEEL_CASES:
             raise InputError(
-                f"wheels.case must be one of {', '.join(WHEEL_CASES)}, got {self.case!r}"
+                f"must be one of {', '.join(WHEEL_CASES)}, got {self.case!r}",
+                key="wheels.case",
+                value=self.case,
             )
         momentum = as_vector3(self.momentum, "angular_momentum", "wheels.momentum")
         object.__setattr__(self, "momentum", momentum)
@@ -94,10 +96,12 @@ class Wheels:
         rate = float(np.linalg.norm(np.linalg.solve(inertia_tensor, self.momentum_vector)))
         if not rate <= MAX_WHEEL_RATE_RAD_S:
             raise InputError(
-                f"{key}.wheels.momentum: {np.asarray(self.momentum).tolist()} N m s would turn "
+                f"{np.asarray(self.momentum).tolist()} N m s would turn "
                 f"the body at {rate:.3g} rad/s ({rate * 30.0 / math.pi:.3g} rpm, |I⁻¹h|): no "
                 f"reaction wheel holds that much (at most {MAX_WHEEL_RATE_RAD_S:g} rad/s is "
-                "accepted); give the wheels' momentum in N m s"
+                "accepted); give the wheels' momentum in N m s",
+                key=f"{key}.wheels.momentum",
+                value=self.momentum_vector,
             )
 
     def describe(self) -> str:

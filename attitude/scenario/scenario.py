@@ -142,6 +142,12 @@ class InitialState:
         return cls(Rotation.from_matrix(a), **rate)
 
 
+def _epoch_key(epoch: Any) -> str:
+    """The key an event's or a burn's time was given as: ``epoch`` (a date) or ``offset``
+    (seconds after the scenario epoch)."""
+    return "epoch" if isinstance(epoch, str) or hasattr(epoch, "jd1") else "offset"
+
+
 class Scenario:
     """Everything needed to propagate: spacecraft, epoch, initial state, events, span.
 
@@ -219,21 +225,35 @@ class Scenario:
     def _set_epoch(self, epoch: Any) -> None:
         self.epoch = as_time(epoch, name="epoch")
         if not self.epoch.isscalar:
-            raise InputError(f"epoch must be a single epoch, got {len(self.epoch)} of them")
+            raise InputError(
+                f"must be a single epoch, got {len(self.epoch)} of them", key="epoch", value=epoch
+            )
         check_year_range(self.epoch, "epoch")
 
     def _set_span(self, stop: Any, duration: Any) -> None:
         """The end of the propagation, ``stop_s``: within 10,000 years and years 1–9999."""
         if (stop is None) == (duration is None):
             raise InputError("give exactly one of stop and duration")
+        # The scenario file's key for the end of the span, which errors about the span's
+        # length name (the ephemeris, the pointing's search, a step too fine for it).
+        self.end_key = "output.duration" if duration is not None else "output.stop"
         if duration is not None:
             self.stop_s = as_si_scalar(duration, "time", "duration")
         else:
             self.stop_s = float(tt_seconds(as_time(stop, self.time_scale, name="stop"), self.epoch))
+        # The span's errors name its end, ``stop`` (given as a stop or as a duration).
         if not self.stop_s > 0.0:
-            raise InputError(f"the span must end after the epoch, got {self.stop_s:g} s")
+            raise InputError(
+                f"the span must end after the epoch, got {self.stop_s:g} s",
+                key="stop",
+                value=self.stop_s,
+            )
         if self.stop_s > _LONGEST_SPAN_S:
-            raise InputError(f"the span must be shorter than 10,000 years, got {self.stop_s:g} s")
+            raise InputError(
+                f"the span must be shorter than 10,000 years, got {self.stop_s:g} s",
+                key="stop",
+                value=self.stop_s,
+            )
         with offline_time():
             end = time_from_tt_seconds(self.epoch, self.stop_s)
             check_year_range(getattr(end, self.time_scale), "stop")
@@ -246,32 +266,47 @@ class Scenario:
             self.start_s = float(tt_seconds(as_time(start, self.time_scale, "start"), self.epoch))
         if not 0.0 <= self.start_s < self.stop_s:
             raise InputError(
-                f"start must lie in [epoch, stop), got {self.start_s:g} s after the epoch "
-                f"(stop at {self.stop_s:g} s)"
+                f"must lie in [epoch, stop), got {self.start_s:g} s after the epoch "
+                f"(stop at {self.stop_s:g} s)",
+                key="start",
+                value=start,
             )
         span = self.stop_s - self.start_s
         self.step_s = span / 1000.0 if step is None else as_si_scalar(step, "time", "step")
         if not self.step_s > 0.0:
-            raise InputError(f"step must be positive, got {self.step_s:g} s")
+            raise InputError(
+                f"must be positive, got {self.step_s:g} s", key="step", value=self.step_s
+            )
         resolution = float(np.spacing(self.stop_s))
         if self.step_s < 4.0 * resolution:
             raise InputError(
-                f"step {self.step_s:g} s is below what TT seconds resolve at the end of the "
+                f"{self.step_s:g} s is below what TT seconds resolve at the end of the "
                 f"span ({self.stop_s:g} s, resolution {resolution:.3g} s): the output grid "
-                "would repeat epochs"
+                "would repeat epochs",
+                key="step",
+                value=self.step_s,
             )
 
     def _place_events(self, events: list[Event] | tuple[Event, ...]) -> None:
         """``events`` as (offset, event) in time order, stably; each within [0, stop]."""
         timed = []
         for index, event in enumerate(events):
-            offset = self._offset_in_span(event.epoch, f"events[{index}].epoch")
-            where = f"events[{index}] ({event.kind} at {self.format_epoch(offset)})"
+            key = f"events[{index}].{_epoch_key(event.epoch)}"
+            offset = self._offset_in_span(event.epoch, key)
+            what = f"the {event.kind} at {self.format_epoch(offset)}"
             if offset < 0.0:
-                raise InputError(f"{where} is before the scenario epoch {self.format_epoch(0.0)}")
+                raise InputError(
+                    f"{what} is before the scenario epoch {self.format_epoch(0.0)}",
+                    key=key,
+                    value=event.epoch,
+                )
             if offset > self.stop_s:
                 end = self.format_epoch(self.stop_s)
-                raise InputError(f"{where} is after the end of the propagation span {end}")
+                raise InputError(
+                    f"{what} is after the end of the propagation span {end}",
+                    key=key,
+                    value=event.epoch,
+                )
             timed.append((offset, index, event))
         timed.sort(key=lambda item: (item[0], item[1]))
         self.events: list[tuple[float, Event]] = [(offset, event) for offset, _, event in timed]
@@ -293,29 +328,38 @@ class Scenario:
         self.burns: list[PlacedBurn] = []
         for index, burn in enumerate(torques.burns):
             where = f"torques.burns[{index}]"
-            start_s = self._offset_in_span(burn.epoch, f"{where}.epoch")
+            key = f"{where}.{_epoch_key(burn.epoch)}"
+            start_s = self._offset_in_span(burn.epoch, key)
             if not 0.0 <= start_s < self.stop_s:
                 raise InputError(
-                    f"{where}.epoch: the burn starts at {self.format_epoch(start_s)}, outside "
-                    f"the span [{self.format_epoch(0.0)}, {self.format_epoch(self.stop_s)})"
+                    f"the burn starts at {self.format_epoch(start_s)}, outside "
+                    f"the span [{self.format_epoch(0.0)}, {self.format_epoch(self.stop_s)})",
+                    key=key,
+                    value=burn.epoch,
                 )
             # The momentum it adds, and the kinetic energy (~ H²/2I), must be floats.
             impulse = math.hypot(*burn.torque) * min(burn.duration, self.stop_s - start_s)
             if not math.isfinite(impulse * impulse):
                 raise InputError(
-                    f"{where}.torque: {burn.torque.tolist()} N m over the span is an angular "
-                    f"impulse of {impulse:.3g} N m s, beyond what floats hold (its square)"
+                    f"{burn.torque.tolist()} N m over the span is an angular "
+                    f"impulse of {impulse:.3g} N m s, beyond what floats hold (its square)",
+                    key=f"{where}.torque",
+                    value=burn.torque.tolist(),
                 )
             self.burns.append(PlacedBurn(start_s, start_s + burn.duration, burn, index))
         if torques.step is not None and torques.step > self.stop_s:
             raise InputError(
-                f"torques.step: {torques.step:g} s is longer than the span ({self.stop_s:g} s)"
+                f"{torques.step:g} s is longer than the span ({self.stop_s:g} s)",
+                key="torques.step",
+                value=torques.step,
             )
         if torques.step is not None and self.stop_s / torques.step > MAX_STEPS:
             raise InputError(
-                f"torques.step: {torques.step:g} s is {self.stop_s / torques.step:.3g} steps "
+                f"{torques.step:g} s is {self.stop_s / torques.step:.3g} steps "
                 f"over the span of {self.stop_s:g} s, more than {MAX_STEPS:g}: give a larger "
-                "step, an accuracy, or a shorter span"
+                "step, an accuracy, or a shorter span",
+                key="torques.step",
+                value=torques.step,
             )
 
     def _gravity_gradient_on_the_orbit(self, torques: ScenarioTorques) -> ScenarioTorques:
@@ -325,17 +369,20 @@ class Scenario:
         if source is True:
             if self.orbit is None:
                 raise InputError(
-                    "torques.gravity_gradient: True acts on the scenario's orbit, and it has "
-                    "none: give Scenario(..., orbit=...)"
+                    "True acts on the scenario's orbit, and it has none: give "
+                    "Scenario(..., orbit=...)",
+                    key="torques.gravity_gradient",
+                    value=True,
                 )
             return dataclasses.replace(torques, gravity_gradient=self.orbit)
         if source is not None and self.orbit is not None:
             disagreement = orbit_disagreement(self.orbit, source, self)
             if disagreement:
                 raise InputError(
-                    f"torques.gravity_gradient: its orbit is not the scenario's: "
+                    f"its orbit is not the scenario's: "
                     f"{disagreement}; give the orbit once, Scenario(..., orbit=...), and "
-                    "gravity_gradient=True"
+                    "gravity_gradient=True",
+                    key="torques.gravity_gradient",
                 )
         return torques
 

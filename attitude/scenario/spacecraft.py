@@ -27,9 +27,11 @@ def check_inertia(inertia: Any, name: str) -> PrincipalAxes:
     if violates_triangle_inequality(axes.moments):
         low, mid, high = np.sort(axes.moments)
         warnings.warn(
-            f"{name}: principal moments {axes.moments.tolist()} kg m² break the triangle "
-            f"inequality ({low:g} + {mid:g} < {high:g}): no real body has them",
-            InertiaWarning,
+            InertiaWarning(
+                f"principal moments {axes.moments.tolist()} kg m² break the triangle "
+                f"inequality ({low:g} + {mid:g} < {high:g}): no real body has them",
+                key=name,
+            ),
             stacklevel=3,
         )
     return axes
@@ -49,7 +51,9 @@ class Spacecraft:
 
     def __init__(self, name: str, inertia: Any) -> None:
         if not isinstance(name, str) or not name.strip():
-            raise InputError(f"spacecraft name must be a non-empty string, got {name!r}")
+            raise InputError(
+                f"spacecraft name must be a non-empty string, got {name!r}", key="name", value=name
+            )
         self._name = name
         self._axes = check_inertia(inertia, "inertia")
 

@@ -109,31 +109,39 @@ class ScenarioTorques:
         burns = tuple(self.burns)
         for index, burn in enumerate(burns):
             if not isinstance(burn, Burn):
-                raise InputError(f"torques.burns[{index}]: must be a Burn, got {burn!r}")
+                raise InputError(
+                    f"must be a Burn, got {burn!r}", key=f"torques.burns[{index}]", value=burn
+                )
         object.__setattr__(self, "burns", burns)
         if self.step is not None and self.accuracy is not None:
-            raise InputError("torques: give step or accuracy, not both")
+            raise InputError("give step or accuracy, not both", key="torques")
         if self.step is not None:
             step = as_si_scalar(self.step, "time", "torques.step")
             if not step > 0.0:
-                raise InputError(f"torques.step: must be positive (s), got {step!r}")
+                raise InputError(
+                    f"must be positive (s), got {step!r}", key="torques.step", value=step
+                )
             object.__setattr__(self, "step", step)
         if self.accuracy is not None:
             accuracy = as_si_scalar(self.accuracy, "angle", "torques.accuracy")
             low, high = _ACCURACY_RANGE_RAD
             if not low <= accuracy <= high:
                 raise InputError(
-                    f"torques.accuracy: must be between {low:g} and {high:g} rad, "
-                    f"got {accuracy!r} rad"
+                    f"must be between {low:g} and {high:g} rad, got {accuracy!r} rad",
+                    key="torques.accuracy",
+                    value=accuracy,
                 )
             object.__setattr__(self, "accuracy", accuracy)
         if isinstance(self.order, bool) or self.order not in (2, 4, 6):
-            raise InputError(f"torques.order: must be 2, 4 or 6, got {self.order!r}")
+            raise InputError(
+                f"must be 2, 4 or 6, got {self.order!r}", key="torques.order", value=self.order
+            )
         threshold = as_si_scalar(self.horizon_threshold, "angle", "torques.horizon_threshold")
         if not 0.0 < threshold < math.pi:
             raise InputError(
-                "torques.horizon_threshold: must be between 0 and 180 deg, "
-                f"got {math.degrees(threshold)!r} deg"
+                f"must be between 0 and 180 deg, got {math.degrees(threshold)!r} deg",
+                key="torques.horizon_threshold",
+                value=math.degrees(threshold),
             )
         object.__setattr__(self, "horizon_threshold", threshold)
         if self.gravity_gradient is False:
@@ -148,9 +156,11 @@ class ScenarioTorques:
             )
         ):
             raise InputError(
-                "torques.gravity_gradient: must be True (the scenario's orbit), an orbit "
+                "must be True (the scenario's orbit), an orbit "
                 "(position(times) or position_velocity(times)) or a callable t -> inertial "
-                f"position (m), got {self.gravity_gradient!r}"
+                f"position (m), got {self.gravity_gradient!r}",
+                key="torques.gravity_gradient",
+                value=self.gravity_gradient,
             )
 
     @property

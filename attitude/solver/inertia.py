@@ -53,7 +53,9 @@ def principal_axes(inertia: Any, name: str = "inertia") -> PrincipalAxes:
     array = as_si_array(inertia, "moment_of_inertia", name)
     if array.shape == (3,):
         if not np.all(array > 0.0):
-            raise InputError(f"{name}: principal moments must be positive, got {array.tolist()}")
+            raise InputError(
+                f"principal moments must be positive, got {array.tolist()}", key=name, value=inertia
+            )
         return PrincipalAxes(array.copy(), Rotation.identity(), np.diag(array))
     if array.shape != (3, 3):
         raise InputError(
@@ -62,19 +64,24 @@ def principal_axes(inertia: Any, name: str = "inertia") -> PrincipalAxes:
     asymmetry = np.max(np.abs(array - array.T))
     if asymmetry > _SYMMETRY_TOLERANCE * np.max(np.abs(array)):
         raise InputError(
-            f"{name}: tensor is not symmetric (|T - Tᵀ| = {asymmetry:.3g}): {array.tolist()}"
+            f"tensor is not symmetric (|T - Tᵀ| = {asymmetry:.3g}): {array.tolist()}",
+            key=name,
+            value=inertia,
         )
     tensor = 0.5 * (array + array.T)
     if np.all(tensor == np.diag(np.diag(tensor))):
         moments = np.diag(tensor).copy()
         if not np.all(moments > 0.0):
-            raise InputError(f"{name}: tensor is not positive definite: {tensor.tolist()}")
+            raise InputError(
+                f"tensor is not positive definite: {tensor.tolist()}", key=name, value=inertia
+            )
         return PrincipalAxes(moments, Rotation.identity(), tensor)
     moments, vectors = np.linalg.eigh(tensor)  # columns: principal axes in body coordinates
     if not np.all(moments > 0.0):
         raise InputError(
-            f"{name}: tensor is not positive definite (eigenvalues {moments.tolist()}): "
-            f"{tensor.tolist()}"
+            f"tensor is not positive definite (eigenvalues {moments.tolist()}): {tensor.tolist()}",
+            key=name,
+            value=inertia,
         )
     if np.linalg.det(vectors) < 0.0:
         vectors[:, 2] = -vectors[:, 2]  # a right-handed principal frame

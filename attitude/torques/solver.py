@@ -489,9 +489,11 @@ class TorquedSolver:
                     else ""
                 )
                 raise InputError(
-                    f"tolerance {tolerance:g} rad over {span:g} s would need a step below "
+                    f"{tolerance:g} rad over {span:g} s would need a step below "
                     f"{step:.3g} s, more than {_SEARCH_MAX_STEPS:g} steps{last}: give a step, "
-                    "a looser tolerance or a shorter span"
+                    "a looser tolerance or a shorter span",
+                    key="tolerance",
+                    value=tolerance,
                 )
             error, propagation = estimate(step)
             tried.append((step, error))
@@ -513,8 +515,10 @@ class TorquedSolver:
                 step *= min(0.8, max(0.125, factor))
         if good is None:
             raise InputError(
-                f"tolerance {tolerance:g} rad over {span:g} s not reached: the estimate was "
-                f"{tried[-1][1]:.3g} rad at a step of {tried[-1][0]:.3g} s"
+                f"{tolerance:g} rad over {span:g} s not reached: the estimate was "
+                f"{tried[-1][1]:.3g} rad at a step of {tried[-1][0]:.3g} s",
+                key="tolerance",
+                value=tolerance,
             )
         step, error, propagation = good
         self.step_choice = StepChoice(step, error, tolerance, span, tuple(tried), len(checks))

@@ -182,11 +182,12 @@ class GuidedMotion:
         law = bound.law
         if min(angle, math.pi - angle) < PARALLEL_LIMIT_RAD and isinstance(law, AlignConstrainLaw):
             raise DegenerateLawError(
-                f"{self.key}: the {law.name} law is undefined at "
+                f"the {law.name} law is undefined at "
                 f"{bound.epoch_text(self._closest[worst])} (t = {self._closest[worst]:.9g} s): "
                 f"its primary direction ({law.primary.describe()}) and secondary direction "
                 f"({law.secondary.describe()}) come within {angle:.3g} rad of each other "
-                f"(parallel within {PARALLEL_LIMIT_RAD:g} rad)"
+                f"(parallel within {PARALLEL_LIMIT_RAD:g} rad)",
+                key=self.key,
             )
 
     # ---- states
@@ -203,10 +204,10 @@ class GuidedMotion:
             return empty
         try:
             state = self.profile.state(τ)
-        except DegenerateLawError:
-            raise
-        except InputError as exc:
-            raise InputError(f"{self.key}: {exc}") from None
+        except InputError as exc:  # the law's own, named after its key
+            if exc.key or str(exc).startswith(self.key):
+                raise
+            raise exc.located(key=self.key) from None
         self._last = (τ.copy(), state)
         return state
 

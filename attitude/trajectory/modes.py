@@ -96,8 +96,9 @@ class _Builder:
 
     # ---- helpers
 
-    def where(self, index: int, offset: float, event: Any) -> str:
-        return f"events[{index}] ({event.kind} at {self.scenario.format_epoch(offset)})"
+    def at(self, event: Any, offset: float) -> str:
+        """An event in words, for reasons: "the control_loss at 2025-05-01T11:50:00 UTC"."""
+        return f"the {event.kind} at {self.scenario.format_epoch(offset)}"
 
     def step_for(self) -> float | None:
         k = len(self.segments)
@@ -113,7 +114,7 @@ class _Builder:
         self, profile: BoundLaw | Slew, inertia: PrincipalAxes, start: float, end: float, key: str
     ) -> GuidedMotion:
         motion = GuidedMotion(profile, inertia, start, end, key)
-        self.check_resolved(motion, start, end, key)
+        self.check_resolved(motion, start, end, key, "")
         return motion
 
     def visibility(self, motion: GuidedMotion) -> None:
@@ -194,36 +195,59 @@ class _Builder:
     # ---- the free stretches
 
     def free_stretch(
-        self, state: State, start: float, end: float, where: str, event: Any, before: State | None
+        self,
+        state: State,
+        start: float,
+        end: float,
+        where: tuple[str, str],
+        event: Any,
+        before: State | None,
     ) -> State:
+        """The free (or torqued) motion from ``state``; ``where``: (key, text), the key
+        that set its rate and the state in words, for errors about it."""
         if self.wheels is not None:
             solver = self.gyrostat(state, start, end, where)
         else:
-            solver = self.free_solver(state, start, end, where, self.step_for())
-        self.check_resolved(solver, start, end, where)
+            solver = self.free_solver(state, start, end, *where, self.step_for())
+        self.check_resolved(solver, start, end, *where)
         self.add(start, end, solver, state, event, before)
         return self.state_at(end)
 
-    def gyrostat(self, state: State, start: float, end: float, where: str) -> TorquedMotion:
+    def gyrostat(
+        self, state: State, start: float, end: float, where: tuple[str, str]
+    ) -> TorquedMotion:
         """The free body with spinning wheels from ``state`` (M total): the splitting
         with the gyroscopic flow, under the scenario's torques acting in [start, end]."""
         assert self.wheels is not None
-        acting = [m for a, b, m in self.models if a < end and b > start]
+        acting = [(m, k) for a, b, m, k in self.models if a < end and b > start]
         settings = self.scenario.torques
         step = self.step_for()
         if step is not None:
             settings = dataclasses.replace(settings, step=step, accuracy=None)
         elif settings.step is None and settings.accuracy is None:
             settings = dataclasses.replace(settings, accuracy=GYROSTAT_ACCURACY_RAD)
+        key, text = where
         if settings.order == 6:
             raise InputError(
-                f"torques.order: 6 keeps its order only without a gyroscopic term, and {where} "
-                "leaves the wheels spinning: give order 2 or 4"
+                f"6 keeps its order only without a gyroscopic term, and {text} leaves the "
+                "wheels spinning: give order 2 or 4",
+                key="torques.order",
+                value=6,
             )
         try:
-            return TorquedMotion(state, start, end, acting, settings, self.wheels.momentum_vector)
+            return TorquedMotion(
+                state,
+                start,
+                end,
+                [m for m, _ in acting],
+                settings,
+                [k for _, k in acting],
+                self.wheels.momentum_vector,
+            )
         except InputError as exc:
-            raise InputError(f"{where}: {exc}") from None
+            if exc.key is not None:
+                raise
+            raise InputError(f"{text}: {exc.reason}", key=key) from None
 
     # ---- the walk
 
@@ -248,13 +272,16 @@ class _Builder:
             else:
                 assert initial.angular_velocity is not None
                 m0 = axes.tensor @ initial.angular_velocity
+            given = (
+                "angular_velocity" if initial.angular_velocity is not None else "angular_momentum"
+            )
+            where = (f"initial_state.{given}", "")
             state = self.free_stretch(
-                State(initial.attitude, m0, axes), 0.0, first_end, "initial_state", None, None
+                State(initial.attitude, m0, axes), 0.0, first_end, where, None, None
             )
             guided = False
         for k, ((offset, event), index) in enumerate(zip(scenario.events, indices, strict=True)):
             end = ends[k + 1]
-            where = self.where(index, offset, event)
             following = (
                 f"the next event, events[{indices[k + 1]}]"
                 if k + 1 < len(indices)
@@ -262,12 +289,12 @@ class _Builder:
             )
             before = state
             if guided:
-                state, guided = self.on_guided(event, index, where, before, offset, end, following)
+                state, guided = self.on_guided(event, index, before, offset, end, following)
             else:
-                state, guided = self.on_free(event, index, where, before, offset, end, following)
+                state, guided = self.on_free(event, index, before, offset, end, following)
         return self.segments
 
-    def on_guided(self, event, index, where, before, offset, end, following):
+    def on_guided(self, event, index, before, offset, end, following):
         key = f"events[{index}]"
         if isinstance(event, ModeChange):
             self.law_key = f"{key}.law"
@@ -294,19 +321,21 @@ class _Builder:
             momentum = before.inertia.tensor @ rate + wheels.momentum_vector
             after = State(before.attitude, momentum, before.inertia)
             self.wheels = wheels if wheels.case == "spinning" else None
-            where_after = f"the state after {where}"
-            return self.free_stretch(after, offset, end, where_after, event, before), False
+            where = (f"{key}.wheels", f"the state after {self.at(event, offset)}")
+            return self.free_stretch(after, offset, end, where, event, before), False
         if isinstance(event, ControlResume):
             raise InputError(
-                f"{where}: control is not lost at that epoch (a law holds the attitude): use "
-                "mode_change to change law"
+                f"{self.at(event, offset)}: control is not lost there (a law holds the "
+                "attitude): use mode_change to change law",
+                key=key,
             )
         raise InputError(
-            f"{where}: an {event.kind} needs a free body, and a law holds the attitude at "
-            "that epoch (its controller would absorb it): put a control_loss before it"
+            f"{self.at(event, offset)}: an {event.kind} needs a free body, and a law holds "
+            "the attitude there (its controller would absorb it): put a control_loss before it",
+            key=key,
         )
 
-    def on_free(self, event, index, where, before, offset, end, following):
+    def on_free(self, event, index, before, offset, end, following):
         key = f"events[{index}]"
         if isinstance(event, ControlResume):
             self.wheels = None  # the controller has the wheels again
@@ -330,7 +359,9 @@ class _Builder:
                 else "it is already lost"
             )
             raise InputError(
-                f"{where}: control is lost at that epoch (since an earlier control_loss): {advice}"
+                f"{self.at(event, offset)}: control is lost there (since an earlier "
+                f"control_loss): {advice}",
+                key=key,
             )
         after = event.apply(before)
         if (
@@ -340,8 +371,20 @@ class _Builder:
         ):  # the total momentum of a gyrostat turning at ω is Iω + h
             momentum = after.angular_momentum + self.wheels.momentum_vector
             after = State(after.attitude, momentum, after.inertia)
-        state = self.free_stretch(after, offset, end, f"the state after {where}", event, before)
+        where = (_rate_key(key, event), f"the state after {self.at(event, offset)}")
+        state = self.free_stretch(after, offset, end, where, event, before)
         return state, False
+
+
+def _rate_key(key: str, event: Any) -> str:
+    """The key of an event that set the free body's rate (an impulse, a reset's rate),
+    or the event's table."""
+    if event.kind == "angular_impulse":
+        return f"{key}.impulse"
+    for name in ("angular_velocity", "angular_momentum"):
+        if event.kind == "attitude_reset" and getattr(event, name, None) is not None:
+            return f"{key}.{name}"
+    return key
 
 
 def mode_segments(
@@ -355,8 +398,10 @@ def mode_segments(
     as (start, end, solver, state, event, before).
 
     ``steps``: per segment, the torqued solver's step (None: as the scenario says);
-    ``free_solver(state, t0, end, where, step)``: the free or torqued solver from a
-    state; ``check_resolved(solver, t0, end, where)``: refuses motion too fast for TT
-    seconds; ``models``: the scenario's torques as (start, stop, model).
+    ``free_solver(state, t0, end, key, text, step)``: the free or torqued solver from a
+    state, errors about the state named by ``key`` (the scenario key that set its rate)
+    and ``text`` (the state in words); ``check_resolved(solver, t0, end, key, text)``:
+    refuses motion too fast for TT seconds; ``models``: the scenario's torques as
+    (start, stop, model, key).
     """
     return _Builder(scenario, steps, free_solver, check_resolved).build(models)

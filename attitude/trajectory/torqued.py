@@ -45,18 +45,22 @@ _SHORTEST_SEARCH_S = 1e-6
 _CHECKS = 32
 
 
-def scenario_torque_models(scenario: Scenario) -> list[tuple[float, float, Torque]]:
+def scenario_torque_models(scenario: Scenario) -> list[tuple[float, float, Torque, str]]:
     """The scenario's torques as models, each with the span [start, stop) it acts in
-    (TT seconds since the epoch; the gravity gradient over the whole span)."""
+    (TT seconds since the epoch; the gravity gradient over the whole span) and the
+    scenario key that gives it (``torques.burns[2].torque``, ``torques.gravity_gradient``),
+    which errors it causes name."""
     torques: ScenarioTorques = scenario.torques
-    models: list[tuple[float, float, Torque]] = []
+    models: list[tuple[float, float, Torque, str]] = []
     if torques.gravity_gradient is not None:
         gradient = GravityGradient(_position_source(torques.gravity_gradient, scenario))
-        models.append((-math.inf, math.inf, gradient))
+        models.append((-math.inf, math.inf, gradient, "torques.gravity_gradient"))
     for placed in scenario.burns:
         burn = placed.burn
         model = ConstantTorque(burn.torque, placed.start_s, placed.stop_s, burn.frame)
-        models.append((placed.start_s, placed.stop_s, model))
+        models.append(
+            (placed.start_s, placed.stop_s, model, f"torques.burns[{placed.index}].torque")
+        )
     return models
 
 
@@ -96,7 +100,12 @@ class _OrbitAtEpoch:
 
 
 def _refuse_a_long_search(
-    state: State, t0: float, span: float, torques, wheel_momentum: NDArray | None = None
+    state: State,
+    t0: float,
+    span: float,
+    torques,
+    keys: list[str | None],
+    wheel_momentum: NDArray | None = None,
 ) -> None:
     """Refuse a step search whose first try alone would take more than MAX_STEPS steps.
 
@@ -104,31 +113,56 @@ def _refuse_a_long_search(
     body (at most a fortieth of the orbit) and at twice that; the body's fastest turn
     is bounded by |ω| ≤ √(2T/I_min) at the start, and by |ω| ≤ |m|/I_min with
     |m| ≤ |m0| + ∫|τ| dt later: the burns within the span may spin the body up.
+    The error names the burn (its key in ``keys``, beside ``torques``) when the body
+    would be slow enough without the burns' impulse, else ``torques.accuracy``: the
+    accuracy asked for over this span.
     """
     I_min = float(np.min(state.inertia.moments))
-    rate = math.sqrt(2.0 * state.kinetic_energy / I_min)
+    own_rate = math.sqrt(2.0 * state.kinetic_energy / I_min)
     if wheel_momentum is not None:  # the gyroscopic turn |I⁻¹h| (attitude.torques.gyrostat)
         gyroscopic = np.linalg.solve(state.inertia.tensor, wheel_momentum)
-        rate = max(rate, float(np.linalg.norm(gyroscopic)))
-    impulse = sum(
-        float(np.linalg.norm(torque.torque))
-        * max(0.0, min(torque.stop, t0 + span) - max(torque.start, t0))
-        for torque in torques
+        own_rate = max(own_rate, float(np.linalg.norm(gyroscopic)))
+    impulses = [
+        (
+            float(np.linalg.norm(torque.torque))
+            * max(0.0, min(torque.stop, t0 + span) - max(torque.start, t0)),
+            key,
+        )
+        for torque, key in zip(torques, keys, strict=True)
         if isinstance(torque, ConstantTorque)
-    )
+    ]
+    impulse = sum(size for size, _ in impulses)
+    rate = own_rate
     if impulse > 0.0:
         rate = max(rate, (float(np.linalg.norm(state.angular_momentum)) + impulse) / I_min)
-    first = [0.5 * 2.0 * math.pi / rate / 4.0] if rate > 0.0 else []
-    for torque in torques:
-        if isinstance(torque, GravityGradient):
-            radius = float(np.linalg.norm(torque.position(np.array([t0]))[0]))
-            first.append(0.5 * 2.0 * math.pi * math.sqrt(radius**3 / torque.mu) / 20.0)
-    if first and span / min(first) * 1.5 > MAX_STEPS:
+
+    def quarter_turns(rate: float) -> list[float]:
+        return [0.5 * 2.0 * math.pi / rate / 4.0] if rate > 0.0 else []
+
+    orbits = [
+        0.5 * 2.0 * math.pi * math.sqrt(radius**3 / torque.mu) / 20.0
+        for torque in torques
+        if isinstance(torque, GravityGradient)
+        for radius in [float(np.linalg.norm(torque.position(np.array([t0]))[0]))]
+    ]
+    first = quarter_turns(rate) + orbits
+    if not (first and span / min(first) * 1.5 > MAX_STEPS):
+        return
+    steps = f"{span / min(first) * 1.5:.3g} steps of {min(first):.3g} s (more than {MAX_STEPS:g})"
+    without_burns = quarter_turns(own_rate) + orbits
+    burn_size, burn_key = max(impulses, key=lambda item: item[0], default=(0.0, None))
+    if burn_key and not (without_burns and span / min(without_burns) * 1.5 > MAX_STEPS):
         raise InputError(
-            f"torques.accuracy: choosing the step over {span:g} s would start with "
-            f"{span / min(first) * 1.5:.3g} steps of {min(first):.3g} s (more than "
-            f"{MAX_STEPS:g}): give torques.step, or a shorter span"
+            f"the burns spin the body up to {rate:.3g} rad/s (this one adds {burn_size:.3g} "
+            f"N m s): choosing the step for torques.accuracy over {span:g} s would start "
+            f"with {steps}: give a smaller torque, torques.step, or a shorter span",
+            key=burn_key,
         )
+    raise InputError(
+        f"choosing the step over {span:g} s would start with {steps}: give torques.step, "
+        "or a shorter span",
+        key="torques.accuracy",
+    )
 
 
 class TorquedMotion:
@@ -151,6 +185,7 @@ class TorquedMotion:
         end_s: float,
         torques: list[Torque],
         settings: ScenarioTorques,
+        keys: list[str | None] | None = None,
         wheel_momentum: NDArray[np.float64] | None = None,
     ) -> None:
         self.state = state
@@ -163,19 +198,24 @@ class TorquedMotion:
         span = self.end_s - t0
         options: dict[str, Any] = {"order": settings.order}
         if settings.step is None and span > _SHORTEST_SEARCH_S:
-            _refuse_a_long_search(state, t0, span, self.torques, wheel_momentum)
+            keys = list(keys) if keys is not None else [None] * len(self.torques)
+            _refuse_a_long_search(state, t0, span, self.torques, keys, wheel_momentum)
             options.update(tolerance=settings.accuracy_rad, span=span)
         else:
             options["step"] = settings.step if settings.step is not None else max(span, 1.0)
-        self.solver = TorquedSolver(
-            state.inertia.tensor,
-            state.angular_momentum,
-            state.attitude,
-            t0,
-            list(torques),
-            wheel_momentum=wheel_momentum,
-            **options,
-        )
+        try:
+            self.solver = TorquedSolver(
+                state.inertia.tensor,
+                state.angular_momentum,
+                state.attitude,
+                t0,
+                list(torques),
+                wheel_momentum=wheel_momentum,
+                **options,
+            )
+        except InputError as exc:  # the solver's names for the scenario's settings
+            named = {"tolerance": "torques.accuracy", "step": "torques.step"}
+            raise (exc.located(key=named[exc.key]) if exc.key in named else exc) from None
         self._last: tuple[NDArray, NDArray, NDArray] | None = None
 
     # ---- states

@@ -30,6 +30,7 @@ from attitude.environment.timescales import SAME_INSTANT_S, tt_seconds
 from attitude.scenario.events import Event, State
 from attitude.scenario.scenario import Scenario
 from attitude.solver.euler_solver import EulerSolver
+from attitude.torques.models import ConstantTorque
 from attitude.torques.solver import angles_between
 from attitude.trajectory.guided import GuidedMotion
 from attitude.trajectory.modes import mode_segments, uses_laws
@@ -49,7 +50,10 @@ class Segment:
     """One stretch of torque-free motion: [start_s, end_s] in TT seconds since the epoch.
 
     ``event`` is the event that started it (None for the first segment); ``before``
-    and ``after`` are the states on either side of that event.
+    and ``after`` are the states on either side of that event.  ``rate_key``: the
+    scenario key that sets how fast the body turns in it, for errors that are about
+    that rate (the state's ``initial_state.angular_velocity``, ``events[i].impulse``,
+    or the burn that spins it up, ``torques.burns[i].torque``).
     """
 
     start_s: float
@@ -58,67 +62,163 @@ class Segment:
     state: State
     event: Event | None = None
     before: State | None = None
+    rate_key: str | None = None
 
 
 # The time representation must resolve this fraction of the fastest turn of the body.
 _RESOLVED_FRACTION_OF_A_TURN = 1e-3
 
 
+@dataclass(frozen=True)
+class _Where:
+    """The state a segment starts from, as errors name it: ``key``, the scenario key
+    that gave its rate (``initial_state.angular_velocity``, ``events[2].impulse``), and
+    ``text``, the state in words for the reason (empty for the initial state)."""
+
+    key: str
+    text: str = ""
+
+    def error(self, reason: str) -> InputError:
+        return InputError(f"{self.text}: {reason}" if self.text else reason, key=self.key)
+
+
+def _initial_where(scenario: Scenario) -> _Where:
+    given = "angular_velocity" if scenario.initial_state.angular_velocity is not None else None
+    return _Where(f"initial_state.{given or 'angular_momentum'}")
+
+
+def _event_where(scenario: Scenario, index: int, offset: float, event: Event) -> _Where:
+    """events[index]: its key that changed the rate (an impulse, a reset's new rate), or
+    the event's table (an inertia change: moments or a tensor)."""
+    key = f"events[{index}]"
+    if event.kind == "angular_impulse":
+        key += ".impulse"
+    elif event.kind == "attitude_reset":
+        for name in ("angular_velocity", "angular_momentum"):
+            if getattr(event, name, None) is not None:
+                key += f".{name}"
+    return _Where(key, f"the state after the {event.kind} at {scenario.format_epoch(offset)}")
+
+
+def _acting(models: list, t0: float, end_s: float) -> list[tuple[Any, str]]:
+    """The torque models (and their keys) that act within [t0, end_s]."""
+    return [(model, key) for start, stop, model, key in models if start < end_s and stop > t0]
+
+
 def _solver(
     state: State,
     t0: float,
     end_s: float,
-    where: str,
+    where: _Where,
     scenario: Scenario,
     models: list,
     step: float | None = None,
 ) -> EulerSolver | TorquedMotion:
     """The exact solver from ``state`` at ``t0``, or the torqued one if a torque acts
-    within [t0, end_s] (``models``: (start, stop, torque) of the scenario), at ``step``
-    if given, else as the scenario's torques say."""
-    acting = [model for start, stop, model in models if start < end_s and stop > t0]
+    within [t0, end_s] (``models``: (start, stop, torque, key) of the scenario), at
+    ``step`` if given, else as the scenario's torques say.  An error that names no key
+    (the solver refuses the state) is the state's, ``where``."""
+    acting = _acting(models, t0, end_s)
     try:
         if acting:
+            _check_resolved_at_start(state, t0, end_s, where)
             settings = scenario.torques
             if step is not None:
                 settings = dataclasses.replace(settings, step=step, accuracy=None)
-            return TorquedMotion(state, t0, end_s, acting, settings)
+            torques = [model for model, _ in acting]
+            return TorquedMotion(state, t0, end_s, torques, settings, [k for _, k in acting])
         return EulerSolver(state.inertia.tensor, state.angular_momentum, state.attitude, t0=t0)
     except InputError as exc:
-        raise InputError(f"{where}: {exc}") from None
+        if exc.key is not None:  # a torque's key, or the orbit's: the value that is bad
+            raise
+        raise where.error(exc.reason) from None
 
 
-def _check_resolved(
-    solver: EulerSolver | TorquedMotion, start_s: float, end_s: float, where: str
-) -> None:
-    """Refuse a motion faster than TT seconds (floats) can follow over [start_s, end_s].
+def _strongest_burn(models: list, t0: float, end_s: float) -> str | None:
+    """The key of the burn that adds the most momentum within [t0, end_s], or None."""
+    burns = [
+        (float(np.linalg.norm(model.torque)) * (min(model.stop, end_s) - max(model.start, t0)), key)
+        for model, key in _acting(models, t0, end_s)
+        if isinstance(model, ConstantTorque)
+    ]
+    return max(burns, key=lambda item: item[0])[1] if burns else None
+
+
+def _resolution_error(
+    where: _Where, G: float, I_min: float, period: float, start_s: float, end_s: float
+) -> InputError | None:
+    """The error for a motion faster than TT seconds (floats) follow over [start_s,
+    end_s], or None.
 
     The body turns at most at |ω| ≤ G/I_min, once every 2π I_min/G seconds, and m(t)
     repeats every period T.  Where the spacing of floats near end_s exceeds a
     thousandth of the shorter of the two, every output would be noise: the elliptic
     phase λt, exact for the t given, is exact for a t that no one meant.
     """
+    if G == 0.0:
+        return None
+    turn_s = 2.0 * math.pi * (I_min / G)
+    fastest = min(turn_s, period)
+    resolution = float(np.spacing(max(abs(start_s), abs(end_s))))
+    if resolution <= _RESOLVED_FRACTION_OF_A_TURN * fastest:
+        return None
+    return where.error(
+        f"the body turns in {fastest:.3g} s, too fast for TT seconds over "
+        f"this span (they resolve {resolution:.3g} s at {end_s:g} s, and a thousandth "
+        f"of a turn is needed): give a slower rate or a shorter span"
+    )
+
+
+def _check_resolved_at_start(state: State, start_s: float, end_s: float, where: _Where) -> None:
+    """Refuse a state that turns too fast for TT seconds before any torque acts on it
+    (:func:`_resolution_error` at the state's own rate): the state, not a torque, is
+    what is wrong, and the torqued solver would only spend its step search finding so."""
+    G = float(np.linalg.norm(state.angular_momentum))
+    if not math.isfinite(G):
+        raise where.error("the angular momentum is beyond the float range")
+    I_min = float(np.min(state.inertia.moments))
+    error = _resolution_error(where, G, I_min, math.inf, start_s, end_s)
+    if error is not None:
+        raise error
+
+
+def _check_resolved(
+    solver: EulerSolver | TorquedMotion,
+    start_s: float,
+    end_s: float,
+    where: _Where,
+    burn: str | None = None,
+) -> None:
+    """Refuse a motion faster than TT seconds (floats) can follow over [start_s, end_s]
+    (:func:`_resolution_error`).  Under torques the bound is the largest over the
+    segment: when the state was slow enough at its start (checked before), the burn
+    ``burn`` (the key of the segment's strongest) spun it up."""
+    if burn is not None:
+        where = _Where(burn, "spun up by the burns")
     try:
         G = solver.angular_momentum_norm  # under torques: the grid over the segment
     except InputError as exc:
-        raise InputError(f"{where}: {exc}") from None
+        raise (exc if exc.key else where.error(exc.reason)) from None
     if not math.isfinite(G):
-        raise InputError(
-            f"{where}: under the torques, the angular momentum goes beyond the float range"
-        )
-    if G == 0.0:
-        return
-    turn_s = 2.0 * math.pi * (float(np.min(solver.moments_of_inertia)) / G)
-    fastest = min(turn_s, solver.period)
-    resolution = float(np.spacing(max(abs(start_s), abs(end_s))))
-    if not resolution <= _RESOLVED_FRACTION_OF_A_TURN * fastest:
-        raise InputError(
-            f"{where}: the body turns in {fastest:.3g} s, too fast for TT seconds over "
-            f"this span (they resolve {resolution:.3g} s at {end_s:g} s, and a thousandth "
-            f"of a turn is needed): give a slower rate or a shorter span"
-        )
+        raise where.error("under the torques, the angular momentum goes beyond the float range")
+    I_min = float(np.min(solver.moments_of_inertia))
+    error = _resolution_error(where, G, I_min, solver.period, start_s, end_s)
+    if error is not None:
+        raise error
     if not math.isfinite(solver.kinetic_energy):
-        raise InputError(f"{where}: the kinetic energy is beyond the float range")
+        raise where.error("the kinetic energy is beyond the float range")
+
+
+def _rate_key(
+    solver: EulerSolver | TorquedMotion, state: State, where: _Where, burn: str | None
+) -> str:
+    """The key that sets the segment's fastest turn: the burn when the burns at least
+    double the momentum the segment starts with, else the state's."""
+    if burn is not None and solver.angular_momentum_norm > 2.0 * float(
+        np.linalg.norm(state.angular_momentum)
+    ):
+        return burn
+    return where.key
 
 
 def propagate(scenario: Scenario, steps: list[float | None] | None = None) -> Trajectory:
@@ -126,19 +226,28 @@ def propagate(scenario: Scenario, steps: list[float | None] | None = None) -> Tr
 
     ``steps``: per segment, the torqued solver's step (None: as the scenario says), to
     rerun a torqued trajectory at other steps (:attr:`Trajectory.error_estimate`).
-    Raises :class:`InputError` naming the state (``initial_state`` or ``events[i]``)
-    whose motion the solver refuses, or that turns too fast for TT seconds (floats)
-    to follow over the span.
+    Raises :class:`InputError` whose ``key`` names what holds the bad value: the
+    state (``initial_state.angular_velocity``, ``events[i].impulse``) whose motion the
+    solver refuses, or that turns too fast for TT seconds (floats) to follow over the
+    span; a burn (``torques.burns[i].torque``) that spins the body up that fast; the
+    torques' settings or the orbit the gravity gradient needs.
     """
     models = scenario_torque_models(scenario) if scenario.torques.any else []
     if uses_laws(scenario):  # laws, slews and control losses: attitude.trajectory.modes
         raw = mode_segments(
             scenario,
             steps or [],
-            lambda state, t0, end, where, step: _solver(
-                state, t0, end, where, scenario, models, step
+            lambda state, t0, end, key, text, step: _solver(
+                state, t0, end, _Where(key, text), scenario, models, step
             ),
-            _check_resolved,
+            lambda solver, t0, end, key, text: _check_resolved(
+                solver,
+                t0,
+                end,
+                _Where(key, text),
+                # Under a law its controller takes the burns: they spin up free bodies only.
+                None if isinstance(solver, GuidedMotion) else _strongest_burn(models, t0, end),
+            ),
             models,
         )
         return Trajectory(scenario, [Segment(*item) for item in raw])
@@ -154,24 +263,30 @@ def propagate(scenario: Scenario, steps: list[float | None] | None = None) -> Tr
     starts: list[tuple[float, State, Event | None, State | None]] = [(0.0, state, None, None)]
     ends = [offset for offset, _ in scenario.events] + [scenario.stop_s]
     steps = steps or [None] * len(ends)
-    solver = _solver(state, 0.0, ends[0], "initial_state", scenario, models, steps[0])
-    _check_resolved(solver, 0.0, ends[0], "initial_state")
+    where = _initial_where(scenario)
+    solver = _solver(state, 0.0, ends[0], where, scenario, models, steps[0])
+    burn = _strongest_burn(models, 0.0, ends[0])
+    _check_resolved(solver, 0.0, ends[0], where, burn)
     solvers = [solver]
+    rate_keys = [_rate_key(solver, state, where, burn)]
     indices = getattr(scenario, "event_indices", range(len(scenario.events)))
     for k, ((offset, event), index, end) in enumerate(
         zip(scenario.events, indices, ends[1:], strict=True), start=1
     ):
-        where = f"events[{index}] ({event.kind} at {scenario.format_epoch(offset)})"
         before = State(solver.attitude(offset), solver.angular_momentum(offset), state.inertia)
         state = event.apply(before)
-        where = f"the state after {where}"
+        where = _event_where(scenario, index, offset, event)
         solver = _solver(state, offset, end, where, scenario, models, steps[k])
-        _check_resolved(solver, offset, end, where)
+        burn = _strongest_burn(models, offset, end)
+        _check_resolved(solver, offset, end, where, burn)
         solvers.append(solver)
+        rate_keys.append(_rate_key(solver, state, where, burn))
         starts.append((offset, state, event, before))
     segments = [
-        Segment(start, end, solver, state, event, before)
-        for (start, state, event, before), end, solver in zip(starts, ends, solvers, strict=True)
+        Segment(start, end, solver, state, event, before, rate_key)
+        for (start, state, event, before), end, solver, rate_key in zip(
+            starts, ends, solvers, rate_keys, strict=True
+        )
     ]
     return Trajectory(scenario, segments)
 

@@ -1,0 +1,55 @@
+"""Stage messages for a user who waits: what is being done, and since when.
+
+:class:`Progress` writes ``[   12.3 s] message`` lines (the command line writes them
+to stderr), its clock counted from ``start``.  The command line counts from the
+start of its own process (:func:`process_started_at`), so that the first line comes
+within the first second and the last one, ``done``, states the whole wall time the
+user waited, imports and checks included.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+__all__ = ["Progress", "process_started_at"]
+
+_IMPORTED = time.perf_counter()
+
+
+class Progress:
+    """Stage messages with the time since ``start`` (a ``time.perf_counter()`` value;
+    default: now), to ``write`` (nothing when None)."""
+
+    def __init__(self, write: Callable[[str], None] | None = None, start: float | None = None):
+        self._write = write
+        self._start = time.perf_counter() if start is None else start
+
+    @property
+    def elapsed_s(self) -> float:
+        return time.perf_counter() - self._start
+
+    def __call__(self, message: str) -> None:
+        if self._write is not None:
+            self._write(f"[{self.elapsed_s:7.1f} s] {message}")
+
+
+def process_started_at() -> float:
+    """The ``time.perf_counter()`` reading at which this process started: on Linux from
+    ``/proc`` (its start time in clock ticks since boot, against the time since boot,
+    both to 10 ms), elsewhere when this module was first imported."""
+    try:
+        stat = Path("/proc/self/stat").read_text()
+        # Field 22, starttime, counted from field 3, after the command's "(name)".
+        start_ticks = int(stat.rsplit(")", 1)[1].split()[19])
+        since_boot = float(Path("/proc/uptime").read_text().split()[0])
+        age = since_boot - start_ticks / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, IndexError, AttributeError):
+        return _IMPORTED
+    now = time.perf_counter()
+    since_import = now - _IMPORTED
+    # The process began before this import, and not a minute before it: otherwise the
+    # clocks disagree (a container's /proc/uptime, say), and the import is close.
+    return now - age if since_import - 0.1 <= age <= since_import + 60.0 else _IMPORTED
