@@ -283,11 +283,27 @@ class GuidedMotion:
             bound = min(bound, self.profile.rate_bound)
         return bound
 
-    @cached_property
-    def peak_acceleration_s(self) -> float:
-        """The sampled instant of the largest |ω̇| (where the AEM is hardest to follow)."""
-        t, _, α = self._samples
-        return float(t[int(np.argmax(np.linalg.norm(α, axis=-1)))])
+    def largest_rate(self, start_s: float, end_s: float) -> tuple[float, float]:
+        """(|ω| in rad/s, when it is reached) over [start_s, end_s]: the largest of the
+        samples (and both ends), refined by Brent's bounded search between its
+        neighbouring samples."""
+        t = self._samples[0]
+        inside = (t >= start_s) & (t <= end_s)
+        grid = np.unique(np.concatenate([[start_s, end_s], t[inside]]))
+        rates = np.linalg.norm(self.angular_velocity(grid), axis=-1)
+        k = int(np.argmax(rates))
+        best = (float(rates[k]), float(grid[k]))
+        low, high = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
+        if high > low:
+            found = minimize_scalar(
+                lambda s: -float(np.linalg.norm(self.angular_velocity(np.array([s, s]))[0])),
+                bounds=(low, high),
+                method="bounded",
+                options={"xatol": 1e-6},
+            )
+            if -found.fun > best[0]:
+                best = (float(-found.fun), float(found.x))
+        return best
 
     @property
     def angular_momentum_norm(self) -> float:
@@ -323,13 +339,6 @@ class GuidedMotion:
         ]
         inside = [(t, what) for t, what in points if start_s < t < end_s]
         return sorted(inside)
-
-    def aem_test_windows(self, start_s: float, end_s: float) -> list[tuple[float, float]]:
-        """Where an AEM of this segment is tested: the whole stretch (the records'
-        intervals are then drawn across it) and around the largest acceleration."""
-        peak = self.peak_acceleration_s
-        half = 0.05 * (end_s - start_s)
-        return [(start_s, end_s), (max(start_s, peak - half), min(end_s, peak + half))]
 
     def __repr__(self) -> str:
         return f"GuidedMotion([{self._t0:g}, {self.end_s:g}] s, {self.describe()})"

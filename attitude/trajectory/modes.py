@@ -33,8 +33,7 @@ orientation table's coverage), stated by ``check`` and in the summary.
 
 from __future__ import annotations
 
-import dataclasses
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -48,10 +47,11 @@ from attitude.scenario.events import AttitudeReset, InertiaChange, State
 from attitude.scenario.modes import MODE_EVENTS, ControlLoss, ControlResume, ModeChange, Wheels
 from attitude.scenario.scenario import Scenario
 from attitude.solver.inertia import PrincipalAxes
+from attitude.torques.solver import TorquedSolver
 from attitude.trajectory.guided import GuidedMotion
 from attitude.trajectory.torqued import TorquedMotion
 
-__all__ = ["GYROSTAT_ACCURACY_RAD", "mode_segments", "uses_laws"]
+__all__ = ["GYROSTAT_ACCURACY_RAD", "law_initial_state", "mode_segments", "uses_laws"]
 
 # The accuracy (rad) a gyrostat's step is chosen for when [torques] states none: the
 # gyroscopic term is not small, and the splitting's dense output bends at each grid
@@ -59,8 +59,6 @@ __all__ = ["GYROSTAT_ACCURACY_RAD", "mode_segments", "uses_laws"]
 # (Orekit's AEM reader) sees at 3.5 times the accuracy: a tenth of the AEM's default
 # tolerance (1e-6 rad) keeps it within (measured: 3.5e-7 rad on the example).
 GYROSTAT_ACCURACY_RAD = 1e-7
-# (start, end, solver, state, event, before): what trajectory.Segment holds.
-RawSegment = tuple[float, float, Any, State, Any, State | None]
 
 
 def uses_laws(scenario: Scenario) -> bool:
@@ -81,16 +79,18 @@ class _Builder:
     def __init__(
         self,
         scenario: Scenario,
-        steps: list[float | None],
+        step: float | Sequence[float | None] | None,
         free_solver: Callable[..., Any],
-        check_resolved: Callable[..., None],
+        make: Callable[..., Any],
+        where: Callable[..., Any],
     ) -> None:
         self.scenario = scenario
-        self.steps = steps
+        self.step = step
         self.free_solver = free_solver
-        self.check_resolved = check_resolved
+        self.make = make
+        self.where = where
         self.orbit = _orbit(scenario)
-        self.segments: list[RawSegment] = []
+        self.segments: list[Any] = []
         self.wheels: Wheels | None = None  # spinning wheels of the free body, or None
         self.law_key = ""
 
@@ -101,21 +101,30 @@ class _Builder:
         return f"the {event.kind} at {self.scenario.format_epoch(offset)}"
 
     def step_for(self) -> float | None:
+        """The torqued step of the next segment: the run's, or a run's own per segment."""
+        if self.step is None or isinstance(self.step, int | float):
+            return self.step
         k = len(self.segments)
-        return self.steps[k] if k < len(self.steps) else None
+        return self.step[k] if k < len(self.step) else None
 
-    def add(self, start: float, end: float, solver: Any, state: State, event, before) -> None:
-        self.segments.append((start, end, solver, state, event, before))
+    def add(
+        self,
+        start: float,
+        end: float,
+        solver: Any,
+        state: State,
+        event: Any,
+        before: State | None,
+        key: str,
+        text: str = "",
+    ) -> None:
+        """The segment made and checked (``key``, ``text``: what errors about its
+        motion name: the key that set its rate, the state in words)."""
+        raw = (start, end, solver, state, event, before)
+        self.segments.append(self.make(raw, self.where(key, text)))
 
     def bind(self, law: Any, start: float, end: float, key: str) -> BoundLaw:
         return law.bind(self.scenario.epoch, start, end, self.orbit, key)
-
-    def guided(
-        self, profile: BoundLaw | Slew, inertia: PrincipalAxes, start: float, end: float, key: str
-    ) -> GuidedMotion:
-        motion = GuidedMotion(profile, inertia, start, end, key)
-        self.check_resolved(motion, start, end, key, "")
-        return motion
 
     def visibility(self, motion: GuidedMotion) -> None:
         """The ground site of a target law: its passes over the segment
@@ -172,25 +181,27 @@ class _Builder:
                 format_epoch=self.scenario.format_epoch,
             )
             if slew.duration_s > SAME_INSTANT_S:  # else already on the law, at its rate
-                motion = self.guided(slew, inertia, start, slew.end_s, key)
-                self.add(start, slew.end_s, motion, motion.state, event, before)
+                motion = GuidedMotion(slew, inertia, start, slew.end_s, key)
+                self.add(start, slew.end_s, motion, motion.state, event, before, slew.key)
                 t = slew.end_s
         if t == start or end - t > SAME_INSTANT_S:
-            motion = self.guided(bound, inertia, t, end, key)
+            motion = GuidedMotion(bound, inertia, t, end, key)
             # After a slew the law takes over without an event of its own.
-            self.add(t, end, motion, motion.state, event, before if t == start else None)
+            self.add(t, end, motion, motion.state, event, before if t == start else None, key)
             self.visibility(motion)
         return self.state_at(end)
 
     def state_at(self, t: float) -> State:
         """The state at ``t`` of the last segment (the state just before an event)."""
-        solver = self.segments[-1][2]
+        last = self.segments[-1]
         pair = np.array([t, t])
-        attitude = solver.attitude(pair)[0]
-        momentum = solver.angular_momentum(pair)[0]
-        self.rate_before = solver.angular_velocity(pair)[0]
-        inertia = self.segments[-1][3].inertia
-        return State(attitude, momentum, inertia)
+        try:
+            attitude = last.solver.attitude(pair)[0]
+            momentum = last.solver.angular_momentum(pair)[0]
+            self.rate_before = last.solver.angular_velocity(pair)[0]
+        except InputError as exc:
+            raise last.refused(exc) from None
+        return State(attitude, momentum, last.state.inertia)
 
     # ---- the free stretches
 
@@ -208,24 +219,20 @@ class _Builder:
         if self.wheels is not None:
             solver = self.gyrostat(state, start, end, where)
         else:
-            solver = self.free_solver(state, start, end, *where, self.step_for())
-        self.check_resolved(solver, start, end, *where)
-        self.add(start, end, solver, state, event, before)
+            solver = self.free_solver(state, start, end, self.where(*where), self.step_for())
+        self.add(start, end, solver, state, event, before, *where)
         return self.state_at(end)
 
     def gyrostat(
         self, state: State, start: float, end: float, where: tuple[str, str]
     ) -> TorquedMotion:
         """The free body with spinning wheels from ``state`` (M total): the splitting
-        with the gyroscopic flow, under the scenario's torques acting in [start, end]."""
+        with the gyroscopic flow, under the scenario's torques acting in [start, end],
+        at the run's step, or (none: no torque acts) at a step of its own chosen for
+        the ``[torques]`` step or accuracy, else :data:`GYROSTAT_ACCURACY_RAD`."""
         assert self.wheels is not None
         acting = [(m, k) for a, b, m, k in self.models if a < end and b > start]
         settings = self.scenario.torques
-        step = self.step_for()
-        if step is not None:
-            settings = dataclasses.replace(settings, step=step, accuracy=None)
-        elif settings.step is None and settings.accuracy is None:
-            settings = dataclasses.replace(settings, accuracy=GYROSTAT_ACCURACY_RAD)
         key, text = where
         if settings.order == 6:
             raise InputError(
@@ -234,24 +241,25 @@ class _Builder:
                 key="torques.order",
                 value=6,
             )
+        h = self.wheels.momentum_vector
+        torques = [m for m, _ in acting]
         try:
-            return TorquedMotion(
-                state,
-                start,
-                end,
-                [m for m, _ in acting],
-                settings,
-                [k for _, k in acting],
-                self.wheels.momentum_vector,
-            )
+            step = self.step_for()
+            estimate = None
+            if step is None:
+                step, estimate = _gyrostat_step(state, start, end, torques, settings, h)
+            motion = TorquedMotion(state, start, end, torques, step, settings.order, h)
         except InputError as exc:
             if exc.key is not None:
                 raise
             raise InputError(f"{text}: {exc.reason}", key=key) from None
+        if estimate is not None:
+            motion.error_estimate = estimate
+        return motion
 
     # ---- the walk
 
-    def build(self, models: list) -> list[RawSegment]:
+    def build(self, models: list) -> list[Any]:
         scenario = self.scenario
         self.models = models
         initial = scenario.initial_state
@@ -311,7 +319,7 @@ class _Builder:
             )
             return state, True
         if isinstance(event, InertiaChange):  # the law holds on, with the new I·ω
-            law = self.segments[-1][2].law
+            law = self.segments[-1].solver.law
             state = self.law_stretch(law, self.law_key, event.inertia, offset, end, event, before)
             return state, True
         if isinstance(event, ControlLoss):
@@ -387,21 +395,60 @@ def _rate_key(key: str, event: Any) -> str:
     return key
 
 
+def _gyrostat_step(
+    state: State, start: float, end: float, torques: list, settings: Any, wheels: Any
+) -> tuple[float, float | None]:
+    """(step, estimated error) of a gyrostat segment that the run gives no step: the
+    ``[torques]`` step, or the step the splitting chooses for the ``[torques]`` accuracy
+    (:data:`GYROSTAT_ACCURACY_RAD` when none is given) over the segment."""
+    if settings.step is not None:
+        return float(settings.step), None
+    span = end - start
+    if span <= SAME_INSTANT_S:
+        return max(span, 1.0), 0.0
+    accuracy = settings.accuracy if settings.accuracy is not None else GYROSTAT_ACCURACY_RAD
+    chooser = TorquedSolver(
+        state.inertia.tensor,
+        state.angular_momentum,
+        state.attitude,
+        start,
+        torques,
+        order=settings.order,
+        tolerance=accuracy,
+        span=span,
+        wheel_momentum=wheels,
+    )
+    choice = chooser.step_choice
+    assert choice is not None  # a tolerance and a gyroscopic term: the step is searched
+    return choice.step, choice.error_estimate
+
+
+def law_initial_state(scenario: Scenario) -> State:
+    """The state at the epoch of a scenario that starts under a law: the law's attitude
+    and momentum I·ω there."""
+    law = scenario.initial_state.law
+    bound = law.bind(scenario.epoch, 0.0, 0.0, _orbit(scenario), "initial_state.law")
+    state = bound.state([0.0, 0.0])
+    axes = scenario.spacecraft.principal_axes
+    return State(state.attitude[0], axes.tensor @ state.angular_velocity[0], axes)
+
+
 def mode_segments(
     scenario: Scenario,
-    steps: list[float | None],
-    free_solver: Callable[..., Any],
-    check_resolved: Callable[..., None],
     models: list,
-) -> list[RawSegment]:
-    """The segments of ``scenario`` (which uses laws: :func:`uses_laws`), in time order,
-    as (start, end, solver, state, event, before).
+    step: float | Sequence[float | None] | None,
+    free_solver: Callable[..., Any],
+    make: Callable[..., Any],
+    where: Callable[..., Any],
+) -> list[Any]:
+    """The segments of ``scenario`` (which uses laws: :func:`uses_laws`), in time order.
 
-    ``steps``: per segment, the torqued solver's step (None: as the scenario says);
-    ``free_solver(state, t0, end, key, text, step)``: the free or torqued solver from a
-    state, errors about the state named by ``key`` (the scenario key that set its rate)
-    and ``text`` (the state in words); ``check_resolved(solver, t0, end, key, text)``:
-    refuses motion too fast for TT seconds; ``models``: the scenario's torques as
-    (start, stop, model, key).
+    ``models``: the scenario's torques as (start, stop, model, key); ``step``: the
+    torqued segments' step, or one per segment (a run made before), or None (no torque
+    acts); ``free_solver(state, t0, end, where, step)``: the free or torqued solver from
+    a state; ``make(raw, where)``: the checked segment of ``raw`` = (start, end, solver,
+    state, event, before); ``where(key, text)``: what errors about a segment's motion
+    name (the key that set its rate, the state in words).  The errors are
+    :class:`InputError` whose ``key`` names what holds the bad value.
     """
-    return _Builder(scenario, steps, free_solver, check_resolved).build(models)
+    return _Builder(scenario, step, free_solver, make, where).build(models)
