@@ -437,8 +437,13 @@ def _initial_state_dispersions(
     if initial is None:
         return attitude, rate, rate_key
     initial.allow("attitude", "angular_velocity", "angular_momentum")
-    attitude = _distribution(initial, "attitude", "angle", isotropic=True)
     state = loaded.scenario.initial_state
+    if state.law is not None:
+        initial.fail(
+            "the initial state is a law ([initial_state.law]): it sets the attitude and the "
+            "rate, and has nothing to disperse"
+        )
+    attitude = _distribution(initial, "attitude", "angle", isotropic=True)
     for key in ("angular_velocity", "angular_momentum"):
         if not initial.has(key):
             continue

@@ -69,6 +69,7 @@ from attitude.report.figures import (
     rate_zoom,
     sun_angle_zoom,
 )
+from attitude.report.guidance import guidance_summary
 from attitude.report.page import render_page
 from attitude.report.plan import RunPlan, horizon_beside, plan_run
 from attitude.report.plots import (
@@ -375,6 +376,7 @@ def _summary_of_the_stream(plan: RunPlan, source: str, stream: _Stream) -> dict[
         "scenario": scenario_summary(scenario, source),
         "motion": motion_summary(plan.trajectory, plan.motion),
         "torques": torques_summary(plan),
+        **({"guidance": guidance} if (guidance := guidance_summary(plan)) else {}),
         "extrema": {
             "max_rate_deg_s": None if largest is None else math.degrees(largest[0]),
             "max_rate_at": None if largest is None else scenario.format_epoch(largest[1]),

@@ -71,18 +71,40 @@ ORBIT_AGREEMENT_M = 1.0
 
 @dataclass(frozen=True)
 class InitialState:
-    """Attitude (body → inertial) and rate at the scenario epoch.
+    """Attitude (body → inertial) and rate at the scenario epoch, or the law the body
+    starts under.
 
     Give exactly one of ``angular_velocity`` (rad/s) and ``angular_momentum``
     (N m s), body axes.  See :meth:`from_quaternion` and :meth:`from_matrix` for
-    the other ways of giving the attitude.
+    the other ways of giving the attitude.  Or give ``law`` alone (an attitude law of
+    :mod:`attitude.laws`, e.g. ``InitialState(law=NadirLaw("zero_doppler"))``): the
+    attitude and the rate are then the law's (``attitude.scenario.modes``).
     """
 
-    attitude: Rotation
+    attitude: Rotation | None = None
     angular_velocity: NDArray[np.float64] | None = None
     angular_momentum: NDArray[np.float64] | None = None
+    law: Any = None
 
     def __post_init__(self) -> None:
+        if self.law is not None:
+            from attitude.laws.align_constrain import AttitudeLaw
+
+            if not isinstance(self.law, AttitudeLaw):
+                raise InputError(
+                    f"initial_state.law must be an attitude law (attitude.laws), got {self.law!r}"
+                )
+            given = [
+                name
+                for name in ("attitude", "angular_velocity", "angular_momentum")
+                if getattr(self, name) is not None
+            ]
+            if given:
+                raise InputError(
+                    f"initial_state: give a law, or an attitude and a rate, not both (got law "
+                    f"and {given[0]})"
+                )
+            return
         if not (isinstance(self.attitude, Rotation) and self.attitude.single):
             raise InputError(
                 f"initial_state.attitude must be a single scipy Rotation, got {self.attitude!r}"

@@ -3,6 +3,8 @@ the torques applied between exact free flows.
 
 Modules:
 
+- ``gyrostat``: Wheels spinning at constant speed relative to the body: the
+  gyrostat's gyroscopic term as an exact flow of the splitting.
 - ``models``: External torques on a rigid spacecraft: gravity gradient, constant
   torques, user torques.
 - ``solver``: Attitude under external torques: splitting with the exact free flow

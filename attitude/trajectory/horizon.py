@@ -35,7 +35,7 @@ from attitude.scenario.scenario import Scenario
 from attitude.scenario.torques import ScenarioTorques
 from attitude.torques.models import MU_EARTH_M3_S2, GravityGradient
 from attitude.torques.solver import angles_between, first_crossing
-from attitude.trajectory.torqued import TorquedMotion, scenario_torque_models
+from attitude.trajectory.torqued import scenario_torque_models
 from attitude.trajectory.trajectory import Trajectory, propagate
 
 __all__ = ["MAX_HORIZON_STEPS", "ValidityHorizon", "validity_horizon"]
@@ -143,7 +143,8 @@ def validity_horizon(trajectory: Trajectory, orbit: Any) -> ValidityHorizon:
         horizon_threshold=threshold,
     )
     torqued = propagate(_truncated(scenario, searched).with_torques(torques))
-    run_step = max(s.solver.step for s in torqued.segments if isinstance(s.solver, TorquedMotion))
+    # (Segments under a law have no step: their attitude is the law's in both runs.)
+    run_step = max(s.solver.step for s in torqued.segments if hasattr(s.solver, "step"))
 
     def angle(t):
         return angles_between(torqued.attitude_quaternion(t), trajectory.attitude_quaternion(t))
@@ -165,4 +166,5 @@ def _truncated(scenario: Scenario, stop_s: float) -> Scenario:
         events,
         duration=stop_s,
         torques=scenario.torques,
+        orbit=getattr(scenario, "orbit", None),
     )
