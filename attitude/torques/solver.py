@@ -55,8 +55,8 @@ from attitude.torques.models import (
 from attitude.torques.splitting import Composition, composition
 
 __all__ = [
+    "ACCURACY_RANGE_RAD",
     "MAX_STEPS",
-    "TOLERANCE_RANGE_RAD",
     "StepChoice",
     "TorquedSolver",
     "angles_between",
@@ -82,11 +82,11 @@ _MAX_REQUEST_STEPS = 1e8
 # free flows a step and tens of µs a flow, 1e7 steps are about an hour of computing.
 # The scenario's run-level search (attitude.trajectory.steps) has the same cap.
 MAX_STEPS = 1e7
-# The tolerances a step search can meet (rad): below 1e-12 the Richardson estimate is
+# The accuracies a step search can meet (rad): below 1e-12 the Richardson estimate is
 # rounding (16-digit states), and the search would shrink the step until it gives up
 # at MAX_STEPS; beyond 0.1 rad an estimate from a linear error model means
 # nothing.  The scenario's ``[torques] accuracy`` has the same range.
-TOLERANCE_RANGE_RAD = (1e-12, 0.1)
+ACCURACY_RANGE_RAD = (1e-12, 0.1)
 # The body must turn by less than this fraction of a turn in the spacing of float
 # seconds at the time reached (as ``attitude.trajectory`` requires of a scenario):
 # beyond, the free flow's phase is rounding, and a torque of 1e300 N m would spin the
@@ -141,7 +141,7 @@ class _Engine:
             return advance_floats(self.moment_floats, m, q, dt)
         m_array = np.stack(np.broadcast_arrays(*m), axis=-1)
         n = m_array.shape[0]
-        if self.unit_batch is None or self.unit_batch.moments.shape[0] != n:
+        if self.unit_batch is None or self.unit_batch.inertia.shape[0] != n:
             # The moments stay from flow to flow: what depends on them alone, once.
             self.unit_batch = UnitBatch(np.broadcast_to(self.moments, (n, 3)))
         # Every argument at its full (N, ...) shape: the free flow need not broadcast.
@@ -296,7 +296,7 @@ def _grid_steps(t_from: float, t_to: float, step: float, breakpoints: NDArray, l
 
 
 # ----------------------------------------------------------------- the step search
-# One search for a step that meets an error target, shared by TorquedSolver(tolerance=)
+# One search for a step that meets an error target, shared by TorquedSolver(accuracy=)
 # and the scenario's run-level search (attitude.trajectory.steps), which estimate the
 # error differently (one solver from its start; the whole run) but move alike.
 
@@ -316,21 +316,21 @@ def search_start_step(rate: float, torques: Iterable[Torque], t: float) -> float
 def next_search_step(
     step: float,
     error: float,
-    tolerance: float,
+    accuracy: float,
     order: int,
     span: float,
     good: float | None,
     bad: float,
 ) -> float | None:
     """The step search's next try after ``step`` gave the estimate ``error``, or None
-    when the search is done.  ``good``: the largest step that met ``tolerance`` so far
+    when the search is done.  ``good``: the largest step that met ``accuracy`` so far
     (None: none yet); ``bad``: the smallest that missed it (inf: none yet).
 
-    The error model C h^p (p = ``order``) aims at half the tolerance, moving at most
+    The error model C h^p (p = ``order``) aims at half the accuracy, moving at most
     8× down (and at least to 0.8 of the step) or 4× up a try, never past half the
     ``span``; once a passing and a failing step bracket the answer, it bisects in
     log h until they are within a factor 1.25."""
-    factor = (0.5 * tolerance / max(error, 1e-300)) ** (1.0 / order)
+    factor = (0.5 * accuracy / max(error, 1e-300)) ** (1.0 / order)
     if good is not None and math.isfinite(bad):
         if bad / good < 1.25:
             return None
@@ -359,7 +359,7 @@ class StepChoice:
 
     step: float
     error_estimate: float
-    tolerance: float
+    accuracy: float
     span: float
     tried: tuple[tuple[float, float], ...] = field(default=())
     checks: int = 0
@@ -458,9 +458,9 @@ class TorquedSolver:
     small, e.g. a gravity-gradient-stabilized body; needs torques independent of ω);
     or ``method``, a name of :data:`attitude.torques.splitting.COMPOSITIONS`.
 
-    The step: ``step`` (s, default 5 s), or ``tolerance`` (rad) with ``span`` (s): the
+    The step: ``step`` (s, default 5 s), or ``accuracy`` (rad) with ``span`` (s): the
     step is then chosen so that the estimated attitude error over [t0, t0 + span] is
-    within the tolerance, and ``step_choice`` reports the estimate.
+    within the accuracy, and ``step_choice`` reports the estimate.
 
     ``wheel_momentum``: the momentum h (body axes, N m s) of wheels spinning at a
     constant speed relative to the body: the body is then a gyrostat
@@ -486,7 +486,7 @@ class TorquedSolver:
         order: int | None = None,
         *,
         method: str | None = None,
-        tolerance: float | None = None,
+        accuracy: float | None = None,
         span: float | None = None,
         wheel_momentum: ArrayLike | None = None,
     ) -> None:
@@ -545,11 +545,11 @@ class TorquedSolver:
             sorted({b for t in self._torques for b in t.breakpoints if b > self._t0})
         )
         self.step_choice: StepChoice | None = None
-        if tolerance is not None and not self._exact:
+        if accuracy is not None and not self._exact:
             if step is not None:
-                raise InputError("give either step or tolerance, not both")
-            self._propagation = self._choose_step(tolerance, span)
-        else:  # (a tolerance without torques: the exact solver needs no step)
+                raise InputError("give either step or accuracy, not both")
+            self._propagation = self._choose_step(accuracy, span)
+        else:  # (an accuracy without torques: the exact solver needs no step)
             step = 5.0 if step is None else as_si_scalar(step, "time", "step")
             if not step > 0.0:
                 raise InputError(f"step must be positive (s), got {step}")
@@ -560,17 +560,17 @@ class TorquedSolver:
     def _new_propagation(self, step: float) -> _Propagation:
         return _Propagation(self._engine, self._t0, self._m0, self._q0, step, self._breakpoints)
 
-    def _choose_step(self, tolerance: Any, span: Any) -> _Propagation:
-        """Step and half step over the span, until the Richardson estimate meets the tolerance."""
-        tolerance = as_si_scalar(tolerance, "angle", "tolerance")
-        low, high = TOLERANCE_RANGE_RAD
-        if not low <= tolerance <= high:
+    def _choose_step(self, accuracy: Any, span: Any) -> _Propagation:
+        """Step and half step over the span, until the Richardson estimate meets the accuracy."""
+        accuracy = as_si_scalar(accuracy, "angle", "accuracy")
+        low, high = ACCURACY_RANGE_RAD
+        if not low <= accuracy <= high:
             raise InputError(
-                f"tolerance must be between {low:g} and {high:g} rad (below, the estimate "
-                f"is rounding; above, it means nothing), got {tolerance!r} rad"
+                f"accuracy must be between {low:g} and {high:g} rad (below, the estimate "
+                f"is rounding; above, it means nothing), got {accuracy!r} rad"
             )
         if span is None:
-            raise InputError("a tolerance needs span=, the duration (s) it is to hold over")
+            raise InputError("an accuracy needs span=, the duration (s) it is to hold over")
         span = as_si_scalar(span, "time", "span")
         if not span > 0.0:
             raise InputError(f"span must be positive (s), got {span}")
@@ -598,34 +598,34 @@ class TorquedSolver:
                     else ""
                 )
                 raise InputError(
-                    f"{tolerance:g} rad over {span:g} s would need a step below "
+                    f"{accuracy:g} rad over {span:g} s would need a step below "
                     f"{step:.3g} s, more than {MAX_STEPS:g} steps{last}: give a step, "
-                    "a looser tolerance or a shorter span",
-                    key="tolerance",
-                    value=tolerance,
+                    "a looser accuracy or a shorter span",
+                    key="accuracy",
+                    value=accuracy,
                 )
             error, propagation = estimate(step)
             tried.append((step, error))
-            if error <= tolerance:
+            if error <= accuracy:
                 if good is None or step > good[0]:
                     good = (step, error, propagation)
             else:
                 bad = min(bad, step)
             following = next_search_step(
-                step, error, tolerance, p, span, None if good is None else good[0], bad
+                step, error, accuracy, p, span, None if good is None else good[0], bad
             )
             if following is None:
                 break
             step = following
         if good is None:
             raise InputError(
-                f"{tolerance:g} rad over {span:g} s not reached: the estimate was "
+                f"{accuracy:g} rad over {span:g} s not reached: the estimate was "
                 f"{tried[-1][1]:.3g} rad at a step of {tried[-1][0]:.3g} s",
-                key="tolerance",
-                value=tolerance,
+                key="accuracy",
+                value=accuracy,
             )
         step, error, propagation = good
-        self.step_choice = StepChoice(step, error, tolerance, span, tuple(tried), len(checks))
+        self.step_choice = StepChoice(step, error, accuracy, span, tuple(tried), len(checks))
         return propagation
 
     def _initial_step(self) -> float:
@@ -772,7 +772,7 @@ class TorquedSolver:
 
 
 def propagate_batch(
-    moments: ArrayLike,
+    inertia: ArrayLike,
     angular_momentum: ArrayLike,
     attitude: Rotation | None = None,
     t0: float = 0.0,
@@ -788,7 +788,7 @@ def propagate_batch(
 
     For dispersion studies: every kick and every free flow acts on all N states at
     once (vectorized), and the time-dependent part of the torques (the orbit position)
-    is computed once for all.  ``moments``: principal moments along the body axes,
+    is computed once for all.  ``inertia``: principal moments along the body axes,
     (3,) shared or (N, 3) dispersed, kg m² (body axes = principal axes here: a full
     tensor is diagonalized by the caller, as ``attitude.solver.inertia.principal_axes`` does);
     ``angular_momentum``: (N, 3), body axes, N m s; ``attitude``: a stack of N
@@ -804,14 +804,14 @@ def propagate_batch(
     quaternions body → inertial, scalar first, (T, N, 4), at each of the T times.
     The same grid and dense output as :class:`TorquedSolver` with the same step.
     """
-    moments = as_si_array(moments, "moment_of_inertia", "moments")
+    inertia = as_si_array(inertia, "moment_of_inertia", "inertia")
     m = as_si_array(angular_momentum, "angular_momentum", "angular_momentum")
     if m.ndim != 2 or m.shape[1] != 3:
         raise InputError(f"angular_momentum must have shape (N, 3), got {m.shape}")
     n = m.shape[0]
-    if moments.shape not in ((3,), (n, 3)) or not np.all(moments > 0.0):
+    if inertia.shape not in ((3,), (n, 3)) or not np.all(inertia > 0.0):
         raise InputError(
-            f"moments must be 3 positive values or shape ({n}, 3), got {moments.shape}"
+            f"inertia must be 3 positive moments or shape ({n}, 3), got {inertia.shape}"
         )
     if attitude is None:
         q = np.tile([1.0, 0.0, 0.0, 0.0], (n, 1))
@@ -826,7 +826,7 @@ def propagate_batch(
         raise InputError(f"step must be positive (s), got {step}")
     torques = as_torque_list(torques)
     chosen = composition(4 if order is None and method is None else order, method)
-    frame = PrincipalFrame(tuple(moments[..., i] for i in range(3)))
+    frame = PrincipalFrame(tuple(inertia[..., i] for i in range(3)))
     gyroscope = None
     if wheel_momentum is not None:
         h = as_si_array(wheel_momentum, "angular_momentum", "wheel_momentum")
@@ -839,7 +839,7 @@ def propagate_batch(
             )
         h = np.broadcast_to(h, (n, 3))
         gyroscope = Gyroscope(tuple(h[:, i] for i in range(3)), frame.moments)
-    engine = _Engine(chosen, merged_constant_torques(torques), frame, moments, gyroscope)
+    engine = _Engine(chosen, merged_constant_torques(torques), frame, inertia, gyroscope)
     breakpoints = np.array(sorted({b for t in torques for b in t.breakpoints if b > t0}))
 
     out_m = np.empty((times.size, n, 3))
@@ -860,7 +860,7 @@ def propagate_batch(
             i += 1
             continue
         data = [d.tolist() for d in engine.time_data(starts, sizes)]
-        largest = largest_momentum(moments, float(starts[-1] + sizes[-1]))
+        largest = largest_momentum(inertia, float(starts[-1] + sizes[-1]))
         for k in range(starts.size):
             while i < times.size and times[i] < starts[k] + sizes[k]:
                 output(i, float(starts[k]))
@@ -868,7 +868,7 @@ def propagate_batch(
             state = engine.step(*state, float(sizes[k]), engine.rows_for_step(data, k))
             m_k = state[0]
             if not np.all(np.abs(m_k[0]) + np.abs(m_k[1]) + np.abs(m_k[2]) <= largest):
-                _refuse_runaway(m_k, moments, float(starts[k] + sizes[k]))
+                _refuse_runaway(m_k, inertia, float(starts[k] + sizes[k]))
         t = float(starts[-1] + sizes[-1])
     return out_m, out_q
 

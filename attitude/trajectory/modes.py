@@ -444,12 +444,12 @@ def _gyrostat_step(
         start,
         torques,
         order=settings.order,
-        tolerance=accuracy,
+        accuracy=accuracy,
         span=span,
         wheel_momentum=wheels,
     )
     choice = chooser.step_choice
-    assert choice is not None  # a tolerance and a gyroscopic term: the step is searched
+    assert choice is not None  # an accuracy and a gyroscopic term: the step is searched
     return choice.step, choice.error_estimate
 
 
