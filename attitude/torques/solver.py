@@ -31,6 +31,7 @@ References: see :mod:`attitude.torques.splitting` and :mod:`attitude.torques.mod
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
@@ -58,9 +59,11 @@ __all__ = [
     "ACCURACY_RANGE_RAD",
     "MAX_STEPS",
     "StepChoice",
+    "StepPrediction",
     "TorquedSolver",
     "angles_between",
     "departure_time",
+    "error_growth",
     "first_crossing",
     "next_search_step",
     "propagate_batch",
@@ -342,6 +345,28 @@ def next_search_step(
     return step * min(0.8, max(0.125, factor))
 
 
+# The exponent k of a search's error e(t) ~ t^k, fitted where a try was cut short.
+GROWTH_RANGE = (1.0, 3.0)
+
+
+def error_growth(times: Iterable[float], worst: Iterable[float], until: float) -> float:
+    """k of e(t) ~ t^k over [until/4, until], from the largest estimate ``worst[i]`` up to
+    each time ``times[i]`` (s from the search's start), within :data:`GROWTH_RANGE`:
+    how a try cut short by `attitude check`'s budget is extrapolated over its span,
+    e(span) = e(until) (span/until)^k (attitude.trajectory.steps explains the choice)."""
+    t = np.asarray(list(times), dtype=np.float64)
+    e = list(worst)
+    if t.size == 0 or until <= 0.0:
+        return GROWTH_RANGE[0]
+    index = int(np.searchsorted(t, 0.25 * until, side="right")) - 1
+    early = e[index] if index >= 0 else 0.0
+    late = e[-1]
+    if not (early > 0.0 and math.isfinite(late) and late > early):
+        return GROWTH_RANGE[0]
+    k = math.log(late / early) / math.log(until / float(t[index]))
+    return float(np.clip(k, *GROWTH_RANGE))
+
+
 # ----------------------------------------------------------------- the solver
 
 
@@ -363,6 +388,43 @@ class StepChoice:
     span: float
     tried: tuple[tuple[float, float], ...] = field(default=())
     checks: int = 0
+    cpu_s: float = 0.0  # the search's CPU time (time.process_time)
+
+
+@dataclass(frozen=True)
+class StepPrediction:
+    """A step search cut by a budget of CPU time (:meth:`TorquedSolver.predict_step`,
+    for `attitude check`): its tries up to the cut are the search's own, and what lies
+    beyond is predicted.
+
+    ``step``: the step the search will end near, from the error model C h^p with a
+    margin of 2 (at most the cut try's); ``cut_step``: the try the budget cut;
+    ``predicted_error``: that try's estimate over the span, extrapolated from
+    ``until`` (s covered from t0) as t^``growth`` and bounded below by the earlier
+    tries scaled as h^p; ``tried``: (step, estimate) of every try, the last predicted;
+    ``cpu_s``: spent here, ``tries_cpu_s`` of it by the tries that finished;
+    ``cpu_per_step``: of one grid step, measured; ``search_cpu_s``: what the whole
+    search will take, predicted: the tries that finished here, the cut one finished
+    (1.5 runs of the span: the step and twice it) and two more tries at ``step``.
+    """
+
+    step: float
+    cut_step: float
+    predicted_error: float
+    until: float
+    growth: float
+    accuracy: float
+    span: float
+    tried: tuple[tuple[float, float], ...]
+    cpu_s: float
+    tries_cpu_s: float
+    cpu_per_step: float
+
+    @property
+    def search_cpu_s(self) -> float:
+        finish = 1.5 * self.span / self.cut_step * self.cpu_per_step
+        more = 2.0 * 1.5 * self.span / self.step * self.cpu_per_step
+        return self.tries_cpu_s + finish + more
 
 
 class _Propagation:
@@ -562,6 +624,27 @@ class TorquedSolver:
 
     def _choose_step(self, accuracy: Any, span: Any) -> _Propagation:
         """Step and half step over the span, until the Richardson estimate meets the accuracy."""
+        choice, propagation = self._search(accuracy, span, None)
+        assert isinstance(choice, StepChoice) and propagation is not None
+        self.step_choice = choice
+        return propagation
+
+    def predict_step(
+        self, accuracy: Any, span: Any, budget_s: float
+    ) -> StepChoice | StepPrediction:
+        """The search that ``accuracy=`` and ``span=`` make, within ``budget_s`` of CPU
+        time: its :class:`StepChoice` when it ends within the budget, else a
+        :class:`StepPrediction` from its tries so far (the same tries, cut where the
+        budget ran out).  Refuses what the search would refuse, and a predicted step
+        of more than :data:`MAX_STEPS` steps over the span.  The solver itself is
+        unchanged (its step stays the one it was made with)."""
+        return self._search(accuracy, span, budget_s)[0]
+
+    def _search(
+        self, accuracy: Any, span: Any, budget_s: float | None
+    ) -> tuple[StepChoice | StepPrediction, _Propagation | None]:
+        """The step search of ``accuracy`` over ``span``; with ``budget_s``, cut when the
+        CPU time spent passes it (:meth:`predict_step`)."""
         accuracy = as_si_scalar(accuracy, "angle", "accuracy")
         low, high = ACCURACY_RANGE_RAD
         if not low <= accuracy <= high:
@@ -575,14 +658,32 @@ class TorquedSolver:
         if not span > 0.0:
             raise InputError(f"span must be positive (s), got {span}")
         p = self.method.order
+        scale = 2.0**p - 1.0
         checks = self._t0 + span * np.linspace(1.0 / 32.0, 1.0, 32)
+        started = time.process_time()
 
-        def estimate(step: float) -> tuple[float, _Propagation]:
-            """Richardson estimate of the error of the run at ``step`` (from 2 step)."""
+        def estimate(step: float) -> tuple[float, _Propagation, tuple | None]:
+            """Richardson estimate of the error of the run at ``step`` (from 2 step), and
+            (checks compared, their running largest estimate, the steps taken, the CPU
+            time of the try) when the budget cut it."""
             fine = self._new_propagation(step)
             coarse = self._new_propagation(2.0 * step)
-            difference = np.max(angles_between(coarse.states(checks)[1], fine.states(checks)[1]))
-            return float(difference) / (2.0**p - 1.0), fine
+            if budget_s is None:
+                difference = np.max(
+                    angles_between(coarse.states(checks)[1], fine.states(checks)[1])
+                )
+                return float(difference) / scale, fine, None
+            begun = time.process_time()
+            worst, envelope = 0.0, []
+            for i in range(checks.size):  # in time order: the grids grow as they are read
+                at = checks[i : i + 1]
+                angle = float(angles_between(coarse.states(at)[1], fine.states(at)[1])[0])
+                worst = max(worst, angle / scale)
+                envelope.append(worst)
+                if i + 1 < checks.size and time.process_time() - started > budget_s:
+                    cost = time.process_time() - begun
+                    return worst, fine, (i + 1, envelope, fine.count + coarse.count, cost)
+            return worst, fine, None
 
         # Search on the adopted step s, within a factor 1.25 of the largest that passes:
         # the error model C s^p to move, bisection (in log s) once bracketed.
@@ -592,19 +693,10 @@ class TorquedSolver:
         tried: list[tuple[float, float]] = []
         for _ in range(10):
             if span / step > MAX_STEPS:
-                last = (
-                    f"; the estimate was {tried[-1][1]:.3g} rad at {tried[-1][0]:.3g} s"
-                    if tried
-                    else ""
-                )
-                raise InputError(
-                    f"{accuracy:g} rad over {span:g} s would need a step below "
-                    f"{step:.3g} s, more than {MAX_STEPS:g} steps{last}: give a step, "
-                    "a looser accuracy or a shorter span",
-                    key="accuracy",
-                    value=accuracy,
-                )
-            error, propagation = estimate(step)
+                raise self._too_many_steps(accuracy, span, step, tried)
+            error, propagation, cut = estimate(step)
+            if cut is not None:
+                return self._prediction(accuracy, span, step, error, cut, tried, started), None
             tried.append((step, error))
             if error <= accuracy:
                 if good is None or step > good[0]:
@@ -625,8 +717,63 @@ class TorquedSolver:
                 value=accuracy,
             )
         step, error, propagation = good
-        self.step_choice = StepChoice(step, error, accuracy, span, tuple(tried), len(checks))
-        return propagation
+        cpu = time.process_time() - started
+        choice = StepChoice(step, error, accuracy, span, tuple(tried), len(checks), cpu)
+        return choice, propagation
+
+    def _too_many_steps(
+        self, accuracy: float, span: float, step: float, tried: list[tuple[float, float]]
+    ) -> InputError:
+        last = f"; the estimate was {tried[-1][1]:.3g} rad at {tried[-1][0]:.3g} s" if tried else ""
+        return InputError(
+            f"{accuracy:g} rad over {span:g} s would need a step below "
+            f"{step:.3g} s, more than {MAX_STEPS:g} steps{last}: give a step, "
+            "a looser accuracy or a shorter span",
+            key="accuracy",
+            value=accuracy,
+        )
+
+    def _prediction(
+        self,
+        accuracy: float,
+        span: float,
+        step: float,
+        error: float,
+        cut: tuple,
+        tried: list[tuple[float, float]],
+        started: float,
+    ) -> StepPrediction:
+        """The search cut at the try of ``step`` after ``cut[0]`` checks: its estimate
+        extrapolated over the span, bounded below by the finished tries scaled as h^p,
+        and the step that meets the accuracy with a margin of 2 (as
+        attitude.trajectory.steps predicts the run-level search)."""
+        count, envelope, steps, cost = cut
+        p = self.method.order
+        times = [float(x) for x in (np.linspace(1.0 / 32.0, 1.0, 32)[:count] * span)]
+        until = times[-1]
+        growth = error_growth(times, envelope, until)
+        predicted = max(
+            [error * (span / until) ** growth] + [e * (step / h) ** p for h, e in tried if e > 0.0]
+        )
+        needed = step * min(1.0, (0.5 * accuracy / max(predicted, 1e-300)) ** (1.0 / p))
+        tried = [*tried, (step, predicted)]
+        if span / needed > MAX_STEPS:
+            raise self._too_many_steps(accuracy, span, needed, tried)
+        per_step = cost / steps if steps else 0.0
+        spent = time.process_time() - started
+        return StepPrediction(
+            needed,
+            step,
+            predicted,
+            until,
+            growth,
+            accuracy,
+            span,
+            tuple(tried),
+            spent,
+            spent - cost,
+            per_step,
+        )
 
     def _initial_step(self) -> float:
         """:func:`search_start_step` at the initial rate (the gyroscopic turn's too)."""

@@ -53,6 +53,7 @@ from attitude.torques.models import ConstantTorque, Torque
 from attitude.torques.solver import (
     MAX_STEPS,
     angles_between,
+    error_growth,
     next_search_step,
     search_start_step,
 )
@@ -75,7 +76,6 @@ STOP_FACTOR = 64.0
 CHECK_BUDGET_S = 3.0
 _CHUNK = 4  # checks compared at a time: a try stops within 1/64 of the span
 _MAX_TRIES = 12
-_GROWTH = (1.0, 3.0)
 
 
 @dataclass(frozen=True)
@@ -162,19 +162,6 @@ def _torqued_steps(items: Iterable[Segment]) -> int:
     return sum(s.solver.steps_computed for s in items if isinstance(s.solver, TorquedMotion))
 
 
-def _growth(times: list[float], worst: list[float], until: float) -> float:
-    """k of e(t) ~ t^k over [until/4, until] (module docstring), within _GROWTH."""
-    if not times or until <= 0.0:
-        return _GROWTH[0]
-    index = int(np.searchsorted(np.asarray(times), 0.25 * until, side="right")) - 1
-    early = worst[index] if index >= 0 else 0.0
-    late = worst[-1]
-    if not (early > 0.0 and math.isfinite(late) and late > early):
-        return _GROWTH[0]
-    k = math.log(late / early) / math.log(until / times[index])
-    return float(np.clip(k, *_GROWTH))
-
-
 def measure(
     scenario: Scenario,
     models: list[tuple[float, float, Torque, str]],
@@ -213,7 +200,7 @@ def measure(
     worst = 0.0
 
     def result(ended: str, until: float, steps: int) -> Measurement:
-        growth = _growth(times, envelope, until) if ended != "span" else 1.0
+        growth = error_growth(times, envelope, until) if ended != "span" else 1.0
         found = Measurement(
             max((h for h in step if h is not None), default=0.0)
             if isinstance(step, list)
