@@ -19,13 +19,15 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
 from attitude.base.vectors import basis_across
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 __all__ = [
     "PIXEL_COLUMNS",
@@ -158,6 +160,8 @@ def _panels(rows: int, height_in: float) -> tuple[Figure, list]:
     """A 9-inch-wide figure of ``rows`` panels, with fixed margins: a layout engine
     (constrained, tight) measures every text and redraws, and took 40% of a figure's
     time here."""
+    from matplotlib.figure import Figure  # here: a run without plots never loads matplotlib
+
     height = height_in * rows + 0.6
     figure = Figure(figsize=(9.0, height))
     inch = 1.0 / height
@@ -168,6 +172,8 @@ def _panels(rows: int, height_in: float) -> tuple[Figure, list]:
 
 
 def _save(figure: Figure, path: Path) -> str:
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+
     FigureCanvasAgg(figure)
     figure.savefig(path, dpi=_DPI)
     return path.name
@@ -480,6 +486,8 @@ def plot_polhode(
     (azimuthal equidistant: distance from the centre = angle from the mean
     direction), so that a small nutation cone is as readable as a flip.
     """
+    from matplotlib.figure import Figure
+
     figure = Figure(figsize=(11.0, 5.2))
     figure.subplots_adjust(left=0.02, right=0.97, bottom=0.1, top=0.88, wspace=0.15)
     sphere = figure.add_subplot(1, 2, 1, projection="3d")
