@@ -3,6 +3,8 @@ the torques applied between exact free flows.
 
 Modules:
 
+- ``compiled_steps``: The splitting loop compiled, for one spacecraft under gravity
+  gradient alone.
 - ``models``: External torques on a rigid spacecraft: gravity gradient, constant
   torques, user torques.
 - ``solver``: Attitude under external torques: splitting with the exact free flow

@@ -105,6 +105,12 @@ class _Engine:
         self.kicks = [j for j, b in enumerate(method.kicks) if b != 0.0]
         self.flows = 0  # free-flow calls made (for benchmarks)
         self.unit_batch: UnitBatch | None = None  # the batch's free flow (see flow)
+        # One spacecraft under gravity gradient alone: steps by the compiled loop.
+        self.compiled = (
+            self.moment_floats is not None
+            and len(torques) == 1
+            and isinstance(torques[0], GravityGradient)
+        )
 
     # ---- the two maps
 
@@ -150,6 +156,29 @@ class _Engine:
         return tuple(m[i] + w / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]) for i in range(3))
 
     # ---- one step
+
+    def compiled_steps(self, m, q, pending, sizes, data, out_m, out_q, out_p) -> int:
+        """Steps of ``sizes`` from (m, q, pending) by the compiled loop
+        (:mod:`attitude.torques.compiled_steps`) into the ``out_*`` rows; the number
+        done (0 when this engine has no compiled loop)."""
+        if not self.compiled:
+            return 0
+        from attitude.torques.compiled_steps import gravity_gradient_steps
+
+        method = self.method
+        done = gravity_gradient_steps(
+            np.asarray(method.flows, dtype=np.float64),
+            np.asarray(method.kicks, dtype=np.float64),
+            np.asarray(self.moment_floats, dtype=np.float64),
+            np.array([*m, *q, pending], dtype=np.float64),
+            np.ascontiguousarray(sizes, dtype=np.float64),
+            np.ascontiguousarray(data[0], dtype=np.float64),
+            out_m,
+            out_q,
+            out_p,
+        )
+        self.flows += int(done) * sum(1 for b in method.kicks if b != 0.0)
+        return int(done)
 
     def step(self, m, q, pending, h, data_by_kick):
         """One step of size h (float or array); data_by_kick[j]: per torque, its row."""
@@ -280,11 +309,16 @@ class _Propagation:
             starts, sizes = _grid_steps(
                 self.t_end, t_max, self.step, self.breakpoints, _CHUNK_STEPS
             )
-            data = [d.tolist() for d in e.time_data(starts, sizes)]
+            arrays = e.time_data(starts, sizes)
             m, q, pending = self._state
             K = len(starts)
             out_m, out_q, out_p = np.empty((K, 3)), np.empty((K, 4)), np.empty(K)
-            for k in range(K):
+            done = e.compiled_steps(m, q, pending, sizes, arrays, out_m, out_q, out_p)
+            if done:
+                m, q = tuple(out_m[done - 1].tolist()), tuple(out_q[done - 1].tolist())
+                pending = float(out_p[done - 1])
+            data = [d.tolist() for d in arrays] if done < K else []
+            for k in range(done, K):
                 m, q, pending = e.step(m, q, pending, float(sizes[k]), e.rows_for_step(data, k))
                 norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
                 q = (q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm)
