@@ -105,7 +105,6 @@ def sample_stages(path: Path) -> dict:
     from attitude.montecarlo.dispersions import draw_sample
     from attitude.montecarlo.metrics import (
         METRICS_ONLY,
-        grid_rates,
         pointing_outcome,
         sun_angles_deg,
     )
@@ -129,7 +128,6 @@ def sample_stages(path: Path) -> dict:
     stages = {
         "draw_s": _best(lambda: draw_sample(d, document, 0)),
         "read_and_plan_s": _best(read_and_plan),
-        "grid_rates_s": _best(lambda: grid_rates([plan.trajectory], seconds)),
         "sun_angles_on_grid_s": _best(lambda: sun_angles_deg(plan, seconds)),
         "pointing_analysis_s": _best(lambda: pointing_outcome(plan)),
     }

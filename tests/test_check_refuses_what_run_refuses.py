@@ -119,14 +119,14 @@ BAD = {
     ),
     "burn: a torque that spins the body beyond what TT seconds follow": (
         _torques("step = 1.0", BURN.replace("[0.0, 0.0, 0.01]", "[1e150, 0.0, 0.0]")),
-        r"torques\.burns\[0\]\.torque: spun up by the burns: the body turns in .* too fast "
-        r"for TT seconds",
+        r"torques\.burns\[0\]\.torque: the torques spin the body up to 1e\+149 rad/s or "
+        r"more .* faster than float seconds can follow",
     ),
     "burn: the same with the step chosen for an accuracy": (
         _torques("", BURN.replace("[0.0, 0.0, 0.01]", "[1e150, 0.0, 0.0]")),
         r"torques\.burns\[0\]\.torque: the burns spin the body up to 2e\+149 rad/s \(this one "
-        r"adds 2e\+150 N m s\): choosing the step for torques\.accuracy over 5 s would start "
-        r"with 1\.91e\+150 steps of 3\.93e-150 s \(more than 1e\+07\)",
+        r"adds 2e\+150 N m s\): 1e-06 rad over 10 s would need a step below 3\.93e-150 s, "
+        r"more than 1e\+07 steps: give a smaller torque",
     ),
     "burn: after the span": (
         _torques("", BURN.replace("offset = 1.0", "offset = 10.0")),
@@ -190,17 +190,17 @@ BAD = {
             'accuracy = { value = 1e-6, unit = "rad" }',
             BURN.replace("duration = 2.0", "duration = 1e10"),
         ).replace("duration = 10.0", "duration = 1e10"),
-        r"torques\.accuracy: choosing the step over 1e\+10 s would start with "
-        r"[\d.e+]+ steps of [\d.e+-]+ s \(more than 1e\+07\): give torques\.step",
+        r"torques\.accuracy: 1e-06 rad over 1e\+10 s would need a step below [\d.e+-]+ s, "
+        r"more than 1e\+07 steps: give torques\.step",
     ),
     "torques: an accuracy for a burn that spins the body up to 1e8 rad/s": (
         _torques(
             'accuracy = { value = 1e-6, unit = "rad" }',
             BURN.replace("[0.0, 0.0, 0.01]", "[1e9, 0.0, 0.0]"),
         ),
-        r"torques\.burns\[0\]\.torque: the burns spin the body up to 2e\+08 rad/s .*: choosing "
-        r"the step for torques\.accuracy over 5 s would start with [\d.e+]+ steps of "
-        r"[\d.e+-]+ s \(more than 1e\+07\): give a smaller torque",
+        r"torques\.burns\[0\]\.torque: the burns spin the body up to 2e\+08 rad/s .*: 1e-06 "
+        r"rad over 10 s would need a step below [\d.e+-]+ s, more than 1e\+07 steps: give a "
+        r"smaller torque",
     ),
     "torques: negative step": (
         _torques("step = -1.0", BURN),

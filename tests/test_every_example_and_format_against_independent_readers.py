@@ -17,9 +17,6 @@ declares:
   is the one whose reading by Orekit is frozen in ``tests/data/orekit`` (the same
   records per segment, from the same first to the same last epoch), so that
   ``test_aem_oem_against_orekit_frozen.py``'s check of Orekit's reading holds for it.
-
-The torqued example's AEM misses its tolerance around the burn (issue 23, fixed on
-another branch): that one case is a strict xfail.
 """
 
 from __future__ import annotations
@@ -36,7 +33,7 @@ import pyarrow.parquet as pq
 import pytest
 from aem_read_back import interpolate_as_declared, read_back, rotation_angle
 from astropy.time import Time
-from orekit_frozen import TORQUED_AEM_MISSES, read_frozen
+from orekit_frozen import read_frozen
 
 from attitude.cli.main import main
 from attitude.environment.timescales import offline_time, tt_seconds
@@ -70,15 +67,8 @@ def _run(example: Path, folder: Path):
     return _RUNS[example.stem]
 
 
-def _cases(torqued_aem: bool = False) -> list:
-    return [
-        pytest.param(
-            path,
-            id=path.stem,
-            marks=[TORQUED_AEM_MISSES] if torqued_aem and "[torques]" in path.read_text() else [],
-        )
-        for path in EXAMPLES
-    ]
+def _cases() -> list:
+    return [pytest.param(path, id=path.stem) for path in EXAMPLES]
 
 
 def test_the_examples_cover_every_kind_of_run():
@@ -146,7 +136,7 @@ def _declared_tolerance(text: str) -> float:
     return float(found.group(1))
 
 
-@pytest.mark.parametrize("example", _cases(torqued_aem=True))
+@pytest.mark.parametrize("example", _cases())
 def test_aem_read_by_ccsds_ndm_py_within_its_declared_tolerance(example, folder):
     out, scenario, trajectory = _run(example, folder)
     path = out / "attitude.aem"

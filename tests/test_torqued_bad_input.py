@@ -219,3 +219,42 @@ def test_a_huge_span_is_refused_not_hung():
     with pytest.raises(InputError, match="steps"):
         solver.attitude(1e12)
     assert np.all(np.isfinite(solver.attitude_quaternion(3.0)))  # still usable after
+
+
+@pytest.mark.parametrize("tolerance", [1e-300, 1e-13, 0.5, 1e300])
+def test_a_tolerance_no_search_can_meet_is_refused_at_once(tolerance):
+    """The range of the file's ``[torques] accuracy`` (1e-12 to 0.1 rad): below it the
+    estimate is rounding and the search would shrink the step for minutes."""
+    with pytest.raises(InputError, match=r"tolerance must be between 1e-12 and 0\.1 rad"):
+        TorquedSolver(
+            INERTIA, M0, torques=[GravityGradient(circular)], tolerance=tolerance, span=100.0
+        )
+
+
+@pytest.mark.parametrize(
+    "torques",
+    [
+        [GravityGradient(circular, mu=1e300)],
+        [
+            UserTorque(
+                lambda t, a, ω: np.array([1e300, 0.0, 0.0]), depends_on_angular_velocity=False
+            )
+        ],
+        [UserTorque(lambda t, a, ω: np.array([1e300, 0.0, 0.0]))],
+        [ConstantTorque([0.0, 1e300, 0.0], 0.0, 5.0)],
+    ],
+    ids=["mu 1e300", "user torque 1e300", "damper-like 1e300", "burn 1e300"],
+)
+def test_a_torque_of_1e300_is_an_input_error_not_a_numpy_warning(torques):
+    """The momentum would leave the float range (or turn faster than float seconds
+    follow) within a step: one InputError naming the rate and the time, no warning."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a RuntimeWarning would fail the test
+        for options in ({"step": 10.0}, {}):
+            solver = TorquedSolver(INERTIA, M0, torques=torques, **options)
+            with pytest.raises(InputError, match=r"the torques spin the body up to .* by t = "):
+                solver.attitude_quaternion([5.0, 100.0])
+        with pytest.raises(InputError, match=r"the torques spin the body up to"):
+            propagate_batch(INERTIA, [M0], None, 0.0, [5.0, 100.0], torques, step=10.0)

@@ -120,7 +120,7 @@ def test_check_echoes_angles_in_degrees(tmp_path, capsys):
     assert main(["check", str(_file(tmp_path, text))]) == 0
     out = capsys.readouterr().out
     assert f"Sun exclusion half angle {math.degrees(0.5):.12g} deg" in out
-    assert "rate        [0.0, 0.0, 0.5729577951308232] deg/s" in out
+    assert "rate        [0, 0, 0.572958] deg/s" in out
 
 
 @pytest.mark.parametrize(

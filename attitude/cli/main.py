@@ -180,17 +180,21 @@ def _describe(loaded, plan, out: Path | None = None) -> str:
         f"{scenario.format_epoch(scenario.start_s)}",
         f"  formats     {','.join(plan.outputs.formats)}",
         f"  outputs     {plan.budget.describe()}",
-        f"  spacecraft  {craft.name}, principal moments {craft.principal_moments.tolist()} kg m²",
+        f"  spacecraft  {craft.name}, principal moments "
+        f"[{', '.join(f'{v:.6g}' for v in craft.principal_moments)}] kg m²",
     ]
     initial = scenario.initial_state
     if initial.angular_velocity is not None:
-        lines.append(
-            "  rate        "
-            f"{np.degrees(initial.angular_velocity).tolist()} deg/s (body, at the epoch)"
-        )
+        rate = ", ".join(f"{v:.6g}" for v in np.degrees(initial.angular_velocity))
+        lines.append(f"  rate        [{rate}] deg/s (body, at the epoch)")
     for index, item in enumerate(plan.motion):
         period = "" if math.isinf(item.period_s) else f", body period {item.period_s:.6g} s"
-        flips = f", {item.flip_count} flips" if item.flip_count else ""
+        if item.flip_count is None:
+            flips = ", flips located by run"
+        elif item.flip_count:
+            flips = f", {item.flip_count} flip{'' if item.flip_count == 1 else 's'}"
+        else:
+            flips = ""
         how = "splitting" if item.formula == "torqued" else f"formula {item.formula}"
         lines.append(
             f"  segment {index}   from {scenario.format_epoch(item.start_s)}: {item.motion} "
@@ -285,12 +289,14 @@ def _checked_run(args, state: dict) -> int:
             return command(args, loaded, progress)
         outputs = _outputs(args, loaded.outputs)
         # A run computes the validity horizon beside its outputs (attitude.report.run).
+        checking = args.command == "check"
         plan = plan_run(
             loaded.scenario,
             loaded.pointing,
             outputs,
-            horizon=args.command == "check",
+            horizon=checking,
             progress=progress,
+            check=checking,
         )
         montecarlo = None
         if "dispersions" in loaded.document:  # checked by run too: one reading of the file

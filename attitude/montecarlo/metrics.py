@@ -18,7 +18,7 @@ from attitude.pointing.spec import PointingSpec
 from attitude.report.plan import RunPlan
 from attitude.report.summaries import motion_summary, pointing_summary
 from attitude.scenario.scenario import Scenario
-from attitude.trajectory.trajectory import Trajectory
+from attitude.trajectory.motion import largest_rate_of
 
 __all__ = [
     "ANGLE_STEPS",
@@ -26,7 +26,6 @@ __all__ = [
     "METRICS_ONLY",
     "TIME_BINS",
     "angle_extremes",
-    "grid_rates",
     "metric_names",
     "pointing_outcome",
     "sample_metrics",
@@ -137,6 +136,11 @@ def _number(value: Any) -> float:
     return math.nan if value is None else float(value)
 
 
+def _count(value: int | None) -> int | float:
+    """A count as an integer, NaN where it was not computed (never a 0 for it)."""
+    return math.nan if value is None else int(value)
+
+
 def pointing_outcome(plan: RunPlan) -> dict[str, float]:
     """The pointing metrics of one checked scenario, as ``summary.json`` reports them:
     each body vector's extrema (with their times, TT seconds) and constraint totals, and
@@ -183,39 +187,22 @@ def sun_angles_deg(plan: RunPlan, seconds: NDArray[np.float64]) -> NDArray[np.fl
     return np.array(angles).reshape(len(samples.vectors), seconds.size)
 
 
-def grid_rates(trajectories: list[Trajectory], seconds: NDArray[np.float64]) -> NDArray:
-    """|ω| (rad/s) of each trajectory on the output grid, shape (samples, epochs).
-
-    Each trajectory is evaluated over all its epochs at once (the solver is vectorized
-    over times).  Advancing the batch's samples together instead, with the free-flow map
-    vectorized over states (``attitude.solver.free_flow.advance``), does not pay here: this
-    step is under 0.1 % of a sample's cost, which is the exact pointing search
-    (docs/benchmarks.md, "Monte Carlo").
-    """
-    rates = np.empty((len(trajectories), seconds.size))
-    for row, trajectory in zip(rates, trajectories, strict=True):
-        row[:] = np.linalg.norm(trajectory.angular_velocity(seconds), axis=1)
-    return rates
-
-
-def sample_metrics(
-    plan: RunPlan, rate: NDArray[np.float64] | None = None
-) -> tuple[dict[str, Any], NDArray[np.float64]]:
+def sample_metrics(plan: RunPlan) -> tuple[dict[str, Any], NDArray[np.float64]]:
     """The metrics of one checked scenario: the numbers its ``summary.json`` holds
     (flips, each segment's motion, the largest rate, the pointing extrema, violation
     and eclipse totals), and its Sun-angle series (one row per body vector, deg).
 
-    ``rate``: |ω| on the output grid, if already evaluated (:func:`grid_rates`).
+    The largest rate is the summary's, found on the motion
+    (``attitude.trajectory.rates``), not on the output grid; a count that was not
+    computed (flips not located) is NaN, never 0.
     """
     scenario = plan.scenario
     seconds = scenario.output_seconds()
-    if rate is None:
-        rate = grid_rates([plan.trajectory], seconds)[0]
     motion = motion_summary(plan.trajectory, plan.motion)
-    # As the report takes it: the largest |ω| among the output epochs, in deg/s.
+    largest = largest_rate_of(plan.motion)
     metrics: dict[str, Any] = {
-        "flip_count": motion["flips"]["count"],
-        "max_rate_deg_s": math.degrees(float(rate[int(np.argmax(rate))])),
+        "flip_count": _count(motion["flips"]["count"]),
+        "max_rate_deg_s": math.nan if largest is None else math.degrees(largest[0]),
     }
     for k, segment in enumerate(motion["segments"]):
         names = _segment_metric_names(k)
@@ -234,7 +221,7 @@ def sample_metrics(
         ]
         metrics[names[0]] = values[0]
         metrics.update({n: _number(v) for n, v in zip(names[1:], values[1:], strict=True)})
-        metrics[names[2]] = segment["flip_count"]  # a count: an integer column
+        metrics[names[2]] = _count(segment["flip_count"])
     angles = np.empty((0, seconds.size))
     if not plan.pointing.is_empty:
         metrics.update(pointing_outcome(plan))

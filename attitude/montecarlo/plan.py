@@ -9,7 +9,6 @@ with its parameters and its error; the job goes on.
 
 from __future__ import annotations
 
-import contextlib
 import time
 import warnings
 from dataclasses import dataclass
@@ -28,7 +27,6 @@ from attitude.montecarlo.metrics import (
     METRICS_ONLY,
     TIME_BINS,
     angle_extremes,
-    grid_rates,
     metric_names,
     sample_metrics,
 )
@@ -183,16 +181,11 @@ def evaluate_batch(job: Job, first: int, stop: int) -> BatchResult:
         built.append((index, sample.parameters, plan, notes))
 
     ran, extremes = [], []
-    rates: list[Any] = [None] * len(built)  # None: each sample evaluates its own
-    if built:
-        seconds = built[0][2].scenario.output_seconds()
-        with contextlib.suppress(Exception):  # a failure is then the sample's, below
-            rates = list(grid_rates([plan.trajectory for _, _, plan, _ in built], seconds))
-    for (index, parameters, plan, notes), rate in zip(built, rates, strict=True):
+    for index, parameters, plan, notes in built:
         try:
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always")
-                metrics, angles = sample_metrics(plan, rate)
+                metrics, angles = sample_metrics(plan)
         except Exception as exc:  # the same
             rows.append(failure_row(index, parameters, error_text(exc)))
             continue

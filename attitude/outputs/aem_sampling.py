@@ -25,23 +25,45 @@ reader who also uses the rates (Orekit's Hermite with degree + 1 records) only d
 better.  Higher degrees gain little more and amplify the 16-digit rounding of the
 records.
 
+Where the segments end: at every event (the rate jumps there), and at every point
+inside a stretch of motion where the motion is not smooth (``Segment.breakpoints``:
+a burn starting or stopping, any torque switching on or off, a guidance mode
+changing).  There the rate is continuous but its derivative is not, and a polynomial
+through records on both sides would be off by far more than the tolerance (8.5e-5
+rad just after a burn starts, for a tolerance of 1e-6); each side is its own AEM
+segment, whose first and last records are the attitude at the breakpoint.
+
 How the step is chosen, per segment: a first guess from that bound at the body's
-largest rate G/I_min, then the declared reading is carried out on test intervals (the
-four at each end, where the window is off-centre, and up to 2048 spread over one body
-period, where every phase of the motion occurs: ω(t) is periodic in the body) and
-compared with the exact attitude, and the step is scaled by (target/error)^(1/8) until
-the largest error is between a quarter and a half of the tolerance.  Separatrix
-segments are also tested around their flip.  The records themselves are exact (the
+largest rate G/I_min, then the declared reading is carried out on test intervals and
+compared with the propagated attitude, and the step is scaled by (target/error)^(1/8)
+until the largest error is between a quarter and a half of the tolerance.  The test
+intervals: the four at each end, where the window is off-centre, and, torque-free, up
+to 2048 spread over one body period, where every phase of the motion occurs (ω(t) is
+periodic in the body), and around the first flip of a separatrix segment; under
+torques, where nothing repeats, every interval of the segment, or 4096 spread over it
+when it has more.  Each test interval is read where the interpolation error peaks,
+the extremum of the node polynomial ∏(t − tᵢ) over it (:data:`PEAKS`), and at its
+quarter points.
+
+**The figure stated is measured on the file.**  While the records are written, every
+interval of every segment is read as declared at that peak and compared with the
+attitude there: the largest of those errors, times a margin for the rest of the
+interval (:attr:`AemSegmentPlan.peak_margin`, 1 + |ω|h/18 at degree 7: about 1.07 at
+the default tolerance), plus |ω| × 0.5 ns for the records' time tags, is the largest
+error stated in ``summary.json`` (:attr:`AemSegmentPlan.measured_error_rad`): a
+measurement over the whole file, not an estimate from samples.  A measurement beyond
+the tolerance is an error, never a file.  The records themselves are exact (the
 solver's), and written to 1 ns: a time tag rounded by up to 0.5 ns costs ω × 0.5 ns,
-which is why a tolerance below that is refused.
-``tests/test_aem_meets_its_tolerance.py`` reads the written files back and
-interpolates them as declared at every mid-step.
+which is why a tolerance below that is refused.  ``tests/test_aem_meets_its_tolerance.py``
+and ``tests/test_aem_of_a_torqued_run_read_back_by_ccsds_ndm_py.py`` read the written
+files back with an independent parser, interpolate them as declared inside every
+interval, and check them against the tolerance and the stated figure.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import BinaryIO
 
 import numpy as np
@@ -52,12 +74,14 @@ from attitude.environment.epoch_texts import EpochTexts
 from attitude.environment.timescales import SAME_INSTANT_S
 from attitude.outputs.aem_writer import AemWriter
 from attitude.trajectory.motion import SegmentMotion
+from attitude.trajectory.torqued import TorquedMotion
 from attitude.trajectory.trajectory import Segment, Trajectory
 
 __all__ = [
     "DEFAULT_TOLERANCE_RAD",
     "INTERPOLATION_DEGREE",
     "INTERPOLATION_METHOD",
+    "PEAKS",
     "AemPlan",
     "AemSegmentPlan",
     "lagrange_quaternions",
@@ -75,6 +99,7 @@ MIN_TOLERANCE_RAD = 1e-12
 # The step is tuned until the largest error tested lies in [¼, ½] of the tolerance.
 _TARGET = 0.5
 _TEST_INTERVALS = 2048
+_TORQUED_TEST_INTERVALS = 4096
 _END_INTERVALS = 4
 _MAX_ITERATIONS = 12
 # Time tags are written to 1 ns (half of it is the rounding), and records closer than
@@ -83,10 +108,34 @@ _TIME_TAG_S = 0.5e-9
 _MIN_STEP_S = 2e-9
 
 
+def _peaks(degree: int) -> NDArray[np.float64]:
+    """For each interval j of a window of degree + 1 evenly spaced nodes 0 … degree,
+    the fraction of the interval (from node j) where |∏(x − i)| is largest."""
+    fractions = np.linspace(0.0, 1.0, 20001)
+    nodes = np.arange(degree + 1.0)
+    peaks = []
+    for j in range(degree):
+        x = j + fractions
+        product = np.abs(np.prod(x[:, None] - nodes[None, :], axis=1))
+        peaks.append(fractions[int(np.argmax(product))])
+    return np.array(peaks)
+
+
+# PEAKS[d][j]: where the interpolation error of degree d peaks in the window's interval
+# j (the error of a polynomial through smooth data is f^(d+1)(ξ)/(d+1)! times the node
+# polynomial, whose extremum this is): ½ in the centred interval, off-centre at the ends.
+PEAKS = {degree: _peaks(degree) for degree in range(1, INTERPOLATION_DEGREE + 1)}
+
+
 @dataclass(frozen=True)
 class AemSegmentPlan:
     """The records of one AEM segment: ``count`` epochs evenly spaced over
-    [start_s, end_s] (TT seconds since the epoch), and the interpolation declared."""
+    [start_s, end_s] (TT seconds since the epoch), and the interpolation declared.
+
+    ``started_by``: what happens at ``start_s`` when the segment starts inside a
+    stretch of motion (a breakpoint: a torque switching), else None.
+    ``measured_error_rad``: set when the records are written (module docstring).
+    """
 
     segment: int  # index of the trajectory segment
     start_s: float
@@ -94,6 +143,20 @@ class AemSegmentPlan:
     count: int
     degree: int | None  # INTERPOLATION_DEGREE (None: a single record)
     tested_error_rad: float  # the largest error found when choosing the step
+    time_tag_rad: float = 0.0  # |ω| × (0.5 ns + float spacing): the time tags' rounding
+    started_by: str | None = None
+    measured_error_rad: float | None = None
+    rate_rad_s: float = 0.0  # the bound on |ω| the step was guessed from
+
+    @property
+    def peak_margin(self) -> float:
+        """How much the error may exceed its value at an interval's peak elsewhere in
+        it: the error is the node polynomial times a divided difference of the
+        quaternion, f^(d+1)(ξ)/(d+1)!, whose components turn at |ω|/2 or less, so
+        across half an interval it changes by at most |ω| h / (2 (d + 2)) of itself
+        (to first order): 1 plus that."""
+        degree = self.degree if self.degree is not None else 1
+        return 1.0 + self.rate_rad_s * self.step_s / (2.0 * (degree + 2))
 
     @property
     def step_s(self) -> float:
@@ -118,6 +181,14 @@ class AemPlan:
     @property
     def records(self) -> int:
         return sum(item.count for item in self.segments)
+
+    @property
+    def measured_error_rad(self) -> float | None:
+        """The largest error measured while writing (None before)."""
+        found = [item.measured_error_rad for item in self.segments]
+        if not found or any(value is None for value in found):
+            return None
+        return max(value for value in found if value is not None)
 
 
 def check_tolerance(tolerance_rad: float, name: str = "aem_tolerance") -> float:
@@ -192,22 +263,90 @@ def _same_hemisphere(q: NDArray[np.float64]) -> NDArray[np.float64]:
     return q * signs[..., None]
 
 
+def _read_errors(
+    solver,
+    index: NDArray[np.intp],
+    record_s: NDArray[np.float64],
+    record_q: NDArray[np.float64],
+    interval: NDArray[np.intp],
+    count: int,
+    degree: int,
+    fractions: tuple[str, ...] = ("peak",),
+) -> NDArray[np.float64]:
+    """The error of the declared reading in each of ``interval`` (indices of records
+    i, i + 1 of a segment of ``count``), where ``record_s``/``record_q`` hold the
+    records of the increasing indices ``index`` (every one the windows need), at the
+    peak of the node polynomial and, if asked, at the quarter points: one value per
+    interval."""
+    first = _window(count, interval, degree)
+    nodes = np.searchsorted(index, first[:, None] + np.arange(degree + 1))
+    x = record_s[nodes]
+    q = _same_hemisphere(record_q[nodes])
+    j = interval - first
+    spots = []
+    if "peak" in fractions:
+        spots.append(PEAKS[degree][j])
+    if "quarters" in fractions:
+        spots += [np.full(interval.shape, 0.25), np.full(interval.shape, 0.75)]
+    worst = np.zeros(interval.shape)
+    for fraction in spots:
+        left = x[np.arange(len(interval)), j]
+        right = x[np.arange(len(interval)), j + 1]
+        t = left + fraction * (right - left)
+        worst = np.maximum(worst, _angle(_lagrange(x, q, t), solver.attitude_quaternion(t)))
+    return worst
+
+
 def _tested_error(
     segment: Segment,
     start_s: float,
     end_s: float,
     count: int,
     degree: int,
-    windows: list[tuple[float, float]],
-    rng: np.random.Generator,
+    intervals: NDArray[np.intp],
 ) -> float:
     """The largest error of the declared reading of ``count`` even records over
-    [start_s, end_s], at ¼, ½ and ¾ of test intervals: the end ones, and some in each
-    of ``windows`` (TT second spans)."""
+    [start_s, end_s] in the test ``intervals``, each record evaluated once."""
+    step = (end_s - start_s) / (count - 1)
+    first = _window(count, intervals, degree)
+    needed = np.unique(first[:, None] + np.arange(degree + 1))
+    τ = start_s + needed * step
+    τ[needed == count - 1] = end_s
+    q = segment.solver.attitude_quaternion(τ)
+    errors = _read_errors(
+        segment.solver, needed, τ, q, intervals, count, degree, ("peak", "quarters")
+    )
+    return float(np.max(errors))
+
+
+def _test_intervals(
+    segment: Segment,
+    motion: SegmentMotion,
+    start_s: float,
+    end_s: float,
+    count: int,
+    rng: np.random.Generator,
+) -> NDArray[np.intp]:
+    """The intervals tested (module docstring): the end ones; torque-free, one body
+    period (every phase of ω(t) occurs in it; without a period, the start) and around
+    the first flip; under torques, every interval, or _TORQUED_TEST_INTERVALS spread
+    over the segment."""
     intervals = count - 1
     step = (end_s - start_s) / intervals
     picked = [np.arange(min(_END_INTERVALS, intervals))]
     picked.append(np.arange(max(0, intervals - _END_INTERVALS), intervals))
+    if isinstance(segment.solver, TorquedMotion):
+        if intervals <= _TORQUED_TEST_INTERVALS:
+            picked.append(np.arange(intervals))
+        else:
+            picked.append(rng.integers(0, intervals, _TORQUED_TEST_INTERVALS))
+        return np.unique(np.concatenate(picked))
+    span = max(64.0 * step, motion.period_s if math.isfinite(motion.period_s) else 0.0)
+    windows = [(start_s, min(end_s, start_s + span))]
+    flips = motion.flip_times_s
+    flips = flips[(flips >= start_s) & (flips <= end_s)]
+    if flips.size:
+        windows.append((max(start_s, flips[0] - 32.0 * step), min(end_s, flips[0] + span)))
     for low, high in windows:
         a = int(np.clip((low - start_s) // step, 0, intervals - 1))
         b = int(np.clip(np.ceil((high - start_s) / step), a + 1, intervals))
@@ -215,34 +354,7 @@ def _tested_error(
             picked.append(np.arange(a, b))
         else:
             picked.append(rng.integers(a, b, _TEST_INTERVALS))
-    interval = np.unique(np.concatenate(picked))
-    first = _window(count, interval, degree)
-    nodes = first[:, None] + np.arange(degree + 1)
-    record_s = start_s + nodes * step
-    record_s[nodes == count - 1] = end_s
-    solver = segment.solver
-    q = _same_hemisphere(solver.attitude_quaternion(record_s.ravel()).reshape(*nodes.shape, 4))
-    fractions = np.array([0.25, 0.5, 0.75])
-    errors = []
-    for fraction in fractions:
-        t = start_s + (interval + fraction) * step
-        errors.append(_angle(_lagrange(record_s, q, t), solver.attitude_quaternion(t)))
-    return float(np.max(errors))
-
-
-def _test_windows(
-    segment: Segment, motion: SegmentMotion, start_s: float, end_s: float, step_s: float
-) -> list[tuple[float, float]]:
-    """Spans where the declared reading is tested: one body period (every phase of
-    ω(t) occurs in it) or, without a period, the start and the neighbourhood of the
-    first flip."""
-    span = max(64.0 * step_s, motion.period_s if math.isfinite(motion.period_s) else 0.0)
-    windows = [(start_s, min(end_s, start_s + span))]
-    flips = motion.flip_times_s
-    flips = flips[(flips >= start_s) & (flips <= end_s)]
-    if flips.size:
-        windows.append((max(start_s, flips[0] - 32.0 * step_s), min(end_s, flips[0] + span)))
-    return windows
+    return np.unique(np.concatenate(picked))
 
 
 def _plan_segment(
@@ -252,6 +364,7 @@ def _plan_segment(
     start_s: float,
     end_s: float,
     tolerance_rad: float,
+    started_by: str | None,
 ) -> AemSegmentPlan:
     length = end_s - start_s
     most = max(2, int(length / _MIN_STEP_S) + 1)  # records ≥ 2 ns apart
@@ -259,8 +372,8 @@ def _plan_segment(
     G = solver.angular_momentum_norm
     rate = G / float(np.min(solver.moments_of_inertia)) if G > 0.0 else 0.0
     degree = INTERPOLATION_DEGREE
-    if rate == 0.0 or most <= 2:
-        return AemSegmentPlan(index, start_s, end_s, 2, 1, 0.0)  # at rest: constant
+    if rate == 0.0 or most <= 2:  # at rest: constant
+        return AemSegmentPlan(index, start_s, end_s, 2, 1, 0.0, 0.0, started_by, None, rate)
     time_tags = rate * (_TIME_TAG_S + float(np.spacing(max(abs(end_s), 1.0))))
     if time_tags >= 0.5 * tolerance_rad:
         # The rate's fault, and the key that set it (a runaway burn, a state's absurd
@@ -287,10 +400,12 @@ def _plan_segment(
     for _ in range(_MAX_ITERATIONS):
         count = min(max(math.ceil(length / step) + 1, degree + 1), most)
         degree_here = min(degree, count - 1)
-        windows = _test_windows(segment, motion, start_s, end_s, length / (count - 1))
-        error = _tested_error(segment, start_s, end_s, count, degree_here, windows, rng)
+        intervals = _test_intervals(segment, motion, start_s, end_s, count, rng)
+        error = _tested_error(segment, start_s, end_s, count, degree_here, intervals)
         if error <= target:
-            accepted = AemSegmentPlan(index, start_s, end_s, count, degree_here, error)
+            accepted = AemSegmentPlan(
+                index, start_s, end_s, count, degree_here, error, time_tags, started_by, None, rate
+            )
             if error >= 0.5 * target or count <= degree + 1:
                 break
         elif count >= most:
@@ -305,6 +420,21 @@ def _plan_segment(
     return accepted
 
 
+def _pieces(
+    segment: Segment, start_s: float, stop_s: float
+) -> list[tuple[float, float, str | None]]:
+    """The segment's stretch within [start_s, stop_s] cut at its breakpoints: (start,
+    end, what happens at start when it is a breakpoint)."""
+    a, b = max(segment.start_s, start_s), min(segment.end_s, stop_s)
+    cuts = [(a, None)] + [
+        (point.time_s, point.what)
+        for point in segment.breakpoints()
+        if a + SAME_INSTANT_S < point.time_s < b - SAME_INSTANT_S
+    ]
+    ends = [t for t, _ in cuts[1:]] + [b]
+    return [(t, end, what) for (t, what), end in zip(cuts, ends, strict=True)]
+
+
 def plan_aem(
     trajectory: Trajectory,
     motion: list[SegmentMotion],
@@ -313,24 +443,25 @@ def plan_aem(
     tolerance_rad: float = DEFAULT_TOLERANCE_RAD,
     name: str = "aem_tolerance",
 ) -> AemPlan:
-    """The AEM's segments over [start_s, stop_s]: one per stretch of motion between
-    events, each sampled for ``tolerance_rad`` (see the module docstring).
+    """The AEM's segments over [start_s, stop_s]: one per stretch of smooth motion,
+    between events and breakpoints, each sampled for ``tolerance_rad`` (see the
+    module docstring).
 
     A segment ends with its own (pre-event) state at the next event's epoch and the
     next one starts with the post-event state there: the attitude is continuous but
-    the rate jumps, and a reader must not interpolate across.
+    the rate jumps, and a reader must not interpolate across.  At a breakpoint both
+    segments hold the same state; the rate's derivative jumps there.
     """
     tolerance_rad = check_tolerance(tolerance_rad, name)
     plans = []
     for index, (segment, item) in enumerate(zip(trajectory.segments, motion, strict=True)):
-        start = max(segment.start_s, start_s)
-        end = min(segment.end_s, stop_s)
-        if end - start <= SAME_INSTANT_S:
+        if min(segment.end_s, stop_s) - max(segment.start_s, start_s) <= SAME_INSTANT_S:
             continue  # before the output span, or a zero-length stretch between events
-        try:
-            plans.append(_plan_segment(index, segment, item, start, end, tolerance_rad))
-        except InputError as exc:  # the tolerance's, unless it names the rate's key
-            raise (exc if exc.key else exc.located(key=name)) from None
+        for start, end, what in _pieces(segment, start_s, stop_s):
+            try:
+                plans.append(_plan_segment(index, segment, item, start, end, tolerance_rad, what))
+            except InputError as exc:  # the tolerance's, unless it names the rate's key
+                raise (exc if exc.key else exc.located(key=name)) from None
     return AemPlan(tolerance_rad, plans)
 
 
@@ -344,10 +475,14 @@ def write_planned_aem(
     object_id: str,
     comments: tuple[str, ...] = (),
     chunk_records: int = 16384,
-) -> None:
+) -> AemPlan:
     """The AEM of ``plan`` into the binary ``stream``, written as it is computed: a
-    segment per stretch of motion, its records ``chunk_records`` at a time, each
+    segment per stretch of smooth motion, its records ``chunk_records`` at a time, each
     declaring the interpolation it was sampled for (:data:`INTERPOLATION_METHOD`).
+
+    Returns ``plan`` with each segment's error measured on the records written
+    (``measured_error_rad``: module docstring); a measurement beyond the tolerance
+    raises :class:`RuntimeError` (the sampling failed: a bug, not the user's).
 
     ``texts``: the epoch texts of the scenario's time scale; ``comments``: the
     header's first comment lines (a statement of the sampling's accuracy follows them).
@@ -366,6 +501,7 @@ def write_planned_aem(
             "rad of the exact attitude",
         ),
     )
+    measured = []
     for item in plan.segments:
         segment = trajectory.segments[item.segment]
         ends = texts(np.array([item.start_s, item.end_s]))
@@ -375,18 +511,41 @@ def write_planned_aem(
             interpolation=None if item.degree is None else (INTERPOLATION_METHOD, item.degree),
             comments=(
                 f"motion segment {item.segment}",
-                *((f"started by {segment.event.kind}",) if segment.event else ()),
+                *(
+                    (f"started by {segment.event.kind}",)
+                    if segment.event and item.start_s == segment.start_s
+                    else ()
+                ),
+                *((f"starts where {item.started_by}",) if item.started_by else ()),
                 f"a record every {item.step_s:.6g} s",
             ),
         )
+        worst = 0.0
+        degree = item.degree if item.degree is not None else 1
         for first in range(0, item.count, chunk_records):
-            τ = item.seconds(first, first + chunk_records)
+            stop = min(first + chunk_records, item.count)
+            # The chunk's records, and the neighbours the windows of its intervals use.
+            low, high = max(0, first - degree), min(item.count, stop + degree)
+            τ = item.seconds(low, high)
             # One record is evaluated as a pair (see attitude.outputs.csv.sample).
             pair = np.repeat(τ, 2) if τ.size == 1 else τ
-            writer.write_records(
-                texts(τ),
-                segment.solver.attitude_quaternion(pair)[: τ.size],
-                segment.solver.angular_velocity(pair)[: τ.size],
-            )
+            q = segment.solver.attitude_quaternion(pair)[: τ.size]
+            ω = segment.solver.angular_velocity(pair)[: τ.size]
+            own = slice(first - low, stop - low)
+            writer.write_records(texts(τ[own]), q[own], ω[own])
+            interval = np.arange(first, min(stop, item.count - 1))
+            if interval.size and item.count > 1:
+                index = np.arange(low, high)
+                found = _read_errors(segment.solver, index, τ, q, interval, item.count, degree)
+                worst = max(worst, float(np.max(found)))
         writer.end_segment()
+        bound = worst * item.peak_margin + item.time_tag_rad
+        if bound > plan.tolerance_rad:
+            raise RuntimeError(
+                f"attitude.aem segment {len(measured)}: the declared reading is {bound:.3g} rad "
+                f"off the attitude, measured on the records written, beyond the "
+                f"{plan.tolerance_rad:g} rad it was sampled for"
+            )
+        measured.append(replace(item, measured_error_rad=bound))
     writer.close()
+    return replace(plan, segments=measured)

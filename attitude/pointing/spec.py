@@ -288,7 +288,8 @@ def describe_lines(spec: PointingSpec) -> list[str]:
         return []
     where = "Earth centre" if spec.orbit is None else spec.orbit.describe()
     lines = [
-        f"pointing    {len(spec.body_vectors)} body vectors, orbit: {where}, interval ends "
+        f"pointing    {len(spec.body_vectors)} body "
+        f"{'vector' if len(spec.body_vectors) == 1 else 'vectors'}, orbit: {where}, interval ends "
         f"to {spec.interval_precision_s:g} s"
     ]
     if spec.earth_limb_atmosphere_height_m:

@@ -7,7 +7,10 @@ spin); the figures of the motion do not use it:
   periodic in the body with the body period T, so a column longer than T holds its
   whole range, taken once per segment from 4096 samples of one period; a shorter one
   is sampled at 512 points per turn (or per T, if shorter; at most 4096 a column):
-  extremes within 2e-5 of the amplitude.  A steady spin is constant.
+  extremes within 2e-5 of the amplitude.  A steady spin is constant.  Under torques
+  the columns hold the segment's survey (``TorquedMotion.survey``: 32 samples a turn
+  at the largest rate, the samples its flips and largest rate were found on), so the
+  figure propagates nothing: extremes within about 0.5 % of the nutation's amplitude.
 - The polhode is each segment's momentum over one body period (2049 samples, the
   whole closed curve), or over the segment when it is shorter or has no period (the
   separatrix, sampled densely around its flip): a nutation of exactly 60° is drawn at
@@ -31,6 +34,7 @@ from numpy.typing import NDArray
 
 from attitude.report.plots import PIXEL_COLUMNS, Envelope, Zoom
 from attitude.trajectory.motion import SegmentMotion
+from attitude.trajectory.torqued import TorquedMotion
 from attitude.trajectory.trajectory import Trajectory
 
 __all__ = [
@@ -76,6 +80,12 @@ def angular_velocity_envelope(
     edges = envelope.edges
     for _, segment, item, a, b in _pieces(trajectory, motion, start_s, stop_s):
         solver = segment.solver
+        if isinstance(solver, TorquedMotion):
+            # The survey the flips and the largest rate were found on: no new propagation.
+            for t, _, ω in solver.survey():
+                inside = (t >= a) & (t <= b)
+                envelope.add(t[inside], {axis: ω[inside, i] for i, axis in enumerate("xyz")})
+            continue
         period = item.period_s
         # Closed columns: a segment starting on an edge also ends the column before.
         first = max(int(np.searchsorted(edges, a, side="left")) - 1, 0)

@@ -7,11 +7,14 @@ the span, the Sun and Moon ephemeris with the interpolation's margins, the size 
 the exact search), chooses the AEM's records for its tolerance, counts the output
 samples and estimates the outputs' sizes and the (constant) memory of the streamed
 run.  It notes an output step that undersamples the motion (more than a tenth of its
-shortest period).  Segments under torques are propagated (their whole grid, and the
-error estimate of their step); a scenario with an orbit that leaves the gravity
-gradient out (torque-free, or burns alone) gets its validity horizon
-(``attitude.trajectory.horizon.validity_horizon``).  What it refuses, a run would have refused
-later, after computing; what it returns is what the run uses.  Errors are
+shortest period).  Segments under torques are propagated at the step given or chosen
+for the accuracy, and the run's error is estimated (``attitude.trajectory.steps``);
+a scenario with an orbit that leaves the gravity gradient out (torque-free, or burns
+alone) gets its validity horizon (``attitude.trajectory.horizon.validity_horizon``).
+What it refuses, a run would have refused later, after computing; what it returns is
+what the run uses.  ``attitude check`` plans with ``check=True``: the same path
+within a budget of steps, with what lies beyond it predicted (a run that measures
+more can still refuse an accuracy that its measurement says is missed).  Errors are
 ``attitude.base.errors.InputError`` whose ``key`` is the scenario key that holds the
 bad value.
 """
@@ -34,6 +37,7 @@ from attitude.report.beside import Beside
 from attitude.scenario.scenario import Scenario
 from attitude.trajectory.horizon import ValidityHorizon, validity_horizon
 from attitude.trajectory.motion import SegmentMotion, analyze, undersampling_note
+from attitude.trajectory.steps import CHECK_BUDGET_S
 from attitude.trajectory.trajectory import Trajectory, propagate
 
 __all__ = ["RunPlan", "horizon_beside", "plan_run"]
@@ -55,6 +59,8 @@ class RunPlan:
     horizon: ValidityHorizon | None = None  # on an orbit, no gravity gradient: how long it holds
     # The horizon is wanted but left for the run to compute (plan_run(horizon=False)).
     horizon_deferred: bool = False
+    # Planned for `attitude check` (plan_run(check=True)): predictions where the run computes.
+    check: bool = False
 
 
 def plan_run(
@@ -63,6 +69,7 @@ def plan_run(
     outputs: OutputChoice | None = None,
     horizon: bool = True,
     progress: Callable[[str], None] | None = None,
+    check: bool = False,
 ) -> RunPlan:
     """Check ``scenario`` (``pointing``, ``outputs``) as a run would, up to the sampling.
 
@@ -70,6 +77,13 @@ def plan_run(
     (``horizon_deferred`` says it is wanted): a run computes it beside its outputs
     (``attitude.report.run``), since it checks nothing and takes as long as a day's outputs.
     ``progress(text)`` is told each stage as it starts (the command line's stderr).
+
+    ``check``: for ``attitude check``, which answers in seconds: under torques, the
+    step search within its budget (``attitude.trajectory.steps``: what it refuses, the
+    run refuses too), the run's error measured as far as the budget goes and predicted
+    beyond, a run longer than the budget propagated at a longer step for the checks
+    that read the motion (``Trajectory.approximate``), and the flips under torques
+    left to the run.
     """
     say = progress or (lambda text: None)
     # The scenario's orbit, when the pointing gives none (the orbit is given once).
@@ -79,8 +93,8 @@ def plan_run(
     if "parquet" in outputs:
         check_span(scenario.start_s, scenario.stop_s, "--formats parquet")
     _check_gravity_gradient_orbit(scenario)
-    say(_propagating(scenario))
-    trajectory = propagate(scenario)
+    say(_propagating(scenario, check))
+    trajectory = propagate(scenario, check=check)
     # The size and memory checks come before the analysis and the pointing checks,
     # which do not depend on the output grid but can take a while on a long span.
     vectors, on_orbit = len(pointing.body_vectors), pointing.on_orbit
@@ -89,25 +103,26 @@ def plan_run(
         samples, 0, vectors, on_orbit, outputs.formats, aem_records=0, pointing_columns=columns
     )
     check_fits(budget)
+    # The run's estimated error (a given step: measured now; check: within its budget).
+    if not check and trajectory.steps is not None and trajectory.steps.measurement is None:
+        say("estimating the propagation's error: the run again at twice the step")
+    steps = trajectory.steps if check else trajectory.measured()
+    if steps is not None and steps.measurement is not None:
+        if not math.isfinite(steps.measurement.estimate_rad):
+            raise InputError(
+                f"at {steps.step_s:g} s the propagation has no finite error estimate (the "
+                "run at twice the step runs away): give a smaller step or an accuracy",
+                key="torques.step",
+                value=steps.step_s,
+            )
     say("analysing the motion (flips, nutation, spin, precession)")
-    motion = analyze(trajectory)
+    motion = analyze(trajectory, locate=not check)
     if not pointing.is_empty:
         say("checking the pointing: the orbit, the Sun and the Moon over the span")
     notes, search = check_pointing(trajectory, pointing)
     undersampled = undersampling_note(trajectory, motion)
     if undersampled:
         notes.append(undersampled)
-    # The error estimates the summary states (each segment's, and the run's), checked here.
-    errors = [getattr(s.solver, "error_estimate", 0.0) for s in trajectory.segments]
-    if scenario.torques.any:
-        say("estimating the propagation's error: the run again at twice each step")
-    errors.append(trajectory.error_estimate)
-    if not all(math.isfinite(error) for error in errors):
-        raise InputError(
-            f"the propagation has no finite error estimate ({errors}): "
-            "give a smaller step or an accuracy",
-            key="torques",
-        )
     found = None
     # On an orbit, unless the gravity gradient is modelled: a torque-free run, or burns
     # alone, neglects it.
@@ -147,11 +162,14 @@ def plan_run(
         search,
         found,
         horizon_deferred=wanted and not horizon,
+        check=check,
     )
 
 
-def _propagating(scenario: Scenario) -> str:
-    """The propagation stage in words: the segments, and how many are under torques."""
+def _propagating(scenario: Scenario, check: bool) -> str:
+    """The propagation stage in words: the segments, how many are under torques, and
+    how their step is set (chosen for the accuracy, the run's error estimated on the
+    way: ``attitude.trajectory.steps``)."""
     segments = len(scenario.events) + 1
     text = f"propagating {segments} segment{'s' if segments > 1 else ''}"
     what = []
@@ -159,7 +177,21 @@ def _propagating(scenario: Scenario) -> str:
         what.append("gravity gradient")
     if scenario.burns:
         what.append(f"{len(scenario.burns)} burn{'s' if len(scenario.burns) > 1 else ''}")
-    return text + (f" under {' and '.join(what)} (splitting)" if what else "")
+    if not what:
+        return text
+    text += f" under {' and '.join(what)} (splitting)"
+    torques = scenario.torques
+    within = f" within {CHECK_BUDGET_S:g} s of CPU" if check else ""
+    if torques.step is not None:
+        return text + (
+            f" at {torques.step:g} s, and at twice it for the error estimate{within}"
+            if check
+            else f" at {torques.step:g} s"
+        )
+    return text + (
+        f", at the step whose error estimate (the run at h and 2h) meets "
+        f"{torques.accuracy_rad:g} rad{within}"
+    )
 
 
 def _check_gravity_gradient_orbit(scenario: Scenario) -> None:

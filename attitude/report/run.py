@@ -44,7 +44,7 @@ from attitude.base.progress import Progress
 from attitude.base.version import __version__
 from attitude.environment.epoch_texts import EpochTexts
 from attitude.environment.orbit import TleOrbit
-from attitude.outputs.aem_sampling import INTERPOLATION_METHOD, write_planned_aem
+from attitude.outputs.aem_sampling import INTERPOLATION_METHOD, AemPlan, write_planned_aem
 from attitude.outputs.aem_writer import aem_text
 from attitude.outputs.budget import check_fits
 from attitude.outputs.csv import (
@@ -83,11 +83,13 @@ from attitude.report.summaries import (
     outputs_summary,
     pointing_summary,
     scenario_summary,
+    to_json,
     write_json,
 )
 from attitude.report.torques import torques_summary
 from attitude.scenario.scenario import Scenario
 from attitude.trajectory.horizon import ValidityHorizon
+from attitude.trajectory.motion import largest_rate_of
 
 __all__ = ["CHUNK_SAMPLES", "OUTPUT_NAMES", "Progress", "output_grid", "write_report"]
 
@@ -250,7 +252,6 @@ class _Stream:
         plots = "plots" in plan.outputs
         self.sun = Envelope(*span, vectors) if plots and vectors else None
         self.sunlit = Envelope(*span, ["sunlit"]) if plots and plan.pointing.on_orbit else None
-        self.peak_rate = (-1.0, 0.0)  # (rad/s, at TT s)
 
     def add(self, τ: np.ndarray, samples, pointing: PointingSamples | None) -> None:
         columns = trajectory_columns(samples)
@@ -268,10 +269,6 @@ class _Stream:
                 self.csv.write(epochs, columns)
             if self.parquet is not None:
                 self.parquet.write(epochs, τ, columns)
-        rate = np.linalg.norm(samples.angular_velocity, axis=1)
-        peak = int(np.argmax(rate))
-        if rate[peak] > self.peak_rate[0]:  # the first of equal maxima, as on one grid
-            self.peak_rate = (float(rate[peak]), float(τ[peak]))
 
 
 def _build(
@@ -315,10 +312,13 @@ def _build_with(
         analysis = _search_pointing(plan, tmp, source, texts, pointing, progress)
         summary["pointing"] = pointing_summary(analysis, plan.scenario.format_epoch)
         files.append("intervals.csv")
-    summary["outputs"] = outputs_summary(plan)
     if "aem" in outputs:
-        _write_aem(tmp / "attitude.aem", plan, texts, chunk_samples, progress)
+        # The AEM's stated error is measured on its records as they are written.
+        plan = replace(
+            plan, aem=_write_aem(tmp / "attitude.aem", plan, texts, chunk_samples, progress)
+        )
         files.append("attitude.aem")
+    summary["outputs"] = outputs_summary(plan)
     images: dict[str, str] = {}
     if "plots" in outputs:
         progress("plotting")
@@ -330,7 +330,9 @@ def _build_with(
     write_json(tmp / "summary.json", summary)
     files.append("summary.json")
     if "report" in outputs:
-        (tmp / "report.html").write_text(render_page(summary, images, files), encoding="utf-8")
+        # The page from what summary.json holds (no inf where the file has null).
+        page = render_page(to_json(summary), images, files)
+        (tmp / "report.html").write_text(page, encoding="utf-8")
         files.append("report.html")
     files += list(images.values())
     return summary, files
@@ -355,7 +357,8 @@ def _stream_output_grid(
         f"sampling {count} epochs over {scenario.stop_s:g} s, {min(chunk, count)} at a time"
         + (f": writing {', '.join(series)}" if series else "")
         + (
-            f"; pointing: {len(spec.body_vectors)} body vectors, "
+            f"; pointing: {len(spec.body_vectors)} body "
+            f"{'vector' if len(spec.body_vectors) == 1 else 'vectors'}, "
             f"{'Earth centre' if spec.orbit is None else spec.orbit.describe()}"
             if pointing
             else ""
@@ -377,16 +380,18 @@ def _stream_output_grid(
 
 
 def _summary_of_the_stream(plan: RunPlan, source: str, stream: _Stream) -> dict[str, Any]:
-    """The summary's scenario, motion, torques and the extremum found on the output grid."""
+    """The summary's scenario, motion, torques and the largest rate, found on the
+    motion (``attitude.trajectory.rates``), not on the output grid."""
     scenario = plan.scenario
+    largest = largest_rate_of(plan.motion)
     return {
         "attitude_version": __version__,
         "scenario": scenario_summary(scenario, source),
         "motion": motion_summary(plan.trajectory, plan.motion),
         "torques": torques_summary(plan),
         "extrema": {
-            "max_rate_deg_s": math.degrees(stream.peak_rate[0]),
-            "max_rate_at": scenario.format_epoch(stream.peak_rate[1]),
+            "max_rate_deg_s": None if largest is None else math.degrees(largest[0]),
+            "max_rate_at": None if largest is None else scenario.format_epoch(largest[1]),
         },
     }
 
@@ -420,8 +425,9 @@ def _search_pointing(
 
 def _write_aem(
     path: Path, plan: RunPlan, texts: EpochTexts, chunk_samples: int, progress: Progress
-) -> None:
-    """attitude.aem over the records the plan chose for its tolerance."""
+) -> AemPlan:
+    """attitude.aem over the records the plan chose for its tolerance; the plan with
+    the error measured on them."""
     scenario, aem = plan.scenario, plan.aem
     progress(
         f"writing attitude.aem (CCSDS AEM 2.0): {aem.records} records, "
@@ -430,7 +436,7 @@ def _write_aem(
     orbit = plan.pointing.orbit
     designator = orbit.international_designator if isinstance(orbit, TleOrbit) else None
     with open(path, "wb") as stream:
-        write_planned_aem(
+        return write_planned_aem(
             stream,
             plan.trajectory,
             aem,

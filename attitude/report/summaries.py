@@ -99,25 +99,33 @@ _MOTION_TEXT = {
     "asymptotically, so the body turns over at most once",
     "rest": "at rest: no motion",
     "torqued": "under torques (propagated by splitting with the exact free flow): no "
-    "period, flips not located; the kinetic energy and momentum are those at its start",
+    "period; flips located on the propagated motion (the momentum crossing the "
+    "intermediate axis); the kinetic energy and momentum are those at its start",
 }
 
 
 def _flips_summary(scenario, motion: list[SegmentMotion]) -> dict[str, Any]:
     """All flips: their count, and their times up to LISTED_FLIPS (an event's epoch can
-    end one segment and start the next with the same flip: it counts once)."""
+    end one segment and start the next with the same flip: it counts once).  When a
+    segment's flips were not located, the count is None and the note says why."""
+    missing = [item.flips_note for item in motion if item.flip_count is None]
     listed = np.concatenate([item.flip_times_s for item in motion]) if motion else np.empty(0)
     listed, repeated = np.unique(listed, return_counts=True)
-    count = sum(item.flip_count for item in motion) - int(np.sum(repeated - 1))
     listed = listed[:LISTED_FLIPS]
+    if missing:
+        return {
+            "count": None,
+            "times_s": listed,
+            "times": [scenario.format_epoch(t) for t in listed[:1000]],
+            "note": f"flips of segments under torques {missing[0]}",
+        }
+    count = sum(int(item.flip_count or 0) for item in motion) - int(np.sum(repeated - 1))
     complete = listed.size == count
     return {
         "count": count,
         "times_s": listed,
         "times": [scenario.format_epoch(t) for t in listed[:1000]],
-        "note": None
-        if complete
-        else f"times_s lists the first {listed.size} of {count} flips (closed form)",
+        "note": None if complete else f"times_s lists the first {listed.size} of {count} flips",
     }
 
 
@@ -142,6 +150,7 @@ def motion_summary(trajectory: Trajectory, motion: list[SegmentMotion]) -> dict[
                 "body_period_s": item.period_s,
                 "flip_period_s": item.flip_period_s,
                 "flip_count": item.flip_count,
+                "flips_note": item.flips_note,
                 "spin_axis_body": item.spin_axis_body,
                 "nutation_angle_min_deg": None
                 if item.nutation_min_rad is None
@@ -254,22 +263,31 @@ def pointing_summary(analysis: PointingAnalysis, format_epoch) -> dict[str, Any]
 
 
 def outputs_summary(plan: RunPlan) -> dict[str, Any]:
-    """The formats written, and the AEM's sampling and stated accuracy."""
+    """The formats written, and the AEM's sampling and its error measured on the file
+    (``attitude.outputs.aem_sampling``: every interval read as declared where the
+    interpolation error peaks, when the records are written)."""
     entry: dict[str, Any] = {"formats": list(plan.outputs.formats)}
-    if "aem" in plan.outputs:
+    if "aem" in plan.outputs and plan.aem is not None:
         entry["aem"] = {
             "tolerance_rad": plan.aem.tolerance_rad,
             "interpolation": f"{INTERPOLATION_METHOD}, degree as declared per segment: "
             "each of Q1..QC interpolated over the degree + 1 records centred on the "
             "interval, then normalized",
             "records": plan.aem.records,
+            "largest_error_rad": plan.aem.measured_error_rad,
+            "largest_error_note": "measured on the records written: every interval read as "
+            "declared where the interpolation error peaks (the extremum of the node "
+            "polynomial) against the propagated attitude, the largest times 1 + |omega| h/18 "
+            "for the rest of the interval, plus |omega| x 0.5 ns for the 1 ns time tags",
             "segments": [
                 {
                     "segment": item.segment,
+                    "start": plan.scenario.format_epoch(item.start_s),
+                    "starts_where": item.started_by,
                     "records": item.count,
                     "step_s": item.step_s,
                     "interpolation_degree": item.degree,
-                    "largest_error_found_rad": item.tested_error_rad,
+                    "largest_error_rad": item.measured_error_rad,
                 }
                 for item in plan.aem.segments
             ],

@@ -18,9 +18,10 @@ from __future__ import annotations
 from typing import Any
 
 from attitude.report.plan import RunPlan
+from attitude.trajectory.steps import CHECK_BUDGET_S
 from attitude.trajectory.torqued import TorquedMotion
 
-__all__ = ["horizon_text", "torques_lines", "torques_summary"]
+__all__ = ["horizon_text", "run_cost_s", "torques_lines", "torques_summary"]
 
 
 def torques_summary(plan: RunPlan) -> dict[str, Any]:
@@ -38,6 +39,9 @@ def torques_summary(plan: RunPlan) -> dict[str, Any]:
             if horizon is not None
             else "no orbit: the gravity gradient that torque-free motion neglects is not known",
         }
+    steps = plan.trajectory.steps
+    found = None if steps is None else steps.measurement
+    estimate = None if steps is None else steps.estimate_rad
     segments = [
         {
             "segment": k,
@@ -48,6 +52,7 @@ def torques_summary(plan: RunPlan) -> dict[str, Any]:
         for k, segment in enumerate(plan.trajectory.segments)
         if isinstance(segment.solver, TorquedMotion)
     ]
+    accuracy = settings.accuracy_rad
     return {
         "modelled": settings.modelled(),
         "gravity_gradient": settings.gravity_gradient is not None,
@@ -65,12 +70,25 @@ def torques_summary(plan: RunPlan) -> dict[str, Any]:
         "propagation": "splitting with the exact free flow (docs/torques.md)",
         "order": settings.order,
         "step": "given" if settings.step is not None else "chosen for the accuracy",
-        "accuracy_rad": settings.accuracy_rad,
+        "step_s": None if steps is None else steps.step_s,
+        "accuracy_rad": accuracy,
         "segments": segments,
-        "estimated_error_rad": plan.trajectory.error_estimate,
-        "estimated_error_note": "segments[].estimated_error_rad: each segment's own, from its "
-        "start state; estimated_error_rad: the run's, the scenario rerun at twice each step "
-        "through the same events (errors carried into a segment grow with the motion)",
+        "estimated_error_rad": estimate,
+        "estimated_error_measured_over_s": None if found is None else found.until_s,
+        "estimated_error_predicted": None if found is None else not found.complete,
+        "accuracy_met": None
+        if accuracy is None or estimate is None
+        else bool(estimate <= accuracy),
+        "estimated_error_note": "estimated_error_rad: the run's, the scenario rerun at twice "
+        "the step through the same events and compared over the span (errors carried into "
+        "a segment grow with the motion); segments[].estimated_error_rad: the same within "
+        "each segment, the errors carried into it included",
+        "step_search": None
+        if steps is None or steps.given
+        else [
+            {"step_s": step, "estimated_error_rad": error, "ended": ended}
+            for step, error, ended in steps.tried
+        ],
         "validity_horizon": horizon,
         "validity_horizon_note": None if horizon is not None else _horizon_note(settings),
     }
@@ -83,6 +101,29 @@ def _horizon_note(settings: Any) -> str:
     return "no orbit: the gravity gradient that the burns-only motion neglects is not known"
 
 
+def _seconds_text(seconds: float) -> str:
+    """A duration of CPU for `attitude check`: 0.4 s, 25 s, 3.2 min, 1.5 h."""
+    if seconds < 60.0:
+        return f"{seconds:.2g} s" if seconds < 10.0 else f"{seconds:.0f} s"
+    if seconds < 3600.0:
+        return f"{seconds / 60.0:.2g} min"
+    return f"{seconds / 3600.0:.2g} h"
+
+
+def run_cost_s(plan: RunPlan) -> float | None:
+    """The CPU time (s) that the run spends on the motion under torques, from the cost
+    of a step measured here: the step search (as here; when check's budget stopped it,
+    about two more tries of the whole span, 1.5 runs each), or with a given step, the
+    run and its rerun at twice the step (1.5 runs).  None when no step was measured."""
+    steps = plan.trajectory.steps
+    if steps is None or steps.cpu_per_step_s <= 0.0:
+        return None
+    whole = 1.5 * steps.grid_steps * steps.cpu_per_step_s
+    if steps.given:
+        return whole
+    return steps.search_cpu_s + (0.0 if steps.settled else 2.0 * whole)
+
+
 def torques_lines(plan: RunPlan) -> list[str]:
     """The lines of ``attitude check`` (without their indentation)."""
     entry = torques_summary(plan)
@@ -92,24 +133,79 @@ def torques_lines(plan: RunPlan) -> list[str]:
         if horizon is not None:
             lines.append(f"horizon     {horizon}")
         return lines
+    steps = plan.trajectory.steps
+    assert steps is not None
     how = (
         f"step {plan.scenario.torques.step:g} s"
         if entry["step"] == "given"
         else f"step chosen for {entry['accuracy_rad']:g} rad"
     )
     lines = [f"torques     {', '.join(entry['modelled'])}; order {entry['order']}, {how}"]
-    for item in entry["segments"]:
+    count = len(steps.tried)
+    tries = f"{count} {_plural(count, 'try', 'tries')}"
+    found = steps.measurement
+    if not steps.settled:
+        assert found is not None
+        within = found.predicted_rad <= entry["accuracy_rad"]
+        lines += [
+            f"  step        the search stopped at check's {CHECK_BUDGET_S:g} s budget after "
+            f"{tries}; the run finishes it over the whole span",
+            f"  at a step of {found.step_s:.4g} s the run's error is predicted at "
+            f"{found.predicted_rad:.2g} rad (from its first {found.until_s:.6g} s, growing as "
+            f"t^{found.growth:.2g}), {'within' if within else 'beyond'} "
+            f"{entry['accuracy_rad']:g} rad: the step will be near {steps.step_s:.4g} s",
+        ]
+    else:
+        how_chosen = "" if steps.given else f" ({tries})"
         lines.append(
-            f"  segment {item['segment']} {item['method']} at a step of {item['step_s']:.6g} s, "
-            f"estimated error {item['estimated_error_rad']:.2g} rad from its start"
+            f"  step        {steps.step_s:.4g} s in every segment under torques{how_chosen}"
         )
-    lines.append(
-        f"  estimated error of the run, through the events: {entry['estimated_error_rad']:.2g} rad"
-    )
+        if found is not None and found.complete:
+            for item in entry["segments"]:
+                error = item["estimated_error_rad"]
+                lines.append(
+                    f"  segment {item['segment']} {item['method']}: estimated error "
+                    + ("none" if error is None else f"{error:.2g} rad")
+                    + " (the run's, within it)"
+                )
+        if found is not None:
+            verdict = ""
+            if entry["accuracy_met"] is not None:
+                verdict = (
+                    f", within {entry['accuracy_rad']:g} rad"
+                    if entry["accuracy_met"]
+                    else f", beyond {entry['accuracy_rad']:g} rad"
+                )
+            if found.complete:
+                where = "measured over the whole span"
+            else:
+                where = (
+                    f"predicted from its first {found.until_s:.6g} s (growing as "
+                    f"t^{found.growth:.2g}); the run measures it over the whole span"
+                )
+            lines.append(
+                f"  estimated error of the run: {entry['estimated_error_rad']:.2g} rad"
+                f"{verdict}, {where}"
+            )
+    if plan.trajectory.approximate:
+        lines.append(
+            f"  the motion below was propagated at {plan.trajectory.approximate_step_s:.4g} s "
+            f"({steps.grid_steps} steps at the run's step): its sizes are close, not exact"
+        )
+    cost = run_cost_s(plan)
+    if cost is not None:
+        lines.append(
+            f"  run cost    about {_seconds_text(cost)} of CPU for the motion under torques "
+            f"({steps.grid_steps} steps at {steps.step_s:.4g} s, and the error estimate)"
+        )
     horizon = horizon_text(plan)
     if horizon is not None:  # burns alone, on an orbit: the gravity gradient left out
         lines.append(f"horizon     {horizon}")
     return lines
+
+
+def _plural(count: int, one: str, many: str) -> str:
+    return one if count == 1 else many
 
 
 def horizon_text(plan: RunPlan) -> str | None:

@@ -19,9 +19,10 @@ events.  With :class:`ScenarioTorques` its segments are propagated by
   the inertia or attitude).
 
 The method: ``order`` 2, 4 (default) or 6, with either a ``step`` (s) or an
-``accuracy`` (rad): with an accuracy, each segment's step is chosen so that the
-estimated attitude error over the segment is within it (``docs/torques.md``, "How the
-step is chosen").  Neither: an accuracy of 1e-6 rad (the AEM's default tolerance).
+``accuracy`` (rad): with an accuracy, the one step of every torqued segment is chosen
+so that the estimated attitude error of the whole run, errors carried across events
+included, is within it (``attitude.trajectory.steps``; ``docs/torques.md``, "The
+scenario route").  Neither: an accuracy of 1e-6 rad (the AEM's default tolerance).
 
 ``horizon_threshold`` (rad, default 1°) is the angle that defines the validity
 horizon of a torque-free scenario that has an orbit: how long until the neglected
@@ -43,6 +44,7 @@ from numpy.typing import NDArray
 
 from attitude.base.errors import InputError
 from attitude.base.quantities import as_si_scalar, as_vector3
+from attitude.torques.solver import TOLERANCE_RANGE_RAD
 
 __all__ = [
     "DEFAULT_ACCURACY_RAD",
@@ -56,7 +58,7 @@ __all__ = [
 DEFAULT_ACCURACY_RAD = 1e-6
 DEFAULT_HORIZON_THRESHOLD_RAD = math.radians(1.0)
 # Accuracies the step search can meet: below 1e-12 rad the estimate is rounding.
-_ACCURACY_RANGE_RAD = (1e-12, 0.1)
+_ACCURACY_RANGE_RAD = TOLERANCE_RANGE_RAD
 # More steps than this over the span is refused as a mistake: at 8 free flows a step
 # and tens of µs a flow, 1e7 steps are about an hour of computing.
 MAX_STEPS = 1e7

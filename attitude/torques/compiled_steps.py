@@ -18,8 +18,9 @@ compiled from the same source) at the kick's clock, and the exact free flow
 (:func:`attitude.solver.numba_backend.flow_one`) over the flows owed since the last
 kick, merged across the steps.  The states are those of the Python loop to rounding.
 A state the compiled flow does not take (the separatrix and its neighbourhood, rest:
-``flow_one``'s ``ok`` false), or one that is not finite, stops the kernel before that
-step; the caller's Python loop goes on from there.
+``flow_one``'s ``ok`` false), or one spun up beyond what the solver accepts (or not
+finite), stops the kernel before that step; the caller's Python loop goes on from
+there (and refuses the latter).
 """
 
 from __future__ import annotations
@@ -46,6 +47,7 @@ def gravity_gradient_steps(
     state: NDArray[np.float64],
     sizes: NDArray[np.float64],
     data: NDArray[np.float64],
+    largest: float,
     out_m: NDArray[np.float64],
     out_q: NDArray[np.float64],
     out_pending: NDArray[np.float64],
@@ -53,7 +55,8 @@ def gravity_gradient_steps(
     """Steps of ``sizes`` (K,) from ``state`` = (m1, m2, m3, qw, qx, qy, qz, pending)
     (principal axes; the flow still owed, s); the composition's ``flows`` a_j and
     ``kicks`` b_j; ``moments`` (I1, I2, I3); ``data`` (K, active kicks, 4): the gravity
-    gradient's (ux, uy, uz, 3μ/r³) at each non-zero kick of each step.  Writes each
+    gradient's (ux, uy, uz, 3μ/r³) at each non-zero kick of each step; ``largest``: the
+    largest |m1| + |m2| + |m3| a state may reach (N m s).  Writes each
     step's end state into ``out_m`` (K, 3), ``out_q`` (K, 4), ``out_pending`` (K,);
     returns the number of steps done (K, or the step where it stopped: module
     docstring)."""
@@ -87,7 +90,7 @@ def gravity_gradient_steps(
             if j < s:
                 pending = pending + flows[j] * h
         norm = math.sqrt(qw * qw + qx * qx + qy * qy + qz * qz)
-        if not (math.isfinite(m1 + m2 + m3) and norm > 0.0 and math.isfinite(norm)):
+        if not (abs(m1) + abs(m2) + abs(m3) <= largest and norm > 0.0 and math.isfinite(norm)):
             return k
         qw, qx, qy, qz = qw / norm, qx / norm, qy / norm, qz / norm
         out_m[k, 0], out_m[k, 1], out_m[k, 2] = m1, m2, m3

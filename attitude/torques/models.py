@@ -47,11 +47,13 @@ from attitude.base.quantities import as_si_array, as_si_scalar, as_vector3
 __all__ = [
     "MU_EARTH_M3_S2",
     "ConstantTorque",
+    "ConstantTorqueSchedule",
     "GravityGradient",
     "PrincipalFrame",
     "Torque",
     "UserTorque",
     "as_torque_list",
+    "merged_constant_torques",
 ]
 
 MU_EARTH_M3_S2 = 3.986004418e14  # [IERS2010] table 1.1
@@ -274,6 +276,91 @@ class ConstantTorque(Torque):
         if self.frame == "inertial":
             return rotate_into_principal(q, τ)
         return frame.to_principal(τ)
+
+
+class ConstantTorqueSchedule(Torque):
+    """Many :class:`ConstantTorque` s as one model: their sum, piecewise constant.
+
+    The solver kicks with every model at every kick, so N burns as N models cost N
+    torque evaluations a kick, over a grid that has about 2N breakpoints more: a cost
+    that grows as N².  Their sum is constant between consecutive switches; this model
+    holds it per elementary interval [e_j, e_j+1) (body and inertial parts apart) and
+    finds the interval of a step by bisection, so a kick costs the same for one burn
+    as for a thousand.  The sums are exact sums of the torques on in that interval
+    (``math.fsum``): after the last burn the torque is exactly zero.  The switch rule
+    is :class:`ConstantTorque`'s: a torque is on for a whole step when the step's
+    midpoint lies in [start, stop).
+    """
+
+    data_width = 6  # (body τx, τy, τz, inertial τx, τy, τz), each the sum of those on
+
+    def __init__(self, torques: Sequence[ConstantTorque]) -> None:
+        self.torques = tuple(torques)
+        if not self.torques or not all(isinstance(t, ConstantTorque) for t in self.torques):
+            raise InputError("ConstantTorqueSchedule needs one or more ConstantTorque")
+        edges = sorted({b for t in self.torques for b in (t.start, t.stop)})
+        self._edges = np.array(edges, dtype=np.float64)
+        # Sweep the edges: the torques on over [e_j, e_j+1), summed exactly.
+        starts = sorted(range(len(self.torques)), key=lambda i: self.torques[i].start)
+        on: set[int] = set()
+        sums = np.zeros((len(edges), 6))
+        k = 0
+        for j, edge in enumerate(edges):
+            on = {i for i in on if self.torques[i].stop > edge}
+            while k < len(starts) and self.torques[starts[k]].start <= edge:
+                if self.torques[starts[k]].stop > edge:
+                    on.add(starts[k])
+                k += 1
+            for offset, frame in ((0, "body"), (3, "inertial")):
+                chosen = [self.torques[i].torque for i in on if self.torques[i].frame == frame]
+                if chosen:
+                    sums[j, offset : offset + 3] = [
+                        math.fsum(v[c] for v in chosen) for c in range(3)
+                    ]
+        self._sums = sums
+        self._body = bool(np.any(sums[:, :3]))
+        self._inertial = bool(np.any(sums[:, 3:]))
+
+    def __repr__(self) -> str:
+        return f"ConstantTorqueSchedule({len(self.torques)} torques)"
+
+    @property
+    def breakpoints(self) -> tuple[float, ...]:
+        return tuple(float(e) for e in self._edges if math.isfinite(e))
+
+    def time_data(self, t: NDArray[np.float64], t_step: NDArray[np.float64]) -> NDArray[np.float64]:
+        j = np.searchsorted(self._edges, t_step, side="right") - 1
+        out = np.zeros((np.shape(t_step)[0], 6))
+        inside = j >= 0  # before the first switch, nothing is on
+        out[inside] = self._sums[j[inside]]
+        return out
+
+    def principal_torque(
+        self, data: Components, q: Components, ω: Components, frame: PrincipalFrame
+    ) -> Components:
+        if not self._body:
+            return rotate_into_principal(q, data[3:])
+        body = frame.to_principal(data[:3])
+        if not self._inertial:
+            return body
+        inertial = rotate_into_principal(q, data[3:])
+        return (body[0] + inertial[0], body[1] + inertial[1], body[2] + inertial[2])
+
+
+def merged_constant_torques(torques: Sequence[Torque]) -> list[Torque]:
+    """``torques`` with every :class:`ConstantTorque` gathered into one
+    :class:`ConstantTorqueSchedule` (in the place of the first), for the solver's kicks;
+    a single one is left as it is."""
+    constant = [t for t in torques if isinstance(t, ConstantTorque)]
+    if len(constant) < 2:
+        return list(torques)
+    merged: list[Torque] = []
+    for torque in torques:
+        if not isinstance(torque, ConstantTorque):
+            merged.append(torque)
+        elif torque is constant[0]:
+            merged.append(ConstantTorqueSchedule(constant))
+    return merged
 
 
 class UserTorque(Torque):

@@ -43,10 +43,17 @@ from attitude.base.quantities import as_si_array, as_si_scalar, as_vector3
 from attitude.solver.euler_solver import EulerSolver
 from attitude.solver.free_flow import UnitBatch, advance_floats
 from attitude.solver.inertia import principal_axes
-from attitude.torques.models import GravityGradient, PrincipalFrame, Torque, as_torque_list
+from attitude.torques.models import (
+    GravityGradient,
+    PrincipalFrame,
+    Torque,
+    as_torque_list,
+    merged_constant_torques,
+)
 from attitude.torques.splitting import Composition, composition
 
 __all__ = [
+    "TOLERANCE_RANGE_RAD",
     "StepChoice",
     "TorquedSolver",
     "angles_between",
@@ -68,6 +75,16 @@ _MAX_STEPS = 1e8
 # refused (each try runs the span twice): torques that turn the body faster and faster
 # (a runaway spin-up) would otherwise halve the step for hours before failing.
 _SEARCH_MAX_STEPS = 1e7
+# The tolerances a step search can meet (rad): below 1e-12 the Richardson estimate is
+# rounding (16-digit states), and the search would shrink the step until it gives up
+# at _SEARCH_MAX_STEPS; beyond 0.1 rad an estimate from a linear error model means
+# nothing.  The scenario's ``[torques] accuracy`` has the same range.
+TOLERANCE_RANGE_RAD = (1e-12, 0.1)
+# The body must turn by less than this fraction of a turn in the spacing of float
+# seconds at the time reached (as ``attitude.trajectory`` requires of a scenario):
+# beyond, the free flow's phase is rounding, and a torque of 1e300 N m would spin the
+# momentum past the float range within a step.
+_RESOLVED_FRACTION_OF_A_TURN = 1e-3
 
 
 # ----------------------------------------------------------------- the step engine
@@ -157,10 +174,11 @@ class _Engine:
 
     # ---- one step
 
-    def compiled_steps(self, m, q, pending, sizes, data, out_m, out_q, out_p) -> int:
+    def compiled_steps(self, m, q, pending, sizes, data, largest, out_m, out_q, out_p) -> int:
         """Steps of ``sizes`` from (m, q, pending) by the compiled loop
-        (:mod:`attitude.torques.compiled_steps`) into the ``out_*`` rows; the number
-        done (0 when this engine has no compiled loop)."""
+        (:mod:`attitude.torques.compiled_steps`) into the ``out_*`` rows, stopping before
+        a state beyond ``largest`` (|m1| + |m2| + |m3|, N m s); the number done (0 when
+        this engine has no compiled loop)."""
         if not self.compiled:
             return 0
         from attitude.torques.compiled_steps import gravity_gradient_steps
@@ -173,6 +191,7 @@ class _Engine:
             np.array([*m, *q, pending], dtype=np.float64),
             np.ascontiguousarray(sizes, dtype=np.float64),
             np.ascontiguousarray(data[0], dtype=np.float64),
+            float(largest),
             out_m,
             out_q,
             out_p,
@@ -228,6 +247,27 @@ class _Engine:
         return m, q
 
 
+def largest_momentum(moments: NDArray[np.float64], t: float) -> float:
+    """The largest |m| (N m s) a state may have at time t (s): the body then turns at
+    |ω| ≤ |m|/I_min, by at most a thousandth of a turn in the spacing of floats at t
+    (``_RESOLVED_FRACTION_OF_A_TURN``).  Compared with |m1| + |m2| + |m3| ≥ |m|, which
+    cannot overflow."""
+    rate = 2.0 * math.pi * _RESOLVED_FRACTION_OF_A_TURN / float(np.spacing(max(abs(t), 1.0)))
+    return rate * float(np.min(moments))
+
+
+def _refuse_runaway(m, moments: NDArray[np.float64], t: float) -> None:
+    """The InputError of a state past :func:`largest_momentum` (or not finite)."""
+    components = np.abs(np.stack(np.broadcast_arrays(*m), axis=-1))
+    largest = float(np.max(components)) if np.all(np.isfinite(components)) else math.inf
+    raise InputError(
+        f"the torques spin the body up to {largest / float(np.min(moments)):.3g} rad/s or "
+        f"more (a momentum component of {largest:.3g} N m s) by t = {t:.6g} s, faster than "
+        "float seconds can follow there: a torque that large has no meaningful attitude "
+        "(check its magnitude)"
+    )
+
+
 def _nonzero(pending) -> bool:
     if isinstance(pending, float):
         return pending != 0.0
@@ -244,8 +284,10 @@ def _grid_steps(t_from: float, t_to: float, step: float, breakpoints: NDArray, l
     sizes: list[float] = []
     t = t_from
     while len(starts) < limit and t < t_to:
-        later = breakpoints[breakpoints > t]
-        end = float(later[0]) if later.size else math.inf
+        later = int(
+            np.searchsorted(breakpoints, t, side="right")
+        )  # bisection: linear in breakpoints
+        end = float(breakpoints[later]) if later < breakpoints.size else math.inf
         to_end = max(1, math.ceil((end - t) / step - _SLIVER)) if math.isfinite(end) else None
         wanted = max(1, math.ceil((t_to - t) / step))
         count = min(limit - len(starts), wanted, to_end or wanted)
@@ -295,6 +337,7 @@ class _Propagation:
         self._pending = [np.array([0.0])]
         self._state = (tuple(m0), tuple(q0), 0.0)
         self.t_end = t0
+        self.count = 0  # steps computed so far
         self._arrays: tuple[NDArray[np.float64], ...] | None = None
 
     def extend_to(self, t_max: float) -> None:
@@ -313,7 +356,8 @@ class _Propagation:
             m, q, pending = self._state
             K = len(starts)
             out_m, out_q, out_p = np.empty((K, 3)), np.empty((K, 4)), np.empty(K)
-            done = e.compiled_steps(m, q, pending, sizes, arrays, out_m, out_q, out_p)
+            largest = largest_momentum(e.moments, float(starts[-1] + sizes[-1]))
+            done = e.compiled_steps(m, q, pending, sizes, arrays, largest, out_m, out_q, out_p)
             if done:
                 m, q = tuple(out_m[done - 1].tolist()), tuple(out_q[done - 1].tolist())
                 pending = float(out_p[done - 1])
@@ -321,6 +365,8 @@ class _Propagation:
             for k in range(done, K):
                 m, q, pending = e.step(m, q, pending, float(sizes[k]), e.rows_for_step(data, k))
                 norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+                if not (abs(m[0]) + abs(m[1]) + abs(m[2]) <= largest and norm > 0.0):
+                    _refuse_runaway(m, e.moments, float(starts[k] + sizes[k]))
                 q = (q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm)
                 out_m[k], out_q[k], out_p[k] = m, q, pending
             self._state = (m, q, pending)
@@ -329,6 +375,7 @@ class _Propagation:
             self._q.append(out_q)
             self._pending.append(out_p)
             self.t_end = float(starts[-1] + sizes[-1])
+            self.count += K
             self._arrays = None
 
     def arrays(self):
@@ -350,9 +397,13 @@ class _Propagation:
         m, q = self.engine.partial_steps(
             tuple(grid_m[k].T), tuple(grid_q[k].T), grid_pending[k], grid_t[k], h
         )
+        m_array = np.stack(m, axis=-1)
+        size = np.sum(np.abs(m_array), axis=-1)
+        if not np.all(size <= largest_momentum(self.engine.moments, float(np.max(t)))):
+            _refuse_runaway(m, self.engine.moments, float(np.max(t)))
         q_array = np.stack(q, axis=-1)
         q_array /= np.linalg.norm(q_array, axis=-1, keepdims=True)
-        return np.stack(m, axis=-1), q_array
+        return m_array, q_array
 
 
 class TorquedSolver:
@@ -419,7 +470,10 @@ class TorquedSolver:
             tuple(float(v) for v in self._moments),
             None if self._principal_to_body is None else self._principal_to_body.as_matrix(),
         )
-        self._engine = _Engine(self.method, self._torques, frame, self._moments)
+        # Every ConstantTorque in one model: a kick costs the same for 1 burn or 1000.
+        self._engine = _Engine(
+            self.method, merged_constant_torques(self._torques), frame, self._moments
+        )
         self._m0 = tuple(float(v) for v in m0)
         self._q0 = tuple(R0.as_quat(scalar_first=True).tolist())
         self._breakpoints = np.array(
@@ -444,8 +498,12 @@ class TorquedSolver:
     def _choose_step(self, tolerance: Any, span: Any) -> _Propagation:
         """Step and half step over the span, until the Richardson estimate meets the tolerance."""
         tolerance = as_si_scalar(tolerance, "angle", "tolerance")
-        if not tolerance > 0.0:
-            raise InputError(f"tolerance must be positive (rad), got {tolerance}")
+        low, high = TOLERANCE_RANGE_RAD
+        if not low <= tolerance <= high:
+            raise InputError(
+                f"tolerance must be between {low:g} and {high:g} rad (below, the estimate "
+                f"is rounding; above, it means nothing), got {tolerance!r} rad"
+            )
         if span is None:
             raise InputError("a tolerance needs span=, the duration (s) it is to hold over")
         span = as_si_scalar(span, "time", "span")
@@ -620,6 +678,11 @@ class TorquedSolver:
         return t[keep], np.linalg.norm(m, axis=-1), 0.5 * np.sum(m * m / self._moments, axis=-1)
 
     @property
+    def steps_computed(self) -> int:
+        """Grid steps propagated so far (the grid is extended as far as it is asked for)."""
+        return self._propagation.count
+
+    @property
     def free_flows(self) -> int:
         """Free-flow calls made so far (the cost unit of the method)."""
         return self._engine.flows
@@ -685,7 +748,7 @@ def propagate_batch(
     torques = as_torque_list(torques)
     chosen = composition(4 if order is None and method is None else order, method)
     frame = PrincipalFrame(tuple(moments[..., i] for i in range(3)))
-    engine = _Engine(chosen, torques, frame, moments)
+    engine = _Engine(chosen, merged_constant_torques(torques), frame, moments)
     breakpoints = np.array(sorted({b for t in torques for b in t.breakpoints if b > t0}))
 
     out_m = np.empty((times.size, n, 3))
@@ -706,11 +769,15 @@ def propagate_batch(
             i += 1
             continue
         data = [d.tolist() for d in engine.time_data(starts, sizes)]
+        largest = largest_momentum(moments, float(starts[-1] + sizes[-1]))
         for k in range(starts.size):
             while i < times.size and times[i] < starts[k] + sizes[k]:
                 output(i, float(starts[k]))
                 i += 1
             state = engine.step(*state, float(sizes[k]), engine.rows_for_step(data, k))
+            m_k = state[0]
+            if not np.all(np.abs(m_k[0]) + np.abs(m_k[1]) + np.abs(m_k[2]) <= largest):
+                _refuse_runaway(m_k, moments, float(starts[k] + sizes[k]))
         t = float(starts[-1] + sizes[-1])
     return out_m, out_q
 

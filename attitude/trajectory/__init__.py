@@ -7,6 +7,11 @@ Modules:
   horizon.
 - ``motion``: Flips, spin, precession and nutation of a trajectory, per segment, from
   the closed form.
+- ``rates``: The largest body rate of a segment, found on its motion (not on an output
+  grid).
+- ``segments``: The segments of a scenario's motion, built one after another through
+  its events, and where their motion is not smooth (breakpoints).
+- ``steps``: The step of a scenario's torqued segments, and the run's error estimate.
 - ``torqued``: A stretch of a scenario's motion under torques, seen as the layers above
   see a segment.
 - ``trajectory``: The propagated motion of a scenario: exact solver segments between

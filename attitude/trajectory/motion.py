@@ -29,13 +29,23 @@ Segments without a period are stated as what they are (``SegmentMotion.motion``)
   body turns over at most once (at u = 0) and nothing repeats;
 - ``"rest"``: G = 0;
 - ``"torqued"``: a segment under torques (``attitude.trajectory.torqued``): no period and
-  no closed form; its energy and momentum are given at its start.
+  no closed form; its energy and momentum are given at its start, and its flips are
+  located on the propagated motion (:meth:`TorquedMotion.flip_times`), the momentum
+  crossing from one side of the intermediate axis to the other as the closed form
+  defines a flip.  When they are not located (``attitude check`` leaves them to the
+  run), ``flip_count`` is None and ``flips_note`` says why: never a count that was not
+  computed.
 Flips are counted from the closed form without listing them all: at most
 :data:`LISTED_FLIPS` flip times are kept (a day of a fast tumbler has millions).
+
+Each segment's largest body rate over its part of the output span, and when it is
+first reached, are found on the motion (``attitude.trajectory.rates``), not on the
+output grid.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -44,10 +54,18 @@ from numpy.typing import NDArray
 
 from attitude.base.vectors import basis_across
 from attitude.solver.euler_solver import EulerSolver
+from attitude.trajectory.rates import largest_rate
 from attitude.trajectory.torqued import TorquedMotion
 from attitude.trajectory.trajectory import Segment, Trajectory
 
-__all__ = ["LISTED_FLIPS", "SegmentMotion", "analyze", "undersampling_note"]
+__all__ = [
+    "LISTED_FLIPS",
+    "NOT_LOCATED",
+    "SegmentMotion",
+    "analyze",
+    "largest_rate_of",
+    "undersampling_note",
+]
 
 # Sampling of one body period for the mean precession rate: enough points per turn
 # of the spin axis that the unwrapped azimuth cannot skip a turn.
@@ -66,7 +84,7 @@ class SegmentMotion:
     formula: str
     motion: str  # "periodic", "steady spin", "separatrix", "rest" or "torqued"
     period_s: float  # inf when the motion has no period
-    flip_count: int
+    flip_count: int | None  # None: not located (flips_note says why)
     flip_times_s: NDArray[np.float64]  # the first LISTED_FLIPS of them
     flip_period_s: float | None
     spin_axis_body: NDArray[np.float64] | None
@@ -78,6 +96,11 @@ class SegmentMotion:
     kinetic_energy_J: float
     inertial_angular_momentum_N_m_s: NDArray[np.float64]
     angular_momentum_norm_N_m_s: float  # G, with no overflow of the squares
+    # The largest |ω| over the segment's part of the output span, and when first
+    # reached (None: the segment lies outside it, or the rate was not searched).
+    max_rate_rad_s: float | None = None
+    max_rate_at_s: float | None = None
+    flips_note: str | None = None
 
 
 def _free_solver(segment: Segment) -> EulerSolver:
@@ -155,16 +178,23 @@ def _flips(segment: Segment) -> tuple[int, NDArray[np.float64], float | None]:
     return count, listed[:LISTED_FLIPS], half
 
 
-def _torqued_motion(segment: Segment, solver: TorquedMotion) -> SegmentMotion:
-    """A segment under torques: its state at the start; no period, flips or cone."""
+# Why a torqued segment's flips are not located, when they are not.
+NOT_LOCATED = "not located by `attitude check`: the run locates them on its propagated motion"
+
+
+def _torqued_motion(segment: Segment, solver: TorquedMotion, locate: bool) -> SegmentMotion:
+    """A segment under torques: its state at the start, its flips located on the
+    propagated motion (when ``locate``); no period or cone."""
+    flips = solver.flip_times(segment.start_s, segment.end_s) if locate else np.empty(0)
     return SegmentMotion(
         start_s=segment.start_s,
         end_s=segment.end_s,
         formula="torqued",
         motion="torqued",
         period_s=math.inf,
-        flip_count=0,
-        flip_times_s=np.empty(0),
+        flip_count=int(flips.size) if locate else None,
+        flips_note=None if locate else NOT_LOCATED,
+        flip_times_s=flips[:LISTED_FLIPS],
         flip_period_s=None,
         spin_axis_body=None,
         nutation_min_rad=None,
@@ -178,9 +208,20 @@ def _torqued_motion(segment: Segment, solver: TorquedMotion) -> SegmentMotion:
     )
 
 
-def _segment_motion(segment: Segment) -> SegmentMotion:
+def _with_rate(item: SegmentMotion, segment: Segment, span: tuple[float, float] | None):
+    """``item`` with its largest rate over ``span`` ∩ the segment (None: no rate)."""
+    if span is None:
+        return item
+    a, b = max(segment.start_s, span[0]), min(segment.end_s, span[1])
+    if b < a:
+        return item
+    rate, at = largest_rate(segment, a, b)
+    return dataclasses.replace(item, max_rate_rad_s=rate, max_rate_at_s=at)
+
+
+def _segment_motion(segment: Segment, locate: bool) -> SegmentMotion:
     if isinstance(segment.solver, TorquedMotion):
-        return _torqued_motion(segment, segment.solver)
+        return _torqued_motion(segment, segment.solver, locate)
     solver = _free_solver(segment)
     count, flips, flip_period = _flips(segment)
     axis = nutation_min = nutation_max = nutation_period = spin = precession = None
@@ -230,9 +271,33 @@ def _segment_motion(segment: Segment) -> SegmentMotion:
     )
 
 
-def analyze(trajectory: Trajectory) -> list[SegmentMotion]:
-    """The motion of each segment of ``trajectory`` (see the module docstring)."""
-    return [_segment_motion(segment) for segment in trajectory.segments]
+def analyze(trajectory: Trajectory, locate: bool = True) -> list[SegmentMotion]:
+    """The motion of each segment of ``trajectory`` (see the module docstring).
+
+    ``locate``: locate the flips and the largest rate of the segments under torques
+    on their propagated motion, and the largest rate of every segment (``attitude
+    check`` does not: it leaves them to the run, and says so).
+    """
+    scenario = trajectory.scenario
+    span = (scenario.start_s, scenario.stop_s) if locate else None
+    return [
+        _with_rate(_segment_motion(segment, locate), segment, span)
+        for segment in trajectory.segments
+    ]
+
+
+def largest_rate_of(motion: list[SegmentMotion]) -> tuple[float, float] | None:
+    """The largest body rate over the output span (rad/s) and when it is first
+    reached (TT s), from :func:`analyze`'s segments; None if not searched."""
+    found = [
+        (item.max_rate_rad_s, item.max_rate_at_s)
+        for item in motion
+        if item.max_rate_rad_s is not None and item.max_rate_at_s is not None
+    ]
+    if not found:
+        return None
+    top = max(rate for rate, _ in found)
+    return top, min(at for rate, at in found if rate == top)
 
 
 def undersampling_note(trajectory: Trajectory, motion) -> str | None:

@@ -1,28 +1,37 @@
 """A stretch of a scenario's motion under torques, seen as the layers above see a segment.
 
 Between events, a scenario with torques (``attitude.scenario.torques``) is propagated
-by :class:`~attitude.torques.solver.TorquedSolver`.  :class:`TorquedMotion` wraps it
-with what the trajectory, the motion analysis, the pointing and the reports ask of a
-segment's solver (the interface of :class:`~attitude.solver.euler_solver.EulerSolver`), so
-that they need not care which one propagated it:
+by :class:`~attitude.torques.solver.TorquedSolver` at the step the run chose
+(``attitude.trajectory.steps``).  :class:`TorquedMotion` wraps it with what the
+trajectory, the motion analysis, the pointing and the reports ask of a segment's
+solver (the interface of :class:`~attitude.solver.euler_solver.EulerSolver`), so that
+they need not care which one propagated it:
 
 - the states at any times of the segment (``attitude``, ``attitude_quaternion``,
   ``angular_momentum``, ``angular_velocity``), from the solver's dense output;
-- ``formula`` ``"torqued"``, no ``period``, no closed-form flips and no spin-axis
-  cone: the motion under a torque is not periodic;
+- ``formula`` ``"torqued"``, no ``period`` and no spin-axis cone: the motion under a
+  torque is not periodic;
+- ``flip_times``: the flips located on the propagated motion (:meth:`flip_times`);
+- ``breakpoints``: where the motion is not smooth inside the segment (a torque
+  switching on or off), for the outputs that interpolate it (the AEM);
 - ``angular_momentum_norm`` and ``kinetic_energy``: what the layers above use them
   for is a bound on the body rate (|ω| ≤ G/I_min, |ω|² ≤ 2T/I_min), so here they are
   the **largest** |m| and T over the segment: the largest at the solver's grid points
   plus twice the largest change between two of them (both change smoothly, by at most
   |τ| h over a step);
-- ``error_estimate``: the estimated attitude error over the segment (rad): the step
-  search's when the step came from an accuracy, else the same Richardson estimate
-  (the run at 2 × step, compared at 32 times, over 2^p − 1).
+- ``error_estimate``: the run's estimated attitude error within the segment (rad),
+  errors carried from earlier segments included, set by the trajectory.
+
+:meth:`TorquedMotion.survey` samples the body momentum densely enough to resolve the
+motion (``SURVEY_PER_TURN`` samples per turn at the fastest rate); the flips, the
+largest rate and the report's figure all read it, so the dense output is evaluated
+once for them (for up to a million samples; beyond, once each, in bounded memory).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from functools import cached_property
 from typing import Any
 
@@ -30,19 +39,25 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
-from attitude.base.errors import InputError
 from attitude.environment.timescales import offline_time
 from attitude.scenario.events import State
 from attitude.scenario.scenario import Scenario
-from attitude.scenario.torques import MAX_STEPS, ScenarioTorques
+from attitude.scenario.torques import ScenarioTorques
 from attitude.torques.models import ConstantTorque, GravityGradient, Torque
-from attitude.torques.solver import TorquedSolver, angles_between
+from attitude.torques.solver import TorquedSolver
 
-__all__ = ["TorquedMotion", "scenario_torque_models"]
+__all__ = ["SURVEY_PER_TURN", "TorquedMotion", "flip_amplitude_exceeds", "scenario_torque_models"]
 
-# A segment shorter than this (s) gets a fixed step: nothing to choose it over.
-_SHORTEST_SEARCH_S = 1e-6
-_CHECKS = 32
+# Samples of the survey per turn of the body at its largest rate over the segment: the
+# momentum's direction moves by at most 2π/32 in the body between two of them.
+SURVEY_PER_TURN = 32
+# The survey is evaluated this many samples at a time, and kept when no longer than
+# _SURVEY_KEPT (t, m and ω: 56 bytes a sample).
+_SURVEY_CHUNK = 1 << 16
+_SURVEY_KEPT = 1 << 20
+# Flip times are refined until their bracket is this many float spacings wide.
+_FLIP_SPACINGS = 4.0
+_FLIP_ITERATIONS = 80
 
 
 def scenario_torque_models(scenario: Scenario) -> list[tuple[float, float, Torque, str]]:
@@ -99,68 +114,40 @@ class _OrbitAtEpoch:
         return repr(self.orbit)
 
 
-def _refuse_a_long_search(
-    state: State, t0: float, span: float, torques, keys: list[str | None]
-) -> None:
-    """Refuse a step search whose first try alone would take more than MAX_STEPS steps.
+def flip_amplitude_exceeds(
+    m: NDArray[np.float64], moments: NDArray[np.float64]
+) -> NDArray[np.bool_]:
+    """Whether the free motion through each principal-axes momentum ``m`` (…, 3) swings
+    its intermediate component beyond G/√2: what makes a sign change of that component
+    a flip (``EulerSolver.flip_times``), rather than part of a nutation.
 
-    The search (``TorquedSolver``) first runs the span at half a quarter turn of the
-    body (at most a fortieth of the orbit) and at twice that; the body's fastest turn
-    is bounded by |ω| ≤ √(2T/I_min) at the start, and by |ω| ≤ |m|/I_min with
-    |m| ≤ |m0| + ∫|τ| dt later: the burns within the span may spin the body up.
-    The error names the burn (its key in ``keys``, beside ``torques``) when the body
-    would be slow enough without the burns' impulse, else ``torques.accuracy``: the
-    accuracy asked for over this span.
+    On the polhode (|m|² = G², Σ mᵢ²/Iᵢ = 2T; I_a < I_b < I_c) the intermediate
+    component is largest where one of the others vanishes: where m_c = 0 when the
+    momentum circulates about the axis of least inertia (G²/2T < I_b), then
+    m_b² = (G²/I_a − 2T)/(1/I_a − 1/I_b); where m_a = 0 otherwise, then
+    m_b² = (2T − G²/I_c)/(1/I_b − 1/I_c).  False for a body without a distinct
+    intermediate axis.
     """
-    I_min = float(np.min(state.inertia.moments))
-    own_rate = math.sqrt(2.0 * state.kinetic_energy / I_min)
-    impulses = [
-        (
-            float(np.linalg.norm(torque.torque))
-            * max(0.0, min(torque.stop, t0 + span) - max(torque.start, t0)),
-            key,
-        )
-        for torque, key in zip(torques, keys, strict=True)
-        if isinstance(torque, ConstantTorque)
-    ]
-    impulse = sum(size for size, _ in impulses)
-    rate = own_rate
-    if impulse > 0.0:
-        rate = max(rate, (float(np.linalg.norm(state.angular_momentum)) + impulse) / I_min)
-
-    def quarter_turns(rate: float) -> list[float]:
-        return [0.5 * 2.0 * math.pi / rate / 4.0] if rate > 0.0 else []
-
-    orbits = [
-        0.5 * 2.0 * math.pi * math.sqrt(radius**3 / torque.mu) / 20.0
-        for torque in torques
-        if isinstance(torque, GravityGradient)
-        for radius in [float(np.linalg.norm(torque.position(np.array([t0]))[0]))]
-    ]
-    first = quarter_turns(rate) + orbits
-    if not (first and span / min(first) * 1.5 > MAX_STEPS):
-        return
-    steps = f"{span / min(first) * 1.5:.3g} steps of {min(first):.3g} s (more than {MAX_STEPS:g})"
-    without_burns = quarter_turns(own_rate) + orbits
-    burn_size, burn_key = max(impulses, key=lambda item: item[0], default=(0.0, None))
-    if burn_key and not (without_burns and span / min(without_burns) * 1.5 > MAX_STEPS):
-        raise InputError(
-            f"the burns spin the body up to {rate:.3g} rad/s (this one adds {burn_size:.3g} "
-            f"N m s): choosing the step for torques.accuracy over {span:g} s would start "
-            f"with {steps}: give a smaller torque, torques.step, or a shorter span",
-            key=burn_key,
-        )
-    raise InputError(
-        f"choosing the step over {span:g} s would start with {steps}: give torques.step, "
-        "or a shorter span",
-        key="torques.accuracy",
+    order = np.argsort(moments)
+    I_a, I_b, I_c = (float(moments[k]) for k in order)
+    if not I_a < I_b < I_c:
+        return np.zeros(m.shape[:-1], dtype=bool)
+    x = m[..., order] ** 2
+    G2 = np.sum(x, axis=-1)
+    twice_T = x[..., 0] / I_a + x[..., 1] / I_b + x[..., 2] / I_c
+    about_least = G2 < twice_T * I_b  # G²/2T < I_b
+    peak = np.where(
+        about_least,
+        (G2 / I_a - twice_T) / (1.0 / I_a - 1.0 / I_b),
+        (twice_T - G2 / I_c) / (1.0 / I_b - 1.0 / I_c),
     )
+    return peak > 0.5 * G2
 
 
 class TorquedMotion:
-    """One segment [t0, end_s] under ``torques`` (models), from ``state`` at ``t0``.
+    """One segment [t0, end_s] under ``torques`` (models), from ``state`` at ``t0``, by
+    splitting at ``step`` (s) with the method of ``order``.
 
-    ``settings``: the scenario's :class:`ScenarioTorques` (step or accuracy, order).
     Times within a nanosecond before ``t0`` (which the trajectory counts as ``t0``) are
     evaluated at ``t0``.
     """
@@ -174,34 +161,26 @@ class TorquedMotion:
         t0: float,
         end_s: float,
         torques: list[Torque],
-        settings: ScenarioTorques,
-        keys: list[str | None] | None = None,
+        step: float,
+        order: int,
     ) -> None:
         self.state = state
         self.end_s = float(end_s)
         self.torques = tuple(torques)
-        self.settings = settings
-        span = self.end_s - t0
-        options: dict[str, Any] = {"order": settings.order}
-        if settings.step is None and span > _SHORTEST_SEARCH_S:
-            keys = list(keys) if keys is not None else [None] * len(self.torques)
-            _refuse_a_long_search(state, t0, span, self.torques, keys)
-            options.update(tolerance=settings.accuracy_rad, span=span)
-        else:
-            options["step"] = settings.step if settings.step is not None else max(span, 1.0)
-        try:
-            self.solver = TorquedSolver(
-                state.inertia.tensor,
-                state.angular_momentum,
-                state.attitude,
-                t0,
-                list(torques),
-                **options,
-            )
-        except InputError as exc:  # the solver's names for the scenario's settings
-            named = {"tolerance": "torques.accuracy", "step": "torques.step"}
-            raise (exc.located(key=named[exc.key]) if exc.key in named else exc) from None
+        self.order = int(order)
+        self.solver = TorquedSolver(
+            state.inertia.tensor,
+            state.angular_momentum,
+            state.attitude,
+            t0,
+            list(torques),
+            step=step,
+            order=order,
+        )
+        # The run's estimated error within this segment (attitude.trajectory.steps).
+        self.error_estimate: float | None = None
         self._last: tuple[NDArray, NDArray, NDArray] | None = None
+        self._survey: tuple[NDArray, NDArray, NDArray] | None = None
 
     # ---- states
 
@@ -243,14 +222,125 @@ class TorquedMotion:
         """½ m(t)·ω(t), J."""
         return 0.5 * np.sum(self.angular_momentum(t) * self.angular_velocity(t), axis=-1)
 
-    # ---- what the closed form has and this motion has not
+    def principal_momentum(self, t: ArrayLike) -> NDArray[np.float64]:
+        """The body momentum at ``t`` in principal axes (N m s), the order of
+        ``moments_of_inertia``."""
+        m = self._states(t)[0]
+        axes = self.state.inertia
+        return (
+            m
+            if axes.is_diagonal
+            else axes.body_to_principal.apply(m.reshape(-1, 3)).reshape(m.shape)
+        )
+
+    # ---- where the motion is not smooth
+
+    def breakpoints(self, start_s: float, end_s: float) -> list[tuple[float, str]]:
+        """The times in (start_s, end_s) where a torque switches on or off, with what
+        happens there (the hook ``attitude.trajectory.segments.Segment.breakpoints``
+        reads): the rate is continuous there, its derivative is not."""
+        found: dict[float, list[str]] = {}
+        for torque in self.torques:
+            marks = (
+                [
+                    (torque.start, "a constant torque starts"),
+                    (torque.stop, "a constant torque ends"),
+                ]
+                if isinstance(torque, ConstantTorque)
+                else [(b, f"{torque!r} switches") for b in torque.breakpoints]
+            )
+            for time_s, what in marks:
+                if start_s < time_s < end_s:
+                    found.setdefault(float(time_s), []).append(what)
+        return [(t, "; ".join(sorted(set(found[t])))) for t in sorted(found)]
+
+    # ---- the survey, and what is found on it
+
+    def _survey_grid(self) -> tuple[int, float]:
+        """(count, spacing) of the survey's evenly spaced times over the segment."""
+        span = self.end_s - self.t0
+        G = self.angular_momentum_norm
+        if span <= 0.0:
+            return 1, 0.0
+        if G == 0.0:
+            return 2, span
+        spacing = 2.0 * math.pi * float(np.min(self.moments_of_inertia)) / G / SURVEY_PER_TURN
+        count = max(2, math.ceil(span / spacing) + 1)
+        return count, span / (count - 1)
+
+    def survey(self) -> Iterator[tuple[NDArray, NDArray, NDArray]]:
+        """The survey in chunks, in time order: (t, principal-axes momentum, body angular
+        velocity) at evenly spaced times over the segment, ``SURVEY_PER_TURN`` a turn at
+        the largest rate over it (|ω| ≤ G_max/I_min), both ends included.  Consecutive
+        chunks share their last two samples with the next one's first two (a sample
+        and its neighbours are then always in one chunk).  Kept once computed when it
+        has at most _SURVEY_KEPT samples (64 MB), so that the flips, the largest rate
+        and the figure read one evaluation of the dense output; a longer one is
+        computed again for each, a chunk at a time, in bounded memory."""
+        if self._survey is not None:
+            yield self._survey
+            return
+        count, spacing = self._survey_grid()
+        kept: list[tuple[NDArray, NDArray, NDArray]] = []
+        first = 0
+        while True:
+            stop = min(first + _SURVEY_CHUNK, count)
+            t = self.t0 + spacing * np.arange(first, stop, dtype=np.float64)
+            if stop == count:
+                t[-1] = self.end_s
+            m = self.principal_momentum(t)
+            chunk = (t, m, self.angular_velocity(t))
+            if count <= _SURVEY_KEPT:
+                kept.append(chunk if first == 0 else tuple(a[2:] for a in chunk))
+            yield chunk
+            if stop == count:
+                break
+            first = stop - 2
+        if kept:
+            self._survey = tuple(np.concatenate(parts) for parts in zip(*kept, strict=True))
 
     def flip_times(self, t_start: float, t_end: float) -> NDArray[np.float64]:
-        """None located: flips are a feature of the torque-free closed form."""
-        return np.empty(0)
+        """The flips in [t_start, t_end] on the propagated motion (TT s): the times at
+        which the momentum crosses from one side of the intermediate axis to the other
+        (its component along that axis changes sign) while the free motion through the
+        state there swings that axis beyond 45° of the momentum
+        (:func:`flip_amplitude_exceeds`), as ``EulerSolver.flip_times`` defines a flip.
 
-    def spin_axis_cone(self) -> None:
-        return None
+        Found on :meth:`survey` (a sign change between samples a fraction of a turn
+        apart; two flips are half a body period apart) and refined by bisection on the
+        dense output to a few float spacings.  Empty for a body without a distinct
+        intermediate axis.
+        """
+        moments = self.moments_of_inertia
+        ranked = np.argsort(moments)
+        if not moments[ranked[0]] < moments[ranked[1]] < moments[ranked[2]]:
+            return np.empty(0)
+        middle = int(ranked[1])
+        lows, highs, signs = [], [], []
+        for t, m, _ in self.survey():
+            component = m[:, middle]
+            change = np.flatnonzero(np.signbit(component[1:]) != np.signbit(component[:-1]))
+            if t[-1] < self.end_s:  # the last pair is the next chunk's first
+                change = change[change < t.size - 2]
+            lows.append(t[change])
+            highs.append(t[change + 1])
+            signs.append(np.signbit(component[change]))
+        low, high = np.concatenate(lows), np.concatenate(highs)
+        if low.size == 0:
+            return np.empty(0)
+        low_sign = np.concatenate(signs)
+        for _ in range(_FLIP_ITERATIONS):
+            wide = high - low > _FLIP_SPACINGS * np.spacing(np.abs(high))
+            if not np.any(wide):
+                break
+            mid = 0.5 * (low + high)
+            same = np.signbit(self.principal_momentum(mid[wide])[:, middle]) == low_sign[wide]
+            low[wide] = np.where(same, mid[wide], low[wide])
+            high[wide] = np.where(same, high[wide], mid[wide])
+        times = 0.5 * (low + high)
+        flips = flip_amplitude_exceeds(self.principal_momentum(times), moments)
+        times = times[flips]
+        return times[(times >= t_start) & (times <= t_end)]
 
     # ---- numbers for the layers above
 
@@ -262,10 +352,12 @@ class TorquedMotion:
     def moments_of_inertia(self) -> NDArray[np.float64]:
         return self.state.inertia.moments
 
+    def spin_axis_cone(self) -> None:
+        return None
+
     @cached_property
     def _bounds(self) -> tuple[float, float]:
-        with np.errstate(over="ignore", invalid="ignore"):  # refused above, by the caller
-            _, G, T = self.solver.grid_invariants(self.end_s)
+        _, G, T = self.solver.grid_invariants(self.end_s)
         G = np.append(G, np.linalg.norm(self.state.angular_momentum))
         T = np.append(T, self.initial_kinetic_energy)
         dG = float(np.max(np.abs(np.diff(G)))) if G.size > 1 else 0.0
@@ -298,29 +390,10 @@ class TorquedMotion:
     def method(self) -> str:
         return self.solver.method.name
 
-    @cached_property
-    def error_estimate(self) -> float:
-        """The estimated worst attitude error over the segment, rad (module docstring)."""
-        choice = self.solver.step_choice
-        if choice is not None:
-            return choice.error_estimate
-        span = self.end_s - self.t0
-        if span <= 0.0:
-            return 0.0
-        coarse = TorquedSolver(
-            self.state.inertia.tensor,
-            self.state.angular_momentum,
-            self.state.attitude,
-            self.t0,
-            list(self.torques),
-            step=2.0 * self.solver.step,
-            order=self.settings.order,
-        )
-        checks = self.t0 + span * np.linspace(1.0 / _CHECKS, 1.0, _CHECKS)
-        difference = angles_between(
-            self.solver.attitude_quaternion(checks), coarse.attitude_quaternion(checks)
-        )
-        return float(np.max(difference)) / (2.0**self.solver.order - 1.0)
+    @property
+    def steps_computed(self) -> int:
+        """Grid steps propagated so far (the cost of the segment, for a budget)."""
+        return self.solver.steps_computed
 
     def __repr__(self) -> str:
         return (

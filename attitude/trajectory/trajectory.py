@@ -14,11 +14,8 @@ torque-free motion is far below anything this package reports).
 
 from __future__ import annotations
 
-import dataclasses
 import itertools
-import math
-from dataclasses import dataclass
-from functools import cached_property
+from dataclasses import replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -27,11 +24,15 @@ from scipy.spatial.transform import Rotation
 
 from attitude.base.errors import InputError
 from attitude.environment.timescales import SAME_INSTANT_S, tt_seconds
-from attitude.scenario.events import Event, State
 from attitude.scenario.scenario import Scenario
-from attitude.solver.euler_solver import EulerSolver
-from attitude.torques.models import ConstantTorque
-from attitude.torques.solver import angles_between
+from attitude.trajectory.segments import Breakpoint, Segment, segments
+from attitude.trajectory.steps import (
+    CHECK_BUDGET_S,
+    RunSteps,
+    choose_steps,
+    measure,
+    predicted_steps,
+)
 from attitude.trajectory.torqued import TorquedMotion, scenario_torque_models
 
 if TYPE_CHECKING:  # astropy loads only when a Time is made
@@ -41,233 +42,80 @@ __all__ = ["Segment", "Trajectory", "propagate"]
 
 # Times this close outside [0, stop], or before an event (TT seconds), count as on it.
 _SPAN_TOLERANCE_S = SAME_INSTANT_S
+# `attitude check` propagates a torqued run longer than its budget at a longer step,
+# one that takes about this much CPU, for the checks that read the motion.
+_CHECK_TRAJECTORY_S = 1.0
 
 
-@dataclass(frozen=True)
-class Segment:
-    """One stretch of torque-free motion: [start_s, end_s] in TT seconds since the epoch.
+def propagate(
+    scenario: Scenario, steps: list[float | None] | None = None, *, check: bool = False
+) -> Trajectory:
+    """The motion of ``scenario`` over [epoch, stop], through its events.
 
-    ``event`` is the event that started it (None for the first segment); ``before``
-    and ``after`` are the states on either side of that event.  ``rate_key``: the
-    scenario key that sets how fast the body turns in it, for errors that are about
-    that rate (the state's ``initial_state.angular_velocity``, ``events[i].impulse``,
-    or the burn that spins it up, ``torques.burns[i].torque``).
-    """
+    Without torques, the exact solver between events.  Under torques
+    (``attitude.scenario.torques``), the torqued segments at ``[torques] step``, or at
+    the step chosen for ``[torques] accuracy`` so that the run's estimated error meets
+    it (``attitude.trajectory.steps``): :attr:`Trajectory.steps` says how.
 
-    start_s: float
-    end_s: float
-    solver: EulerSolver | TorquedMotion
-    state: State
-    event: Event | None = None
-    before: State | None = None
-    rate_key: str | None = None
+    ``steps``: per segment, the torqued step to use (None where no torque acts), as
+    a run made before chose them (``[s.solver.step for s in trajectory.segments]``): the
+    same motion again, for a fit that varies the state and not the method.
 
+    ``check``: what ``attitude check`` needs, within seconds: the search (or, with a
+    given step, the run's estimate) within check's CPU budget; when that does not
+    cover the whole run, the estimate is predicted, and the motion is propagated at a
+    longer step for the checks that read it (:attr:`Trajectory.approximate`).
 
-# The time representation must resolve this fraction of the fastest turn of the body.
-_RESOLVED_FRACTION_OF_A_TURN = 1e-3
-
-
-@dataclass(frozen=True)
-class _Where:
-    """The state a segment starts from, as errors name it: ``key``, the scenario key
-    that gave its rate (``initial_state.angular_velocity``, ``events[2].impulse``), and
-    ``text``, the state in words for the reason (empty for the initial state)."""
-
-    key: str
-    text: str = ""
-
-    def error(self, reason: str) -> InputError:
-        return InputError(f"{self.text}: {reason}" if self.text else reason, key=self.key)
-
-
-def _initial_where(scenario: Scenario) -> _Where:
-    given = "angular_velocity" if scenario.initial_state.angular_velocity is not None else None
-    return _Where(f"initial_state.{given or 'angular_momentum'}")
-
-
-def _event_where(scenario: Scenario, index: int, offset: float, event: Event) -> _Where:
-    """events[index]: its key that changed the rate (an impulse, a reset's new rate), or
-    the event's table (an inertia change: moments or a tensor)."""
-    key = f"events[{index}]"
-    if event.kind == "angular_impulse":
-        key += ".impulse"
-    elif event.kind == "attitude_reset":
-        for name in ("angular_velocity", "angular_momentum"):
-            if getattr(event, name, None) is not None:
-                key += f".{name}"
-    return _Where(key, f"the state after the {event.kind} at {scenario.format_epoch(offset)}")
-
-
-def _acting(models: list, t0: float, end_s: float) -> list[tuple[Any, str]]:
-    """The torque models (and their keys) that act within [t0, end_s]."""
-    return [(model, key) for start, stop, model, key in models if start < end_s and stop > t0]
-
-
-def _solver(
-    state: State,
-    t0: float,
-    end_s: float,
-    where: _Where,
-    scenario: Scenario,
-    models: list,
-    step: float | None = None,
-) -> EulerSolver | TorquedMotion:
-    """The exact solver from ``state`` at ``t0``, or the torqued one if a torque acts
-    within [t0, end_s] (``models``: (start, stop, torque, key) of the scenario), at
-    ``step`` if given, else as the scenario's torques say.  An error that names no key
-    (the solver refuses the state) is the state's, ``where``."""
-    acting = _acting(models, t0, end_s)
-    try:
-        if acting:
-            _check_resolved_at_start(state, t0, end_s, where)
-            settings = scenario.torques
-            if step is not None:
-                settings = dataclasses.replace(settings, step=step, accuracy=None)
-            torques = [model for model, _ in acting]
-            return TorquedMotion(state, t0, end_s, torques, settings, [k for _, k in acting])
-        return EulerSolver(state.inertia.tensor, state.angular_momentum, state.attitude, t0=t0)
-    except InputError as exc:
-        if exc.key is not None:  # a torque's key, or the orbit's: the value that is bad
-            raise
-        raise where.error(exc.reason) from None
-
-
-def _strongest_burn(models: list, t0: float, end_s: float) -> str | None:
-    """The key of the burn that adds the most momentum within [t0, end_s], or None."""
-    burns = [
-        (float(np.linalg.norm(model.torque)) * (min(model.stop, end_s) - max(model.start, t0)), key)
-        for model, key in _acting(models, t0, end_s)
-        if isinstance(model, ConstantTorque)
-    ]
-    return max(burns, key=lambda item: item[0])[1] if burns else None
-
-
-def _resolution_error(
-    where: _Where, G: float, I_min: float, period: float, start_s: float, end_s: float
-) -> InputError | None:
-    """The error for a motion faster than TT seconds (floats) follow over [start_s,
-    end_s], or None.
-
-    The body turns at most at |ω| ≤ G/I_min, once every 2π I_min/G seconds, and m(t)
-    repeats every period T.  Where the spacing of floats near end_s exceeds a
-    thousandth of the shorter of the two, every output would be noise: the elliptic
-    phase λt, exact for the t given, is exact for a t that no one meant.
-    """
-    if G == 0.0:
-        return None
-    turn_s = 2.0 * math.pi * (I_min / G)
-    fastest = min(turn_s, period)
-    resolution = float(np.spacing(max(abs(start_s), abs(end_s))))
-    if resolution <= _RESOLVED_FRACTION_OF_A_TURN * fastest:
-        return None
-    return where.error(
-        f"the body turns in {fastest:.3g} s, too fast for TT seconds over "
-        f"this span (they resolve {resolution:.3g} s at {end_s:g} s, and a thousandth "
-        f"of a turn is needed): give a slower rate or a shorter span"
-    )
-
-
-def _check_resolved_at_start(state: State, start_s: float, end_s: float, where: _Where) -> None:
-    """Refuse a state that turns too fast for TT seconds before any torque acts on it
-    (:func:`_resolution_error` at the state's own rate): the state, not a torque, is
-    what is wrong, and the torqued solver would only spend its step search finding so."""
-    G = float(np.linalg.norm(state.angular_momentum))
-    if not math.isfinite(G):
-        raise where.error("the angular momentum is beyond the float range")
-    I_min = float(np.min(state.inertia.moments))
-    error = _resolution_error(where, G, I_min, math.inf, start_s, end_s)
-    if error is not None:
-        raise error
-
-
-def _check_resolved(
-    solver: EulerSolver | TorquedMotion,
-    start_s: float,
-    end_s: float,
-    where: _Where,
-    burn: str | None = None,
-) -> None:
-    """Refuse a motion faster than TT seconds (floats) can follow over [start_s, end_s]
-    (:func:`_resolution_error`).  Under torques the bound is the largest over the
-    segment: when the state was slow enough at its start (checked before), the burn
-    ``burn`` (the key of the segment's strongest) spun it up."""
-    if burn is not None:
-        where = _Where(burn, "spun up by the burns")
-    try:
-        G = solver.angular_momentum_norm  # under torques: the grid over the segment
-    except InputError as exc:
-        raise (exc if exc.key else where.error(exc.reason)) from None
-    if not math.isfinite(G):
-        raise where.error("under the torques, the angular momentum goes beyond the float range")
-    I_min = float(np.min(solver.moments_of_inertia))
-    error = _resolution_error(where, G, I_min, solver.period, start_s, end_s)
-    if error is not None:
-        raise error
-    if not math.isfinite(solver.kinetic_energy):
-        raise where.error("the kinetic energy is beyond the float range")
-
-
-def _rate_key(
-    solver: EulerSolver | TorquedMotion, state: State, where: _Where, burn: str | None
-) -> str:
-    """The key that sets the segment's fastest turn: the burn when the burns at least
-    double the momentum the segment starts with, else the state's."""
-    if burn is not None and solver.angular_momentum_norm > 2.0 * float(
-        np.linalg.norm(state.angular_momentum)
-    ):
-        return burn
-    return where.key
-
-
-def propagate(scenario: Scenario, steps: list[float | None] | None = None) -> Trajectory:
-    """The exact motion of ``scenario`` over [epoch, stop], through its events.
-
-    ``steps``: per segment, the torqued solver's step (None: as the scenario says), to
-    rerun a torqued trajectory at other steps (:attr:`Trajectory.error_estimate`).
     Raises :class:`InputError` whose ``key`` names what holds the bad value: the
     state (``initial_state.angular_velocity``, ``events[i].impulse``) whose motion the
     solver refuses, or that turns too fast for TT seconds (floats) to follow over the
-    span; a burn (``torques.burns[i].torque``) that spins the body up that fast; the
-    torques' settings or the orbit the gravity gradient needs.
+    span; a burn (``torques.burns[i].torque``) that spins the body up that fast, or so
+    fast that no step meets the accuracy; ``torques.accuracy`` when the run cannot
+    meet it otherwise; the orbit the gravity gradient needs.
     """
-    initial = scenario.initial_state
-    axes = scenario.spacecraft.principal_axes
-    if initial.angular_momentum is not None:
-        m0 = initial.angular_momentum
-    else:  # InitialState holds exactly one of the two (checked when it is made)
-        assert initial.angular_velocity is not None
-        m0 = axes.tensor @ initial.angular_velocity
-    state = State(initial.attitude, m0, axes)
-    starts: list[tuple[float, State, Event | None, State | None]] = [(0.0, state, None, None)]
-    ends = [offset for offset, _ in scenario.events] + [scenario.stop_s]
     models = scenario_torque_models(scenario) if scenario.torques.any else []
-    steps = steps or [None] * len(ends)
-    where = _initial_where(scenario)
-    solver = _solver(state, 0.0, ends[0], where, scenario, models, steps[0])
-    burn = _strongest_burn(models, 0.0, ends[0])
-    _check_resolved(solver, 0.0, ends[0], where, burn)
-    solvers = [solver]
-    rate_keys = [_rate_key(solver, state, where, burn)]
-    indices = getattr(scenario, "event_indices", range(len(scenario.events)))
-    for k, ((offset, event), index, end) in enumerate(
-        zip(scenario.events, indices, ends[1:], strict=True), start=1
-    ):
-        before = State(solver.attitude(offset), solver.angular_momentum(offset), state.inertia)
-        state = event.apply(before)
-        where = _event_where(scenario, index, offset, event)
-        solver = _solver(state, offset, end, where, scenario, models, steps[k])
-        burn = _strongest_burn(models, offset, end)
-        _check_resolved(solver, offset, end, where, burn)
-        solvers.append(solver)
-        rate_keys.append(_rate_key(solver, state, where, burn))
-        starts.append((offset, state, event, before))
-    segments = [
-        Segment(start, end, solver, state, event, before, rate_key)
-        for (start, state, event, before), end, solver, rate_key in zip(
-            starts, ends, solvers, rate_keys, strict=True
+    if not models:
+        return Trajectory(scenario, list(segments(scenario, models, None)))
+    settings = scenario.torques
+    if steps is not None:
+        given = [h for h in steps if h is not None]
+        choice = RunSteps(
+            max(given, default=0.0),
+            settings.order,
+            True,
+            None,
+            grid_steps=sum(predicted_steps(scenario, models, h) for h in set(given)),
         )
-    ]
-    return Trajectory(scenario, segments)
+        again = list(segments(scenario, models, list(steps)))
+        return Trajectory(scenario, again, choice, given_steps=list(steps))
+    if settings.step is not None:
+        step = float(settings.step)
+        choice = RunSteps(
+            step, settings.order, True, None, grid_steps=predicted_steps(scenario, models, step)
+        )
+        if not check:
+            return Trajectory(scenario, list(segments(scenario, models, step)), choice)
+        found, run = measure(scenario, models, step, budget_s=CHECK_BUDGET_S)
+        choice = replace(
+            choice,
+            measurement=found,
+            cpu_per_step_s=found.cpu_s / found.steps if found.steps else 0.0,
+        )
+    else:
+        choice, run = choose_steps(scenario, models, CHECK_BUDGET_S if check else None)
+    if run is None:
+        return _approximate(scenario, models, choice)
+    return Trajectory(scenario, run, choice)
+
+
+def _approximate(scenario: Scenario, models, choice: RunSteps) -> Trajectory:
+    """`attitude check`'s run when its own would take longer than check's budget: at a
+    step long enough that it takes about _CHECK_TRAJECTORY_S of CPU."""
+    affordable = _CHECK_TRAJECTORY_S / choice.cpu_per_step_s if choice.cpu_per_step_s else 1e4
+    step = max(choice.step_s, scenario.stop_s / max(affordable, 1.0))
+    run = list(segments(scenario, models, step))
+    exact = step == choice.step_s  # the run's own step after all
+    return Trajectory(scenario, run, choice, approximate_step_s=None if exact else step)
 
 
 class Trajectory:
@@ -278,11 +126,25 @@ class Trajectory:
     body axes unless the name says inertial.
     """
 
-    def __init__(self, scenario: Scenario, segments: list[Segment]) -> None:
+    def __init__(
+        self,
+        scenario: Scenario,
+        run: list[Segment],
+        steps: RunSteps | None = None,
+        approximate_step_s: float | None = None,
+        given_steps: list[float | None] | None = None,
+    ) -> None:
         self.scenario = scenario
-        self.segments = segments
+        self.segments = list(run)
+        # How the torqued segments' step was set, and the run's estimate (None: no torques).
+        self.steps = steps
+        # Set when `attitude check` propagated at a longer step than the run's.
+        self.approximate_step_s = approximate_step_s
+        self._given_steps = given_steps  # per segment, when propagate was given them
+        if steps is not None and steps.measurement is not None:
+            self._share_estimates(steps)
         # Segment k is in force from _starts[k] on (an event's epoch gets its post-event state).
-        self._starts = np.array([segment.start_s for segment in segments]) - _SPAN_TOLERANCE_S
+        self._starts = np.array([s.start_s for s in self.segments]) - _SPAN_TOLERANCE_S
         self._starts[0] = -np.inf
 
     @property
@@ -378,36 +240,61 @@ class Trajectory:
 
         return self._by_segment(times, evaluate, 1)[..., 0]
 
-    @cached_property
+    @property
+    def approximate(self) -> bool:
+        """True for `attitude check`'s propagation at a longer step than the run's."""
+        return self.approximate_step_s is not None
+
+    def _share_estimates(self, steps: RunSteps) -> None:
+        """Each torqued segment's ``error_estimate``: the run's, within it."""
+        assert steps.measurement is not None
+        for segment, own in zip(self.segments, steps.measurement.per_segment, strict=False):
+            if isinstance(segment.solver, TorquedMotion):
+                segment.solver.error_estimate = own
+
+    def measured(self) -> RunSteps | None:
+        """:attr:`steps` with the run's estimate (``attitude.trajectory.steps``),
+        measured now over the whole span if it was not (a given step); ``attitude
+        check``'s estimate (possibly predicted) is kept as it is.  None without
+        torques."""
+        steps = self.steps
+        if steps is None:
+            return None
+        found = steps.measurement
+        if found is not None and (found.complete or self.approximate or not steps.settled):
+            return steps
+        models = scenario_torque_models(self.scenario)
+        step = steps.step_s if self._given_steps is None else self._given_steps
+        found, _ = measure(self.scenario, models, step, fine=self.segments)
+        steps = replace(
+            steps,
+            measurement=found,
+            cpu_per_step_s=found.cpu_s / found.steps if found.steps else steps.cpu_per_step_s,
+        )
+        self.steps = steps
+        self._share_estimates(steps)
+        return steps
+
+    @property
     def error_estimate(self) -> float:
         """The estimated worst attitude error of the run (rad); 0 for the exact solver.
 
         Under torques, the segments' errors carry through the events and grow with the
         motion (an error of the momentum shifts the phase of a tumble), so each
-        segment's own estimate does not add up to the run's.  This is the run's:
-        the same scenario at twice each segment's step, through the same events,
-        compared at 64 times over the span and at each segment's end, the largest angle
-        over 2^p − 1 (Richardson, p the order).
+        segment's own estimate does not add up to the run's.  This is the run's, the
+        same scenario at twice the step through the same events
+        (``attitude.trajectory.steps``), measured now if it was not.
         """
-        steps = [
-            2.0 * s.solver.step if isinstance(s.solver, TorquedMotion) else None
-            for s in self.segments
-        ]
-        if all(step is None for step in steps):
+        steps = self.measured()
+        if steps is None:
             return 0.0
-        coarse = propagate(self.scenario, steps)
-        checks = np.unique(
-            np.concatenate(
-                [
-                    np.linspace(0.0, self.stop_s, 65)[1:],
-                    [s.end_s for s in self.segments if s.end_s > 0.0],
-                ]
-            )
-        )
-        difference = angles_between(
-            self.attitude_quaternion(checks), coarse.attitude_quaternion(checks)
-        )
-        return float(np.max(difference)) / (2.0**self.scenario.torques.order - 1.0)
+        estimate = steps.estimate_rad
+        return float("inf") if estimate is None else estimate
+
+    def breakpoints(self) -> list[Breakpoint]:
+        """Every time inside a segment where the motion is not smooth (a torque
+        switching), in time order (:meth:`Segment.breakpoints`)."""
+        return [b for segment in self.segments for b in segment.breakpoints()]
 
     def flip_times(self) -> NDArray[np.float64]:
         """All Джанибеков flips over [epoch, stop], TT seconds since the epoch (closed form)."""
