@@ -35,6 +35,7 @@ day of a 5 rpm spinner (43 000 steps) costs about 0.3 s of CPU.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
@@ -46,6 +47,7 @@ from attitude.scenario.scenario import Scenario
 from attitude.scenario.torques import ScenarioTorques
 from attitude.torques.models import MU_EARTH_M3_S2
 from attitude.torques.solver import angles_between, first_crossing
+from attitude.trajectory.segments import Segment, segments
 from attitude.trajectory.torqued import scenario_torque_models
 from attitude.trajectory.trajectory import Trajectory, propagate
 
@@ -156,28 +158,40 @@ def validity_horizon(trajectory: Trajectory, orbit: Any) -> ValidityHorizon:
         order=settings.order if given else 4,
         horizon_threshold=threshold,
     )
-    torqued = propagate(scenario.with_torques(torques))
-    run_step = max(segment.solver.step for segment in torqued.segments)
-
-    crossing = _first_crossing(torqued, trajectory, threshold)
+    alongside = scenario.with_torques(torques)
+    if torques.step is not None:  # built segment by segment, as far as the comparison goes
+        runs: Iterable[Segment] = segments(
+            alongside, scenario_torque_models(alongside), torques.step, checked=False
+        )
+    else:  # the step the scenario's accuracy needs: the run-level search, over the span
+        runs = propagate(alongside).segments
+    steps: list[float] = []
+    crossing = _first_crossing(runs, trajectory, threshold, steps)
     searched = min(crossing, scenario.stop_s)
-    return ValidityHorizon(threshold, crossing, searched, scenario.stop_s, run_step, torques.order)
+    return ValidityHorizon(
+        threshold, crossing, searched, scenario.stop_s, max(steps), torques.order
+    )
 
 
-def _first_crossing(torqued: Trajectory, trajectory: Trajectory, threshold: float) -> float:
-    """The first time (TT s) the attitudes of ``torqued`` and ``trajectory`` differ by
-    ``threshold``, or ``math.inf``: compared at every grid point of the run alongside (a
-    step apart, where its state costs one free flow, not a step), a block of
-    :data:`_BLOCK_STEPS` at a time, so that no more of the run is computed than the
-    crossing needs; then refined by bisection to a millisecond between the last point
-    below and the first at or above."""
-
-    def angle(t):
-        return angles_between(torqued.attitude_quaternion(t), trajectory.attitude_quaternion(t))
-
+def _first_crossing(
+    runs: Iterable[Segment], trajectory: Trajectory, threshold: float, steps: list[float]
+) -> float:
+    """The first time (TT s) the attitudes of the run alongside (its segments ``runs``)
+    and ``trajectory`` differ by ``threshold``, or ``math.inf``: compared at every grid
+    point of the run (a step apart, where its state costs one free flow, not a step), a
+    block of :data:`_BLOCK_STEPS` at a time, so that no more of the run is computed than
+    the crossing needs; then refined by bisection to a millisecond between the last point
+    below and the first at or above.  Each segment is compared with the trajectory's
+    segment of the same events (at an event's epoch, both before it).  ``steps``: each
+    segment's step is appended to it."""
     earlier = 0.0
-    for segment in torqued.segments:
+    for segment, free in zip(runs, trajectory.segments, strict=False):
         grid = segment.solver.solver  # the TorquedSolver of a TorquedMotion
+        steps.append(grid.step)
+
+        def angle(t, torqued=segment.solver, free=free.solver):
+            return angles_between(torqued.attitude_quaternion(t), free.attitude_quaternion(t))
+
         start, end = segment.start_s, segment.end_s
         while start < end:
             block_end = min(end, start + _BLOCK_STEPS * grid.step)
