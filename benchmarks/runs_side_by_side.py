@@ -45,13 +45,15 @@ RESULTS = Path(__file__).parent / "results"
 _NOT_RUN = {"spinner_dispersions.toml"}
 
 
-def cases(one_day: bool, folder: Path) -> dict[str, Path]:
-    """name → scenario file (the one-day case written into ``folder``)."""
+def cases(one_day: bool, folder: Path, peer_tree: Path) -> dict[str, Path]:
+    """name → scenario file (the one-day case written into ``folder``).  The examples
+    are the peer's files, which both trees read (a later example may use what the
+    peer does not have: the nadir pointer's Sun sensor)."""
     if one_day:
         path = folder / "spinner_one_day.toml"
         path.write_text(scenario_text(1.0))
         return {"spinner, 1 day at 1 s": path}
-    found = sorted((ROOT / "scenarios").glob("*.toml"))
+    found = sorted((peer_tree / "scenarios").glob("*.toml"))
     return {p.stem: p for p in found if p.name not in _NOT_RUN}
 
 
@@ -59,7 +61,7 @@ def run_once(python: str, tree: Path, scenario: Path, out: Path) -> dict:
     """One ``attitude run`` in a fresh process: CPU (s, the run and its forked child),
     wall (s), peak RSS (MB)."""
     environment = dict(os.environ, PYTHONPATH=str(tree))
-    command = [python, "-m", "attitude.cli.main", "run", str(scenario), "--out", str(out)]
+    command = [python, "-m", "attitude", "run", str(scenario), "--out", str(out)]
     start = time.perf_counter()
     process = subprocess.Popen(
         command, cwd=tree, env=environment, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE
@@ -102,7 +104,7 @@ def main(argv: list[str] | None = None) -> dict:
     report: dict = {"cases": {}}
     with tempfile.TemporaryDirectory() as folder:
         folder = Path(folder)
-        chosen = cases(args.one_day, folder)
+        chosen = cases(args.one_day, folder, args.peer_tree)
         if args.only:
             chosen = {k: v for k, v in chosen.items() if k in args.only}
         for name, scenario in chosen.items():

@@ -312,6 +312,8 @@ def _plot_histograms(result: MonteCarloResult, names, stats, path: Path) -> str:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    from attitude.report.plots import PNG_OPTIONS
+
     ok = result.table[result.table["status"] == "ok"]
     columns = min(4, len(names))
     rows = math.ceil(len(names) / columns)
@@ -334,7 +336,7 @@ def _plot_histograms(result: MonteCarloResult, names, stats, path: Path) -> str:
         f"{len(ok)} samples: percentiles 1, 50, 99 (black), nominal (red)", fontsize="medium"
     )
     FigureCanvasAgg(figure)
-    figure.savefig(path, dpi=100)
+    figure.savefig(path, dpi=100, **PNG_OPTIONS)
     return path.name
 
 
@@ -370,7 +372,7 @@ def _plot_envelopes(result: MonteCarloResult, path: Path) -> str:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from attitude.report.plots import time_axis
+    from attitude.report.plots import PNG_OPTIONS, time_axis
 
     envelope = result.envelope
     values = envelope.percentiles_deg(PERCENTILES)  # (p, vectors, 2, bins)
@@ -391,7 +393,7 @@ def _plot_envelopes(result: MonteCarloResult, path: Path) -> str:
         fontsize="medium",
     )
     FigureCanvasAgg(figure)
-    figure.savefig(path, dpi=100)
+    figure.savefig(path, dpi=100, **PNG_OPTIONS)
     return path.name
 
 

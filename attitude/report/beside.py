@@ -26,6 +26,7 @@ does not exist, the function runs in the parent when its result is asked for.
 from __future__ import annotations
 
 import contextlib
+import gc
 import os
 import pickle
 import signal
@@ -63,9 +64,14 @@ class Beside(Generic[T]):
         sys.stderr.flush()
         # No signal between the fork and the child's default handlers: blocked meanwhile.
         blocked = signal.pthread_sigmask(signal.SIG_BLOCK, STOPPING)
+        # The parent's objects out of the garbage collector's reach in the child: its
+        # collections would otherwise write into every one of them and copy every page
+        # they share with the parent (0.15 s of CPU for a run's horizon).
+        gc.freeze()
         try:
             pid = os.fork()
         except OSError:
+            gc.unfreeze()
             signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
             os.close(read)
             os.close(write)
@@ -79,6 +85,7 @@ class Beside(Generic[T]):
                 _send(write, _outcome(self._function, self._args))
             finally:
                 os._exit(0)
+        gc.unfreeze()
         signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
         os.close(write)
         self._pid, self._read = pid, read

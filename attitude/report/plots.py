@@ -31,6 +31,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "PIXEL_COLUMNS",
+    "PNG_OPTIONS",
     "Envelope",
     "Zoom",
     "plot_angular_velocity",
@@ -42,6 +43,9 @@ __all__ = [
 ]
 
 _DPI = 110
+# zlib's fastest level for the PNGs: the encoding is a fifth of a figure's time at the
+# default level (6), a tenth at this one, for files about 15 % larger.
+PNG_OPTIONS = {"pil_kwargs": {"compress_level": 1}}
 # At least the width of the axes in pixels (9 in at 110 dpi, less the margins).
 PIXEL_COLUMNS = 900
 
@@ -175,7 +179,7 @@ def _save(figure: Figure, path: Path) -> str:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
 
     FigureCanvasAgg(figure)
-    figure.savefig(path, dpi=_DPI)
+    figure.savefig(path, dpi=_DPI, **PNG_OPTIONS)
     return path.name
 
 
