@@ -1,9 +1,9 @@
 """One computation in a forked process beside the run, on the machine's other core.
 
 A report's validity horizon (:func:`attitude.trajectory.horizon.validity_horizon`: the scenario
-propagated again under gravity gradient, 20 000 splitting steps of exact free flows)
-takes as long as the rest of a one-day run and needs none of it; it is a few numbers
-to the summary at the end.  :class:`Beside` computes such a function in a child
+propagated again under gravity gradient over the span, splitting steps of exact free
+flows) takes a fifth of a one-day run's CPU and needs none of the rest; it is a few
+numbers to the summary at the end.  :class:`Beside` computes such a function in a child
 process made by ``fork`` (nothing to import again, nothing to send but the result)
 while the parent streams the outputs, and hands the result, or the exception the
 function raised, back through a pipe (pickled) when it is asked for.
