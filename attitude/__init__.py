@@ -54,6 +54,7 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     )
     from attitude.laws.directions import CelestialTarget, FixedDirection, GroundSite
     from attitude.laws.named_laws import InertialLaw, NadirLaw, OrbitFrameLaw, SunLaw, TargetLaw
+    from attitude.laws.slews import Slew, SlewLimits
     from attitude.laws.visibility import visible_intervals
     from attitude.montecarlo.job import run_montecarlo
     from attitude.outputs.aem_writer import write_aem
@@ -62,6 +63,7 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.pointing.spec import BodyVector, PointingSpec
     from attitude.report.run import write_report
     from attitude.scenario.events import AngularImpulse, AttitudeReset, InertiaChange
+    from attitude.scenario.modes import ControlLoss, ControlResume, ModeChange, Wheels
     from attitude.scenario.scenario import InitialState, Scenario
     from attitude.scenario.spacecraft import Spacecraft
     from attitude.scenario.torques import Burn, ScenarioTorques
@@ -71,6 +73,7 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.solver.sensitivities import FlowSensitivities, flow_sensitivities
     from attitude.torques.models import ConstantTorque, GravityGradient, UserTorque
     from attitude.torques.solver import TorquedSolver, departure_time, propagate_batch
+    from attitude.trajectory.handoff import hand_off, hand_off_at, hand_off_states
     from attitude.trajectory.horizon import validity_horizon
     from attitude.trajectory.motion import analyze
     from attitude.trajectory.trajectory import Trajectory, propagate
@@ -125,6 +128,15 @@ _LAZY = {
     "CelestialTarget": "attitude.laws.directions",
     "FixedDirection": "attitude.laws.directions",
     "visible_intervals": "attitude.laws.visibility",
+    "Slew": "attitude.laws.slews",
+    "SlewLimits": "attitude.laws.slews",
+    "ModeChange": "attitude.scenario.modes",
+    "ControlLoss": "attitude.scenario.modes",
+    "ControlResume": "attitude.scenario.modes",
+    "Wheels": "attitude.scenario.modes",
+    "hand_off": "attitude.trajectory.handoff",
+    "hand_off_at": "attitude.trajectory.handoff",
+    "hand_off_states": "attitude.trajectory.handoff",
     "write_aem": "attitude.outputs.aem_writer",
     "load_scenario": "attitude.files.scenario_reader",
     "write_report": "attitude.report.run",
@@ -144,6 +156,8 @@ __all__ = [
     "Burn",
     "CelestialTarget",
     "ConstantTorque",
+    "ControlLoss",
+    "ControlResume",
     "DegenerateLawError",
     "EulerSolver",
     "EulerSolverBatch",
@@ -159,12 +173,15 @@ __all__ = [
     "InputError",
     "KeplerianOrbit",
     "LawState",
+    "ModeChange",
     "NadirLaw",
     "OemOrbit",
     "OrbitFrameLaw",
     "PointingSpec",
     "Scenario",
     "ScenarioTorques",
+    "Slew",
+    "SlewLimits",
     "Spacecraft",
     "SpinStateFit",
     "SunLaw",
@@ -174,12 +191,16 @@ __all__ = [
     "TorquedSolver",
     "Trajectory",
     "UserTorque",
+    "Wheels",
     "__version__",
     "advance",
     "analyze",
     "departure_time",
     "fit_spin_state",
     "flow_sensitivities",
+    "hand_off",
+    "hand_off_at",
+    "hand_off_states",
     "load_scenario",
     "pointing_analysis",
     "pointing_samples",

@@ -75,8 +75,9 @@ def test_our_aem_read_by_orekit_is_within_its_declared_tolerance(example):
         f"t = {rows['t_s'][worst]:.6f} s (segment {int(rows['segment'][worst])}), "
         f"{tolerance:g} declared"
     )
-    # A segment per stretch of smooth motion: events, and burns' starts and stops.
-    pieces = len(scenario.events) + 1 + len(trajectory.breakpoints())
+    # A segment per stretch of smooth motion: events (and, under laws, a slew's end),
+    # and burns' starts and stops (and a slew's switches).
+    pieces = len(trajectory.segments) + len(trajectory.breakpoints())
     assert len(json.loads(header["records_per_segment"])) == pieces
 
 

@@ -78,7 +78,7 @@ BAD = {
     "unknown event type": (
         _replace('type = "angular_impulse"', 'type = "torque"'),
         r"bad\.toml: events\[0\]\.type: expected one of angular_impulse, inertia_change, "
-        r"attitude_reset, got 'torque'",
+        r"attitude_reset, mode_change, control_loss, control_resume, got 'torque'",
     ),
     "non-finite number": (
         _replace("impulse = [0.0, 0.0, 1.0]", "impulse = [nan, 0.0, 1.0]"),

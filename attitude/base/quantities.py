@@ -29,6 +29,7 @@ SI_UNITS = {
     "moment_of_inertia": "kg m2",
     "angular_momentum": "kg m2 / s",
     "angular_velocity": "rad / s",
+    "angular_acceleration": "rad / s2",
     "angle": "rad",
     "length": "m",
     "torque": "N m",

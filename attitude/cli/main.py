@@ -184,6 +184,8 @@ def _describe(loaded, plan, out: Path | None = None) -> str:
         f"[{', '.join(f'{v:.6g}' for v in craft.principal_moments)}] kg m²",
     ]
     initial = scenario.initial_state
+    if initial.law is not None:
+        lines.append(f"  law         {initial.law.name}: {initial.law.describe()} (at the epoch)")
     if initial.angular_velocity is not None:
         rate = ", ".join(f"{v:.6g}" for v in np.degrees(initial.angular_velocity))
         lines.append(f"  rate        [{rate}] deg/s (body, at the epoch)")
@@ -195,7 +197,9 @@ def _describe(loaded, plan, out: Path | None = None) -> str:
             flips = f", {item.flip_count} flip{'' if item.flip_count == 1 else 's'}"
         else:
             flips = ""
-        how = "splitting" if item.formula == "torqued" else f"formula {item.formula}"
+        how = "splitting" if item.formula in ("torqued", "gyrostat") else f"formula {item.formula}"
+        if item.formula in ("guided", "slew"):  # a law holds the attitude
+            how = plan.trajectory.segments[index].solver.describe()
         lines.append(
             f"  segment {index}   from {scenario.format_epoch(item.start_s)}: {item.motion} "
             f"({how}{period}{flips})"
@@ -203,6 +207,9 @@ def _describe(loaded, plan, out: Path | None = None) -> str:
     from attitude.report.torques import torques_lines
 
     lines += [f"  {line}" for line in torques_lines(plan)]
+    from attitude.report.guidance import guidance_lines
+
+    lines += [f"  {line}" for line in guidance_lines(plan)]
     lines.append(f"  events      {len(scenario.events)}")
     lines += [
         f"    {scenario.format_epoch(t)} (+{t:.12g} s)  {event.kind}"

@@ -5,6 +5,7 @@ Modules:
 
 - ``aem_reader``: An attitude read from a CCSDS Attitude Ephemeris Message (AEM 2.0,
   KVN) at an epoch.
+- ``law_reader``: Attitude laws, slews, wheels and ground sites in scenario files.
 - ``scenario_reader``: Scenario files: the TOML format (``docs/scenarios.md``) read into
   a Scenario.
 - ``scenario_writer``: Scenario files written back: a scenario document (the TOML that

@@ -27,7 +27,7 @@ import tomllib
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import Any, Literal, NoReturn, TypedDict, overload
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -40,10 +40,12 @@ from attitude.environment.oem import OemOrbit
 from attitude.environment.orbit import Orbit, TleOrbit
 from attitude.environment.timescales import SCALES, as_time, time_from_tt_seconds
 from attitude.files.aem_reader import attitude_from_aem
+from attitude.files.law_reader import read_law, read_sites, read_slew, read_wheels
 from attitude.outputs.aem_sampling import check_tolerance
 from attitude.outputs.formats import DEFAULT_FORMATS, OutputChoice, parse_formats
 from attitude.pointing.spec import KINDS, BodyVector, PointingSpec
 from attitude.scenario.events import AngularImpulse, AttitudeReset, InertiaChange
+from attitude.scenario.modes import MODE_EVENTS, ControlLoss, ControlResume, ModeChange
 from attitude.scenario.scenario import InitialState, Scenario
 from attitude.scenario.spacecraft import Spacecraft
 from attitude.scenario.torques import Burn, ScenarioTorques
@@ -128,6 +130,10 @@ class _Table:
     def has(self, key: str) -> bool:
         return key in self.data
 
+    @overload
+    def table(self, key: str, required: Literal[True] = True) -> _Table: ...
+    @overload
+    def table(self, key: str, required: bool) -> _Table | None: ...
     def table(self, key: str, required: bool = True) -> _Table | None:
         if key not in self.data:
             if required:
@@ -148,6 +154,12 @@ class _Table:
             return default
         return self.data[key]
 
+    @overload
+    def string(self, key: str, required: Literal[True] = True, default: None = None) -> str: ...
+    @overload
+    def string(self, key: str, required: bool, default: str) -> str: ...
+    @overload
+    def string(self, key: str, required: bool, default: None = None) -> str | None: ...
     def string(self, key: str, required: bool = True, default: str | None = None) -> str | None:
         value = self.raw(key, required, default)
         if value is not None and not isinstance(value, str):
@@ -372,7 +384,14 @@ def _attitude_in_icrf(table: _Table, orbit: Orbit | None, at) -> Rotation | None
     return orbit_frame_to_icrf(frame, r, v) * attitude
 
 
-def _rate(table: _Table, required: bool) -> dict[str, np.ndarray]:
+class _Rate(TypedDict, total=False):
+    """The rate of an initial state or an attitude reset, as InitialState takes it."""
+
+    angular_velocity: np.ndarray
+    angular_momentum: np.ndarray
+
+
+def _rate(table: _Table, required: bool) -> _Rate:
     given = [k for k in ("angular_velocity", "angular_momentum") if table.has(k)]
     if len(given) > 1:
         table.fail("give one of angular_velocity and angular_momentum, not both")
@@ -380,7 +399,10 @@ def _rate(table: _Table, required: bool) -> dict[str, np.ndarray]:
         if required:
             table.fail("missing angular_velocity (rad/s) or angular_momentum (N m s)")
         return {}
-    return {given[0]: table.quantity(given[0], given[0], (3,))}
+    value = table.quantity(given[0], given[0], (3,))
+    if given[0] == "angular_velocity":
+        return {"angular_velocity": value}
+    return {"angular_momentum": value}
 
 
 def _event_epoch(table: _Table, scale: str):
@@ -397,14 +419,18 @@ def _event_time(at, epoch):
     return at if not isinstance(at, float) else time_from_tt_seconds(epoch, at)
 
 
-def _events(root: _Table, scale: str, epoch, orbit: Orbit | None) -> list:
+def _events(root: _Table, scale: str, epoch, orbit: Orbit | None, sites: dict) -> list:
     events = []
     for table in root.tables("events"):
-        kind = table.choice("type", ("angular_impulse", "inertia_change", "attitude_reset"))
+        kind = table.choice(
+            "type", ("angular_impulse", "inertia_change", "attitude_reset", *MODE_EVENTS)
+        )
         common = ("type", "epoch", "offset", "label")
         label = table.string("label", required=False, default="")
         at = _event_epoch(table, scale)
-        if kind == "angular_impulse":
+        if kind in MODE_EVENTS:
+            events.append(_mode_event(table, kind, common, at, label, sites))
+        elif kind == "angular_impulse":
             table.allow(*common, "impulse", "frame")
             impulse = table.quantity("impulse", "angular_momentum", (3,))
             frame = table.choice("frame", ("body", "inertial"), default="body")
@@ -429,6 +455,22 @@ def _events(root: _Table, scale: str, epoch, orbit: Orbit | None) -> list:
             rate = _rate(table, required=attitude is None)
             events.append(_checked(table, None, AttitudeReset, at, attitude, label=label, **rate))
     return events
+
+
+def _mode_event(table: _Table, kind: str, common: tuple, at, label: str, sites: dict):
+    """A mode_change, control_loss or control_resume (``attitude.files.law_reader``)."""
+    if kind == "control_loss":
+        table.allow(*common, "wheels")
+        wheels = table.table("wheels", required=False)
+        if wheels is None:
+            return _checked(table, None, ControlLoss, at, label=label)
+        return _checked(table, None, ControlLoss, at, read_wheels(wheels), label)
+    table.allow(*common, "law", "slew")
+    law = read_law(table.table("law"), sites)
+    slew_table = table.table("slew", required=False)
+    slew = None if slew_table is None else read_slew(slew_table)
+    build = ModeChange if kind == "mode_change" else ControlResume
+    return _checked(table, None, build, at, law, slew, label)
 
 
 def _angle_deg(item: _Table, key: str, low: float, high: float) -> float | None:
@@ -670,12 +712,14 @@ def scenario_from_document(path: Path, document: dict[str, Any]) -> ScenarioFile
         "pointing",
         "torques",
         "dispersions",
+        "sites",
     )
     name, scale, epoch = _scenario_table(root)
     spacecraft = _spacecraft(root)
     pointing = _pointing(root, scale, epoch, spacecraft.name)
-    state = _initial_state(root, pointing.orbit, epoch)
-    events = _events(root, scale, epoch, pointing.orbit)
+    sites = read_sites(root)
+    state = _initial_state(root, pointing.orbit, epoch, sites)
+    events = _events(root, scale, epoch, pointing.orbit, sites)
     torques = _torques(root, scale, pointing.orbit)
     output = root.table("output")
     output.allow("start", "stop", "duration", "step", "formats", "aem_tolerance")
@@ -720,10 +764,19 @@ def _spacecraft(root: _Table) -> Spacecraft:
     return _checked(craft, key, Spacecraft, craft_name, inertia, keys={"inertia": key})
 
 
-def _initial_state(root: _Table, orbit: Orbit | None, epoch) -> InitialState:
+def _initial_state(root: _Table, orbit: Orbit | None, epoch, sites: dict) -> InitialState:
     """[initial_state]: the attitude (in ICRF, from the frame or AEM file it is given
-    in) and the rate (angular velocity or momentum)."""
+    in) and the rate (angular velocity or momentum); or [initial_state.law], the law the
+    body starts under (``attitude.files.law_reader``)."""
     initial = root.table("initial_state")
+    if initial.has("law"):
+        others = sorted(set(initial.data) - {"law"})
+        if others:
+            initial.fail(
+                f"give [initial_state.law] alone: the law sets the attitude and the rate "
+                f"(got {others[0]!r} too)"
+            )
+        return _checked(initial, None, InitialState, law=read_law(initial.table("law"), sites))
     initial.allow("quaternion", "matrix", "frame", "aem", "angular_velocity", "angular_momentum")
     attitude = _attitude_in_icrf(initial, orbit, epoch)
     if attitude is None:

@@ -19,6 +19,8 @@ Modules:
   frame, nadir (with yaw steering), Sun, target.
 - ``orbit_derivatives``: The orbit's position and velocity with their derivatives:
   analytic, or by finite differences of stated accuracy.
+- ``slews``: Slews between a state and a law: eigen-axis, bang–coast–bang, within a
+  maximum rate and acceleration, from the start rate to the law's.
 - ``visibility``: When a ground site sees the spacecraft: elevation, and the intervals
   above a minimum elevation.
 """

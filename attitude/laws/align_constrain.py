@@ -166,8 +166,9 @@ class AttitudeLaw(ABC):
         none.  (The Sun, the Moon and the Earth's rotation are always available.)"""
         if "orbit" in self.needs and orbit is None:
             raise InputError(
-                f"{key}: the {self.name} law ({self.describe()}) needs {INPUTS['orbit']}, "
-                "and the scenario has none"
+                f"the {self.name} law ({self.describe()}) needs {INPUTS['orbit']}, "
+                "and the scenario has none",
+                key=key,
             )
 
     def bind(
@@ -229,7 +230,7 @@ class BoundLaw:
         try:
             return self.law.evaluate(at)
         except DegenerateLawError as error:
-            raise DegenerateLawError(f"{self.key}: {error}") from None
+            raise error.located(key=self.key) from None
 
     def attitude(self, seconds: ArrayLike) -> Rotation:
         return self.state(seconds).attitude
@@ -240,7 +241,7 @@ class BoundLaw:
         :data:`PARALLEL_LIMIT_RAD`, and its rate about the primary grows as it shrinks."""
         law = self.law
         if not isinstance(law, AlignConstrainLaw):
-            raise InputError(f"{self.key}: the {law.name} law has no pair of directions")
+            raise InputError(f"the {law.name} law has no pair of directions", key=self.key)
         at = self.inputs.at(seconds)
         d1 = law.primary.vector(at).value
         d2 = law.secondary.vector(at).value

@@ -40,7 +40,7 @@ until the largest error is between a quarter and a half of the tolerance.  The t
 intervals: the four at each end, where the window is off-centre, and, torque-free, up
 to 2048 spread over one body period, where every phase of the motion occurs (ω(t) is
 periodic in the body), and around the first flip of a separatrix segment; under
-torques, where nothing repeats, every interval of the segment, or 4096 spread over it
+torques or a law, where nothing repeats, every interval of the segment, or 4096 spread over it
 when it has more.  Each test interval is read where the interpolation error peaks,
 the extremum of the node polynomial ∏(t − tᵢ) over it (:data:`PEAKS`), and at its
 quarter points.
@@ -73,6 +73,7 @@ from attitude.base.errors import InputError
 from attitude.environment.epoch_texts import EpochTexts
 from attitude.environment.timescales import SAME_INSTANT_S
 from attitude.outputs.aem_writer import AemWriter
+from attitude.trajectory.guided import GuidedMotion
 from attitude.trajectory.motion import SegmentMotion
 from attitude.trajectory.torqued import TorquedMotion
 from attitude.trajectory.trajectory import Segment, Trajectory
@@ -343,7 +344,7 @@ def _test_intervals(
     step = (end_s - start_s) / intervals
     picked = [np.arange(min(_END_INTERVALS, intervals))]
     picked.append(np.arange(max(0, intervals - _END_INTERVALS), intervals))
-    if isinstance(segment.solver, TorquedMotion):
+    if isinstance(segment.solver, TorquedMotion | GuidedMotion):  # nothing repeats
         if intervals <= _TORQUED_TEST_INTERVALS:
             picked.append(np.arange(intervals))
         else:
@@ -547,7 +548,7 @@ def write_planned_aem(
             "rad of the exact attitude",
         ),
     )
-    measured = []
+    measured: list[AemSegmentPlan] = []
     for item in plan.segments:
         segment = trajectory.segments[item.segment]
         ends = texts(np.array([item.start_s, item.end_s]))

@@ -188,9 +188,9 @@ class SearchGrid:
 
 def _segment_rate(solver) -> float:
     """A bound on a segment's body rate, rad/s: its own where it states one (a segment
-    under a law or a slew: ``angular_rate_bound``), else √(2T/I_min), since |ω|² =
-    Σ m_i²/I_i² ≤ (Σ m_i²/I_i)/I_min = 2T/I_min (tighter than G/I_min, which it never
-    exceeds)."""
+    under a law or a slew: ``angular_rate_bound``, attitude.trajectory.guided), else
+    √(2T/I_min), since |ω|² = Σ m_i²/I_i² ≤ (Σ m_i²/I_i)/I_min = 2T/I_min (tighter than
+    G/I_min, which it never exceeds)."""
     stated = getattr(solver, "angular_rate_bound", None)
     if stated is not None:
         return float(stated)

@@ -7,6 +7,8 @@ Modules:
   core.
 - ``figures``: What the report's figures show, sampled from the exact motion, and where
   they zoom.
+- ``guidance``: What a run says about its attitude laws: the law of each segment, the
+  slews, the control losses and the ground sites' passes.
 - ``page``: The report's HTML page: the summary as tables, the plots, links to the data
   files.
 - ``plan``: Everything a run checks before it samples: one path for ``attitude check``

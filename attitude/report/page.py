@@ -10,6 +10,8 @@ from __future__ import annotations
 from html import escape
 from typing import Any
 
+from attitude.report.guidance import guidance_section
+
 __all__ = ["render_page"]
 
 _STYLE = """
@@ -172,6 +174,7 @@ def render_page(summary: dict[str, Any], images: dict[str, str], files: list[str
         *_heading(summary),
         *_events_section(summary["scenario"]["events"]),
         *_motion_section(summary["motion"]),
+        *guidance_section(summary.get("guidance"), _table),
         *_torques_section(summary.get("torques")),
         *_pointing_section(summary.get("pointing")),
         *_plots_section(images),

@@ -35,7 +35,9 @@ from attitude.pointing.search import SearchGrid, check_pointing
 from attitude.pointing.spec import PointingSpec, for_scenario
 from attitude.report.beside import Beside
 from attitude.scenario.scenario import Scenario
+from attitude.trajectory.guided import GUIDED
 from attitude.trajectory.horizon import ValidityHorizon, validity_horizon
+from attitude.trajectory.modes import uses_laws
 from attitude.trajectory.motion import SegmentMotion, analyze, undersampling_note
 from attitude.trajectory.steps import CHECK_BUDGET_S
 from attitude.trajectory.trajectory import Trajectory, propagate
@@ -128,6 +130,9 @@ def plan_run(
     if not pointing.is_empty:
         say("checking the pointing: the orbit, the Sun and the Moon over the span")
     notes, search = check_pointing(trajectory, pointing)
+    # Attitude laws: ground sites never seen, the Earth orientation table's coverage.
+    guided = [n for s in trajectory.segments for n in getattr(s.solver, "notes", ())]
+    notes = [*dict.fromkeys(guided), *notes]
     undersampled = undersampling_note(trajectory, motion)
     if undersampled:
         notes.append(undersampled)
@@ -135,6 +140,8 @@ def plan_run(
     # On an orbit, unless the gravity gradient is modelled: a torque-free run, or burns
     # alone, neglects it.
     wanted = pointing.orbit is not None and scenario.torques.gravity_gradient is None
+    # Under a law the controller holds the attitude: only free segments neglect anything.
+    wanted = wanted and any(s.solver.formula not in GUIDED for s in trajectory.segments)
     if wanted and horizon:
         say("the validity horizon: the run again under the gravity gradient it leaves out")
         found = validity_horizon(trajectory, pointing.orbit)
@@ -180,6 +187,9 @@ def _propagating(scenario: Scenario, check: bool) -> str:
     way: ``attitude.trajectory.steps``)."""
     segments = len(scenario.events) + 1
     text = f"propagating {segments} segment{'s' if segments > 1 else ''}"
+    if uses_laws(scenario):  # a slew adds a segment of its own, known once it is made
+        count = len(scenario.events)
+        text = f"propagating the modes through {count} event{'s' if count != 1 else ''}"
     what = []
     if scenario.torques.gravity_gradient is not None:
         what.append("gravity gradient")

@@ -19,7 +19,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -45,7 +45,7 @@ __all__ = [
 _DPI = 110
 # zlib's fastest level for the PNGs: the encoding is a fifth of a figure's time at the
 # default level (6), a tenth at this one, for files about 15 % larger.
-PNG_OPTIONS = {"pil_kwargs": {"compress_level": 1}}
+PNG_OPTIONS: dict[str, Any] = {"pil_kwargs": {"compress_level": 1}}
 # At least the width of the axes in pixels (9 in at 110 dpi, less the margins).
 PIXEL_COLUMNS = 900
 

@@ -27,6 +27,8 @@ import numpy as np
 from attitude.outputs.aem_sampling import INTERPOLATION_METHOD
 from attitude.pointing.intervals import Interval, total_duration
 from attitude.pointing.search import PointingAnalysis
+from attitude.report.guidance import mode_event_entry
+from attitude.scenario.modes import MODE_EVENTS
 from attitude.scenario.scenario import Scenario
 from attitude.trajectory.motion import LISTED_FLIPS, SegmentMotion
 from attitude.trajectory.trajectory import Trajectory
@@ -81,6 +83,8 @@ def _event_summary(scenario: Scenario, offset_s: float, event) -> dict[str, Any]
     elif event.kind == "inertia_change":
         entry["inertia_tensor_body_kg_m2"] = event.inertia.tensor
         entry["principal_moments_kg_m2"] = event.inertia.moments
+    elif event.kind in MODE_EVENTS:
+        entry.update(mode_event_entry(event))
     else:
         if event.attitude is not None:
             entry["q_body_to_icrf_wxyz"] = event.attitude.as_quat(scalar_first=True)
@@ -101,6 +105,14 @@ _MOTION_TEXT = {
     "torqued": "under torques (propagated by splitting with the exact free flow): no "
     "period; flips located on the propagated motion (the momentum crossing the "
     "intermediate axis); the kinetic energy and momentum are those at its start",
+    "gyrostat": "spinning wheels after a control loss (a gyrostat, propagated by splitting "
+    "with the exact free and gyroscopic flows): no period; flips located on the propagated "
+    "motion; the momentum is the total, body plus wheels, and the kinetic energy the "
+    "body's, at its start",
+    "guided": "under an attitude law: the attitude is the law's (guidance.segments names "
+    "it); the kinetic energy and momentum I·ω are those at its start",
+    "slew": "a slew onto a law (guidance.slews); the kinetic energy and momentum I·ω are "
+    "those at its start",
 }
 
 

@@ -5,6 +5,8 @@ Modules:
 
 - ``compiled_steps``: The splitting loop compiled, for one spacecraft under gravity
   gradient alone.
+- ``gyrostat``: Wheels spinning at constant speed relative to the body: the
+  gyrostat's gyroscopic term as an exact flow of the splitting.
 - ``models``: External torques on a rigid spacecraft: gravity gradient, constant
   torques, user torques.
 - ``solver``: Attitude under external torques: splitting with the exact free flow

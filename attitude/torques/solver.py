@@ -1,12 +1,12 @@
 """Attitude under external torques: splitting with the exact free flow (``TorquedSolver``).
 
-The equations of a rigid body under a torque τ(t, R, ω),
+The equations of a rigid body under a torque Γ(t, R, ω),
 
-    dm/dt = m × ω + τ,   dq/dt = ½ q ⊗ (0, ω),   ω = I⁻¹ m   (body axes),
+    dm/dt = m × ω + Γ,   dq/dt = ½ q ⊗ (0, ω),   ω = I⁻¹ m   (body axes),
 
 are split into the free rigid body, whose flow is exact (:mod:`attitude.solver.free_flow`,
 after Celledoni, Fassò, Säfström and Zanna, whose paper's title names this use), and
-the kick dm/dt = τ with the attitude and the clock frozen, exact for any torque that
+the kick dm/dt = Γ with the attitude and the clock frozen, exact for any torque that
 does not depend on ω (see :mod:`attitude.torques.models`).  A composition of the two
 (:mod:`attitude.torques.splitting`) gives a method whose error is proportional to the torque,
 not to the spin, and which is the exact solver when the torque vanishes.  For
@@ -31,6 +31,7 @@ References: see :mod:`attitude.torques.splitting` and :mod:`attitude.torques.mod
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -43,6 +44,7 @@ from attitude.base.quantities import as_si_array, as_si_scalar, as_vector3
 from attitude.solver.euler_solver import EulerSolver
 from attitude.solver.free_flow import UnitBatch, advance_floats
 from attitude.solver.inertia import principal_axes
+from attitude.torques.gyrostat import Gyroscope
 from attitude.torques.models import (
     GravityGradient,
     PrincipalFrame,
@@ -53,13 +55,16 @@ from attitude.torques.models import (
 from attitude.torques.splitting import Composition, composition
 
 __all__ = [
+    "MAX_STEPS",
     "TOLERANCE_RANGE_RAD",
     "StepChoice",
     "TorquedSolver",
     "angles_between",
     "departure_time",
     "first_crossing",
+    "next_search_step",
     "propagate_batch",
+    "search_start_step",
 ]
 
 # Steps computed per call of the torques' time functions (orbit positions, vectorized).
@@ -70,14 +75,16 @@ _DENSE_CHUNK = 8192
 # before a breakpoint.
 _SLIVER = 1e-6
 # More steps than this in one request (hours of computing) is refused as a mistake.
-_MAX_STEPS = 1e8
+_MAX_REQUEST_STEPS = 1e8
 # A step search that would try a step with more than this many steps over its span is
 # refused (each try runs the span twice): torques that turn the body faster and faster
-# (a runaway spin-up) would otherwise halve the step for hours before failing.
-_SEARCH_MAX_STEPS = 1e7
+# (a runaway spin-up) would otherwise halve the step for hours before failing.  At 8
+# free flows a step and tens of µs a flow, 1e7 steps are about an hour of computing.
+# The scenario's run-level search (attitude.trajectory.steps) has the same cap.
+MAX_STEPS = 1e7
 # The tolerances a step search can meet (rad): below 1e-12 the Richardson estimate is
 # rounding (16-digit states), and the search would shrink the step until it gives up
-# at _SEARCH_MAX_STEPS; beyond 0.1 rad an estimate from a linear error model means
+# at MAX_STEPS; beyond 0.1 rad an estimate from a linear error model means
 # nothing.  The scenario's ``[torques] accuracy`` has the same range.
 TOLERANCE_RANGE_RAD = (1e-12, 0.1)
 # The body must turn by less than this fraction of a turn in the spacing of float
@@ -107,8 +114,10 @@ class _Engine:
         torques: list[Torque],
         frame: PrincipalFrame,
         moments: NDArray[np.float64],
+        gyroscope: Gyroscope | None = None,
     ) -> None:
         self.method = method
+        self.gyroscope = gyroscope  # spinning wheels: the gyroscopic flow (torques.gyrostat)
         self.torques = torques
         self.frame = frame
         self.moments = moments  # (3,) or (N, 3), for advance()
@@ -153,24 +162,40 @@ class _Engine:
 
     def torque(self, data, m, q):
         I1, I2, I3 = self.frame.moments
-        ω = (m[0] / I1, m[1] / I2, m[2] / I3)
+        if self.gyroscope is None:
+            ω = (m[0] / I1, m[1] / I2, m[2] / I3)
+        else:
+            ω = self.gyroscope.body_rate(m, self.frame.moments)
         total = (0.0, 0.0, 0.0)
         for model, row in zip(self.torques, data, strict=True):
-            τ = model.principal_torque(row, q, ω, self.frame)
-            total = (total[0] + τ[0], total[1] + τ[1], total[2] + τ[2])
+            torque = model.principal_torque(row, q, ω, self.frame)
+            total = (total[0] + torque[0], total[1] + torque[1], total[2] + torque[2])
         return total
 
     def kick(self, data, m, q, w):
         """m after the kick of duration w (s) at frozen attitude and clock."""
         k1 = self.torque(data, m, q)
-        if not self.rk4:  # τ does not depend on m: the kick is exact
+        if not self.rk4:  # Γ does not depend on m: the kick is exact
             return (m[0] + w * k1[0], m[1] + w * k1[1], m[2] + w * k1[2])
-        # Classical Runge–Kutta on dm/dt = τ(t, R, I⁻¹m), R and t frozen.
+        # Classical Runge–Kutta on dm/dt = Γ(t, R, I⁻¹m), R and t frozen.
         h2 = 0.5 * w
         k2 = self.torque(data, tuple(m[i] + h2 * k1[i] for i in range(3)), q)
         k3 = self.torque(data, tuple(m[i] + h2 * k2[i] for i in range(3)), q)
         k4 = self.torque(data, tuple(m[i] + w * k3[i] for i in range(3)), q)
         return tuple(m[i] + w / 6.0 * (k1[i] + 2.0 * (k2[i] + k3[i]) + k4[i]) for i in range(3))
+
+    def kick_and_turn(self, data, m, q, w):
+        """(m, q) after the kick of duration w: the torques' kick, and with spinning
+        wheels the gyroscopic rotation G around it, G(w/2) T(w) G(w/2) (attitude.torques
+        .gyrostat)."""
+        gyroscope = self.gyroscope
+        if gyroscope is None:
+            return self.kick(data, m, q, w), q
+        if not self.torques:
+            return gyroscope.turn(m, q, w)
+        m, q = gyroscope.turn(m, q, 0.5 * w)
+        m = self.kick(data, m, q, w)
+        return gyroscope.turn(m, q, 0.5 * w)
 
     # ---- one step
 
@@ -208,7 +233,7 @@ class _Engine:
                 if _nonzero(pending):
                     m, q = self.flow(m, q, pending)
                     pending = 0.0
-                m = self.kick(data_by_kick[j], m, q, b[j] * h)
+                m, q = self.kick_and_turn(data_by_kick[j], m, q, b[j] * h)
             if j < s:
                 pending = pending + a[j] * h
         return m, q, pending
@@ -301,6 +326,53 @@ def _grid_steps(t_from: float, t_to: float, step: float, breakpoints: NDArray, l
     return np.array(starts), np.array(sizes)
 
 
+# ----------------------------------------------------------------- the step search
+# One search for a step that meets an error target, shared by TorquedSolver(tolerance=)
+# and the scenario's run-level search (attitude.trajectory.steps), which estimate the
+# error differently (one solver from its start; the whole run) but move alike.
+
+
+def search_start_step(rate: float, torques: Iterable[Torque], t: float) -> float:
+    """Where a step search starts: a quarter turn at ``rate`` (rad/s), at most a
+    twentieth of the period of the orbit of any gravity gradient among ``torques``
+    (its position at TT ``t``), 60 s with neither."""
+    candidates = [2.0 * math.pi / rate / 4.0] if rate > 0.0 else []
+    for torque in torques:
+        if isinstance(torque, GravityGradient):  # the one torque with an orbit period
+            radius = float(np.linalg.norm(torque.position(np.array([t]))[0]))
+            candidates.append(2.0 * math.pi * math.sqrt(radius**3 / torque.mu) / 20.0)
+    return min(candidates, default=60.0)
+
+
+def next_search_step(
+    step: float,
+    error: float,
+    tolerance: float,
+    order: int,
+    span: float,
+    good: float | None,
+    bad: float,
+) -> float | None:
+    """The step search's next try after ``step`` gave the estimate ``error``, or None
+    when the search is done.  ``good``: the largest step that met ``tolerance`` so far
+    (None: none yet); ``bad``: the smallest that missed it (inf: none yet).
+
+    The error model C h^p (p = ``order``) aims at half the tolerance, moving at most
+    8× down (and at least to 0.8 of the step) or 4× up a try, never past half the
+    ``span``; once a passing and a failing step bracket the answer, it bisects in
+    log h until they are within a factor 1.25."""
+    factor = (0.5 * tolerance / max(error, 1e-300)) ** (1.0 / order)
+    if good is not None and math.isfinite(bad):
+        if bad / good < 1.25:
+            return None
+        return math.sqrt(good * bad)
+    if good is not None:
+        if factor < 1.25 or step >= 0.5 * span:
+            return None
+        return min(0.5 * span, step * min(4.0, factor))
+    return step * min(0.8, max(0.125, factor))
+
+
 # ----------------------------------------------------------------- the solver
 
 
@@ -342,10 +414,10 @@ class _Propagation:
 
     def extend_to(self, t_max: float) -> None:
         e = self.engine
-        if (t_max - self.t_end) / self.step > _MAX_STEPS:
+        if (t_max - self.t_end) / self.step > _MAX_REQUEST_STEPS:
             raise InputError(
                 f"t = {t_max:g} s is {(t_max - self.t_end) / self.step:.3g} steps of "
-                f"{self.step:g} s ahead: more than {_MAX_STEPS:g} steps; use a larger step "
+                f"{self.step:g} s ahead: more than {_MAX_REQUEST_STEPS:g} steps; use a larger step "
                 "or a shorter span"
             )
         while self.t_end < t_max:
@@ -426,9 +498,17 @@ class TorquedSolver:
     step is then chosen so that the estimated attitude error over [t0, t0 + span] is
     within the tolerance, and ``step_choice`` reports the estimate.
 
-    With no torque the solver is :class:`~attitude.solver.euler_solver.EulerSolver` itself.
-    Times t ≥ t0 only.  Outputs: :meth:`attitude`, :meth:`angular_momentum`,
-    :meth:`angular_velocity`, :meth:`attitude_quaternion`, as for ``EulerSolver``.
+    ``wheel_momentum``: the momentum h (body axes, N m s) of wheels spinning at a
+    constant speed relative to the body: the body is then a gyrostat
+    (:mod:`attitude.torques.gyrostat`: the gyroscopic term is a third exact flow of the
+    splitting, with or without torques), ``angular_momentum`` is the spacecraft's total,
+    M = Iω + h, and :meth:`angular_velocity` gives ω = I⁻¹(M − h).  Order 6 is refused
+    with it.
+
+    With no torque and no wheels the solver is
+    :class:`~attitude.solver.euler_solver.EulerSolver` itself.  Times t ≥ t0 only.
+    Outputs: :meth:`attitude`, :meth:`angular_momentum`, :meth:`angular_velocity`,
+    :meth:`attitude_quaternion`, as for ``EulerSolver``.
     """
 
     def __init__(
@@ -444,11 +524,24 @@ class TorquedSolver:
         method: str | None = None,
         tolerance: float | None = None,
         span: float | None = None,
+        wheel_momentum: ArrayLike | None = None,
     ) -> None:
         self._free = EulerSolver(inertia, angular_momentum, attitude, t0)  # validates all three
         self._t0 = self._free.t0
         self._torques = as_torque_list(torques)
         self.method = composition(4 if order is None and method is None else order, method)
+        wheels = (
+            None
+            if wheel_momentum is None
+            else as_vector3(wheel_momentum, "angular_momentum", "wheel_momentum")
+        )
+        if wheels is not None and self.method.needs_rkn:
+            raise InputError(
+                f"method {self.method.name!r} (order {self.method.order}) keeps its order only "
+                "without a gyroscopic term; spinning wheels allow order 2 or 4"
+            )
+        # The exact solver alone: no torque and no wheels.
+        self._exact = not self._torques and wheels is None
         if self.method.needs_rkn and any(t.depends_on_angular_velocity for t in self._torques):
             raise InputError(
                 f"method {self.method.name!r} (order {self.method.order}) needs torques that do "
@@ -470,9 +563,17 @@ class TorquedSolver:
             tuple(float(v) for v in self._moments),
             None if self._principal_to_body is None else self._principal_to_body.as_matrix(),
         )
+        self._wheels_principal: NDArray[np.float64] | None = None
+        gyroscope = None
+        if wheels is not None:
+            h = wheels if axes.is_diagonal else axes.body_to_principal.apply(wheels)
+            self._wheels_principal = np.asarray(h, dtype=np.float64)
+            gyroscope = Gyroscope(
+                tuple(float(v) for v in h), tuple(float(v) for v in self._moments)
+            )
         # Every ConstantTorque in one model: a kick costs the same for 1 burn or 1000.
         self._engine = _Engine(
-            self.method, merged_constant_torques(self._torques), frame, self._moments
+            self.method, merged_constant_torques(self._torques), frame, self._moments, gyroscope
         )
         self._m0 = tuple(float(v) for v in m0)
         self._q0 = tuple(R0.as_quat(scalar_first=True).tolist())
@@ -480,7 +581,7 @@ class TorquedSolver:
             sorted({b for t in self._torques for b in t.breakpoints if b > self._t0})
         )
         self.step_choice: StepChoice | None = None
-        if tolerance is not None and self._torques:
+        if tolerance is not None and not self._exact:
             if step is not None:
                 raise InputError("give either step or tolerance, not both")
             self._propagation = self._choose_step(tolerance, span)
@@ -526,7 +627,7 @@ class TorquedSolver:
         bad = math.inf
         tried: list[tuple[float, float]] = []
         for _ in range(10):
-            if span / step > _SEARCH_MAX_STEPS:
+            if span / step > MAX_STEPS:
                 last = (
                     f"; the estimate was {tried[-1][1]:.3g} rad at {tried[-1][0]:.3g} s"
                     if tried
@@ -534,7 +635,7 @@ class TorquedSolver:
                 )
                 raise InputError(
                     f"{tolerance:g} rad over {span:g} s would need a step below "
-                    f"{step:.3g} s, more than {_SEARCH_MAX_STEPS:g} steps{last}: give a step, "
+                    f"{step:.3g} s, more than {MAX_STEPS:g} steps{last}: give a step, "
                     "a looser tolerance or a shorter span",
                     key="tolerance",
                     value=tolerance,
@@ -546,17 +647,12 @@ class TorquedSolver:
                     good = (step, error, propagation)
             else:
                 bad = min(bad, step)
-            factor = (0.5 * tolerance / max(error, 1e-300)) ** (1.0 / p)
-            if good is not None and math.isfinite(bad):
-                if bad / good[0] < 1.25:
-                    break
-                step = math.sqrt(good[0] * bad)
-            elif good is not None:
-                if factor < 1.25 or step >= 0.5 * span:
-                    break
-                step = min(0.5 * span, step * min(4.0, factor))
-            else:
-                step *= min(0.8, max(0.125, factor))
+            following = next_search_step(
+                step, error, tolerance, p, span, None if good is None else good[0], bad
+            )
+            if following is None:
+                break
+            step = following
         if good is None:
             raise InputError(
                 f"{tolerance:g} rad over {span:g} s not reached: the estimate was "
@@ -569,14 +665,11 @@ class TorquedSolver:
         return propagation
 
     def _initial_step(self) -> float:
-        """A quarter of the spin period, at most a twentieth of any orbit period."""
-        ω = float(np.linalg.norm(np.asarray(self._m0) / self._moments))
-        candidates = [2.0 * math.pi / ω / 4.0] if ω > 0.0 else []
-        for torque in self._torques:
-            if isinstance(torque, GravityGradient):  # the one torque with an orbit period
-                radius = float(np.linalg.norm(torque.position(np.array([self._t0]))[0]))
-                candidates.append(2.0 * math.pi * math.sqrt(radius**3 / torque.mu) / 20.0)
-        return min(candidates) if candidates else 60.0
+        """:func:`search_start_step` at the initial rate (the gyroscopic turn's too)."""
+        ω = float(np.linalg.norm(self._principal_rate(np.asarray(self._m0))))
+        if self._engine.gyroscope is not None:  # the gyroscopic turn, too
+            ω = max(ω, float(self._engine.gyroscope.speed))
+        return search_start_step(ω, self._torques, self._t0)
 
     # ----------------------------------------------------------------- evaluation
 
@@ -595,6 +688,12 @@ class TorquedSolver:
             m[part], q[part] = self._propagation.states(flat[part])
         return m, q, τ.shape
 
+    def _principal_rate(self, m: NDArray) -> NDArray:
+        """ω = I⁻¹(M − h) in principal axes (h = 0 without wheels)."""
+        if self._wheels_principal is not None:
+            m = m - self._wheels_principal
+        return m / self._moments
+
     def _body_quaternions(self, q_principal: NDArray) -> NDArray:
         """Body → inertial quaternions (scalar first) from principal → inertial ones."""
         if self._principal_to_body is None:
@@ -608,31 +707,31 @@ class TorquedSolver:
     def states(self, t: ArrayLike) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Body-frame angular momentum (N m s) and attitude quaternions body → inertial,
         scalar first, at ``t``, from one evaluation: shapes ``np.shape(t) + (3,)``, ``+ (4,)``."""
-        if not self._torques:
+        if self._exact:
             return self._free.angular_momentum(t), self._free.attitude_quaternion(t)
         m, q, shape = self._principal_states(t)
         return self._to_body(m).reshape((*shape, 3)), self._body_quaternions(q).reshape((*shape, 4))
 
     def angular_momentum(self, t: ArrayLike) -> NDArray[np.float64]:
         """Body-frame angular momentum at ``t`` (N m s), shape ``np.shape(t) + (3,)``."""
-        if not self._torques:
+        if self._exact:
             return self._free.angular_momentum(t)
         m, _, shape = self._principal_states(t)
         return self._to_body(m).reshape((*shape, 3))
 
     def angular_velocity(self, t: ArrayLike) -> NDArray[np.float64]:
         """Body-frame angular velocity at ``t`` (rad/s), shape ``np.shape(t) + (3,)``."""
-        if not self._torques:
+        if self._exact:
             return self._free.angular_velocity(t)
         m, _, shape = self._principal_states(t)
-        return self._to_body(m / self._moments).reshape((*shape, 3))
+        return self._to_body(self._principal_rate(m)).reshape((*shape, 3))
 
     def attitude_quaternion(self, t: ArrayLike, scalar_first: bool = True) -> NDArray[np.float64]:
         """Attitude at ``t``, body → inertial, unit quaternions of shape ``np.shape(t) + (4,)``.
 
         Scalar first (w, x, y, z) by default.
         """
-        if not self._torques:
+        if self._exact:
             return self._free.attitude_quaternion(t, scalar_first)
         _, q, shape = self._principal_states(t)
         q = self._body_quaternions(q).reshape((*shape, 4))
@@ -640,7 +739,7 @@ class TorquedSolver:
 
     def attitude(self, t: ArrayLike) -> Rotation:
         """Rotation body → inertial at ``t``: one for a scalar, a stack for a 1-D array."""
-        if not self._torques:
+        if self._exact:
             return self._free.attitude(t)
         if np.ndim(t) > 1:
             raise InputError(f"t must be a scalar or a 1-D array for attitude(), got {np.shape(t)}")
@@ -662,6 +761,12 @@ class TorquedSolver:
         return self.method.order
 
     @property
+    def wheel_momentum(self) -> NDArray[np.float64] | None:
+        """The spinning wheels' momentum h, body axes (N m s), or None."""
+        h = self._wheels_principal
+        return None if h is None else np.asarray(self._to_body(h), dtype=np.float64)
+
+    @property
     def torques(self) -> tuple[Torque, ...]:
         return tuple(self._torques)
 
@@ -670,12 +775,17 @@ class TorquedSolver:
 
         Both quantities are those of the states at the grid points: the free flow
         conserves them, so a flow still owed there (see ``_Engine``) does not change them.
+        With wheels the energy is the body's, ½ ω·Iω with ω = I⁻¹(M − h), which the free
+        flow changes: it is then taken at the grid points after the owed flow.
         """
         self._propagation.extend_to(float(t_end))
         t, m, _, _ = self._propagation.arrays()
         keep = t <= t_end
-        m = m[keep]
-        return t[keep], np.linalg.norm(m, axis=-1), 0.5 * np.sum(m * m / self._moments, axis=-1)
+        t, m = t[keep], m[keep]
+        if self._wheels_principal is not None:
+            m = self._propagation.states(t)[0]
+        ω = self._principal_rate(m)
+        return t, np.linalg.norm(m, axis=-1), 0.5 * np.sum(ω * ω * self._moments, axis=-1)
 
     @property
     def steps_computed(self) -> int:
@@ -708,6 +818,7 @@ def propagate_batch(
     order: int | None = None,
     *,
     method: str | None = None,
+    wheel_momentum: ArrayLike | None = None,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """N spacecraft advanced together under the same torque models, states at ``times``.
 
@@ -720,6 +831,10 @@ def propagate_batch(
     rotations body → inertial at ``t0`` (or one, or None for the identity);
     ``times``: increasing, ≥ ``t0``, s.  The orbit is shared: spacecraft on different
     orbits are different batches.
+
+    ``wheel_momentum``: wheels spinning at constant speed relative to each body, their
+    momentum h (body axes, N m s), (3,) shared or (N, 3): gyrostats
+    (:mod:`attitude.torques.gyrostat`), whose ``angular_momentum`` is the total M = Iω + h.
 
     Returns (momentum, quaternions): body-frame momentum (T, N, 3) and attitude
     quaternions body → inertial, scalar first, (T, N, 4), at each of the T times.
@@ -748,7 +863,19 @@ def propagate_batch(
     torques = as_torque_list(torques)
     chosen = composition(4 if order is None and method is None else order, method)
     frame = PrincipalFrame(tuple(moments[..., i] for i in range(3)))
-    engine = _Engine(chosen, merged_constant_torques(torques), frame, moments)
+    gyroscope = None
+    if wheel_momentum is not None:
+        h = as_si_array(wheel_momentum, "angular_momentum", "wheel_momentum")
+        if h.shape not in ((3,), (n, 3)):
+            raise InputError(f"wheel_momentum must have shape (3,) or ({n}, 3), got {h.shape}")
+        if chosen.needs_rkn:
+            raise InputError(
+                f"method {chosen.name!r} (order {chosen.order}) keeps its order only without "
+                "a gyroscopic term; spinning wheels allow order 2 or 4"
+            )
+        h = np.broadcast_to(h, (n, 3))
+        gyroscope = Gyroscope(tuple(h[:, i] for i in range(3)), frame.moments)
+    engine = _Engine(chosen, merged_constant_torques(torques), frame, moments, gyroscope)
     breakpoints = np.array(sorted({b for t in torques for b in t.breakpoints if b > t0}))
 
     out_m = np.empty((times.size, n, 3))

@@ -1,10 +1,17 @@
-"""The propagated motion of a scenario: its segments (exact or torqued), the validity
-horizon, and what each segment's motion is.
+"""The propagated motion of a scenario: its segments (exact, torqued, or guided by an
+attitude law), the hand-off at a control loss, the validity horizon, and what each
+segment's motion is.
 
 Modules:
 
+- ``guided``: A stretch of a scenario's motion under an attitude law or a slew, seen
+  as the layers above see a segment.
+- ``handoff``: The exact hand-off: from a law's state at a control loss to the free
+  motion after it.
 - ``horizon``: How long a scenario that neglects gravity gradient holds: its validity
   horizon.
+- ``modes``: The segments of a scenario with attitude laws: guided, slewing, free,
+  torqued.
 - ``motion``: Flips, spin, precession and nutation of a trajectory, per segment, from
   the closed form.
 - ``rates``: The largest body rate of a segment, found on its motion (not on an output

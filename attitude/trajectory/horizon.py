@@ -45,10 +45,10 @@ from numpy.typing import NDArray
 from attitude.environment.timescales import offline_time
 from attitude.scenario.scenario import Scenario
 from attitude.scenario.torques import ScenarioTorques
-from attitude.torques.models import MU_EARTH_M3_S2
+from attitude.torques.models import MU_EARTH_M3_S2, GravityGradient
 from attitude.torques.solver import angles_between, first_crossing
 from attitude.trajectory.segments import Segment, segments
-from attitude.trajectory.torqued import scenario_torque_models
+from attitude.trajectory.torqued import TorquedMotion, scenario_torque_models
 from attitude.trajectory.trajectory import Trajectory, propagate
 
 __all__ = ["HORIZON_RELATIVE_ACCURACY", "ORBIT_TOLERANCE_M", "ValidityHorizon", "validity_horizon"]
@@ -136,6 +136,8 @@ def _step(trajectory: Trajectory, orbit: Any) -> float:
     scenario = trajectory.scenario
     with_orbit = scenario.with_torques(ScenarioTorques(gravity_gradient=orbit))
     gradient = scenario_torque_models(with_orbit)[0][2]
+    if not isinstance(gradient, GravityGradient):
+        raise TypeError(f"the first torque model is the gravity gradient, got {gradient!r}")
     radius = float(np.linalg.norm(gradient.position(np.array([0.0]))[0]))
     candidates.append(2.0 * math.pi * math.sqrt(radius**3 / MU_EARTH_M3_S2) * _ORBIT_FRACTION)
     return min(candidates)
@@ -169,7 +171,7 @@ def validity_horizon(trajectory: Trajectory, orbit: Any) -> ValidityHorizon:
     crossing = _first_crossing(runs, trajectory, threshold, steps)
     searched = min(crossing, scenario.stop_s)
     return ValidityHorizon(
-        threshold, crossing, searched, scenario.stop_s, max(steps), torques.order
+        threshold, crossing, searched, scenario.stop_s, max(steps, default=step), torques.order
     )
 
 
@@ -186,7 +188,11 @@ def _first_crossing(
     segment's step is appended to it."""
     earlier = 0.0
     for segment, free in zip(runs, trajectory.segments, strict=False):
-        grid = segment.solver.solver  # the TorquedSolver of a TorquedMotion
+        if not isinstance(segment.solver, TorquedMotion):
+            # A segment under a law: its attitude is the law's in both runs.
+            earlier = segment.end_s
+            continue
+        grid = segment.solver.solver
         steps.append(grid.step)
 
         def angle(t, torqued=segment.solver, free=free.solver):

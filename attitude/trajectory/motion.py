@@ -34,7 +34,10 @@ Segments without a period are stated as what they are (``SegmentMotion.motion``)
   crossing from one side of the intermediate axis to the other as the closed form
   defines a flip.  When they are not located (``attitude check`` leaves them to the
   run), ``flip_count`` is None and ``flips_note`` says why: never a count that was not
-  computed.
+  computed; ``"gyrostat"``: a body with spinning wheels and no torque, likewise;
+- ``"guided"`` and ``"slew"``: a segment under an attitude law or a slew
+  (``attitude.trajectory.guided``): the attitude is the law's, not a motion of its own;
+  no flips; its energy and momentum (I·ω) are given at its start.
 Flips are counted from the closed form without listing them all: at most
 :data:`LISTED_FLIPS` flip times are kept (a day of a fast tumbler has millions).
 
@@ -54,6 +57,7 @@ from numpy.typing import NDArray
 
 from attitude.base.vectors import basis_across
 from attitude.solver.euler_solver import EulerSolver
+from attitude.trajectory.guided import GuidedMotion
 from attitude.trajectory.rates import largest_rate
 from attitude.trajectory.torqued import TorquedMotion
 from attitude.trajectory.trajectory import Segment, Trajectory
@@ -82,7 +86,8 @@ class SegmentMotion:
     start_s: float
     end_s: float
     formula: str
-    motion: str  # "periodic", "steady spin", "separatrix", "rest" or "torqued"
+    motion: str  # "periodic", "steady spin", "separatrix", "rest", "torqued", "gyrostat",
+    # "guided" or "slew"
     period_s: float  # inf when the motion has no period
     flip_count: int | None  # None: not located (flips_note says why)
     flip_times_s: NDArray[np.float64]  # the first LISTED_FLIPS of them
@@ -182,15 +187,20 @@ def _flips(segment: Segment) -> tuple[int, NDArray[np.float64], float | None]:
 NOT_LOCATED = "not located by `attitude check`: the run locates them on its propagated motion"
 
 
-def _torqued_motion(segment: Segment, solver: TorquedMotion, locate: bool) -> SegmentMotion:
-    """A segment under torques: its state at the start, its flips located on the
-    propagated motion (when ``locate``); no period or cone."""
+def _torqued_motion(
+    segment: Segment, solver: TorquedMotion | GuidedMotion, locate: bool
+) -> SegmentMotion:
+    """A segment under torques (or with spinning wheels): its state at the start, its
+    flips located on the propagated motion (when ``locate``); no period or cone.  Under
+    a law or a slew: its state at the start, no flips (the law holds the attitude)."""
+    guided = isinstance(solver, GuidedMotion)
+    locate = locate or guided
     flips = solver.flip_times(segment.start_s, segment.end_s) if locate else np.empty(0)
     return SegmentMotion(
         start_s=segment.start_s,
         end_s=segment.end_s,
-        formula="torqued",
-        motion="torqued",
+        formula=solver.formula,
+        motion=solver.formula,
         period_s=math.inf,
         flip_count=int(flips.size) if locate else None,
         flips_note=None if locate else NOT_LOCATED,
@@ -220,7 +230,7 @@ def _with_rate(item: SegmentMotion, segment: Segment, span: tuple[float, float] 
 
 
 def _segment_motion(segment: Segment, locate: bool) -> SegmentMotion:
-    if isinstance(segment.solver, TorquedMotion):
+    if isinstance(segment.solver, TorquedMotion | GuidedMotion):
         return _torqued_motion(segment, segment.solver, locate)
     solver = _free_solver(segment)
     count, flips, flip_period = _flips(segment)

@@ -35,9 +35,12 @@ import numpy as np
 
 from attitude.base.errors import InputError
 from attitude.scenario.events import Event, State
+from attitude.scenario.modes import ModeEvent
 from attitude.scenario.scenario import Scenario
 from attitude.solver.euler_solver import EulerSolver
 from attitude.torques.models import ConstantTorque, Torque
+from attitude.trajectory.guided import GuidedMotion
+from attitude.trajectory.modes import law_initial_state, mode_segments, uses_laws
 from attitude.trajectory.torqued import TorquedMotion
 
 __all__ = ["Breakpoint", "Segment", "Where", "check_resolved", "initial_state", "segments"]
@@ -98,9 +101,9 @@ class Segment:
 
     start_s: float
     end_s: float
-    solver: EulerSolver | TorquedMotion
+    solver: EulerSolver | TorquedMotion | GuidedMotion
     state: State
-    event: Event | None = None
+    event: Event | ModeEvent | None = None
     before: State | None = None
     where: Where | None = None
     burn_key: str | None = None
@@ -143,14 +146,17 @@ class Segment:
 
 
 def initial_state(scenario: Scenario) -> State:
-    """The state at the epoch, in body axes."""
+    """The state at the epoch, in body axes (under a law, the law's there)."""
     initial = scenario.initial_state
+    if initial.law is not None:
+        return law_initial_state(scenario)
     axes = scenario.spacecraft.principal_axes
     if initial.angular_momentum is not None:
         m0 = initial.angular_momentum
     else:  # InitialState holds exactly one of the two (checked when it is made)
         assert initial.angular_velocity is not None
         m0 = axes.tensor @ initial.angular_velocity
+    assert initial.attitude is not None  # without a law, the attitude is given
     return State(initial.attitude, m0, axes)
 
 
@@ -295,6 +301,9 @@ def segments(
     Errors are :class:`InputError` whose ``key`` names the state whose motion the
     solver refuses, or the burn that spins it up (:meth:`Segment.refused`).
     """
+    if uses_laws(scenario):  # laws, slews, control losses: attitude.trajectory.modes
+        yield from _law_segments(scenario, models, step, checked)
+        return
     ends = [offset for offset, _ in scenario.events] + [scenario.stop_s]
     state = initial_state(scenario)
     per_segment: list[float | None] = (
@@ -324,3 +333,35 @@ def segments(
         if checked:
             check_resolved(segment)
         yield segment
+
+
+def _law_segments(
+    scenario: Scenario,
+    models: list[tuple[float, float, Torque, str]],
+    step: float | Sequence[float | None] | None,
+    checked: bool,
+) -> Iterator[Segment]:
+    """The segments of a scenario with laws (:func:`attitude.trajectory.modes.mode_segments`),
+    with this module's solvers for the free stretches and its checks; the walk is made
+    whole before the first is yielded (a free stretch's start is the guided one's end)."""
+    order = scenario.torques.order
+
+    def free_solver(
+        state: State, t0: float, end_s: float, where: Where, step: float | None
+    ) -> EulerSolver | TorquedMotion:
+        return _solver(state, t0, end_s, where, _acting(models, t0, end_s), step, order)
+
+    def make(raw: tuple, where: Where) -> Segment:
+        start_s, end_s, solver, state, event, before = raw
+        # Under a law its controller takes the burns: they spin up free bodies only.
+        burn = (
+            None
+            if isinstance(solver, GuidedMotion)
+            else _strongest_burn(_acting(models, start_s, end_s), start_s, end_s)
+        )
+        segment = Segment(start_s, end_s, solver, state, event, before, where, burn)
+        if checked:
+            check_resolved(segment)
+        return segment
+
+    yield from mode_segments(scenario, models, step, free_solver, make, Where)

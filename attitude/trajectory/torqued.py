@@ -18,7 +18,7 @@ they need not care which one propagated it:
   for is a bound on the body rate (|ω| ≤ G/I_min, |ω|² ≤ 2T/I_min), so here they are
   the **largest** |m| and T over the segment: the largest at the solver's grid points
   plus twice the largest change between two of them (both change smoothly, by at most
-  |τ| h over a step);
+  |Γ| h over a step);
 - ``error_estimate``: the run's estimated attitude error within the segment (rad),
   errors carried from earlier segments included, set by the trajectory.
 
@@ -148,8 +148,11 @@ class TorquedMotion:
     """One segment [t0, end_s] under ``torques`` (models), from ``state`` at ``t0``, by
     splitting at ``step`` (s) with the method of ``order``.
 
-    Times within a nanosecond before ``t0`` (which the trajectory counts as ``t0``) are
-    evaluated at ``t0``.
+    ``wheel_momentum``: wheels spinning at constant speed relative to the body, their
+    momentum h (body axes, N m s): a gyrostat (:mod:`attitude.torques.gyrostat`), whose
+    ``state.angular_momentum`` is the total M = Iω + h (``formula`` ``"gyrostat"``
+    without torques).  Times within a nanosecond before ``t0`` (which the trajectory
+    counts as ``t0``) are evaluated at ``t0``.
     """
 
     formula = "torqued"
@@ -163,8 +166,12 @@ class TorquedMotion:
         torques: list[Torque],
         step: float,
         order: int,
+        wheel_momentum: NDArray[np.float64] | None = None,
     ) -> None:
         self.state = state
+        self.wheel_momentum = wheel_momentum
+        # Spinning wheels alone: the torque-free gyrostat (attitude.torques.gyrostat).
+        self.formula = "gyrostat" if wheel_momentum is not None and not torques else "torqued"
         self.end_s = float(end_s)
         self.torques = tuple(torques)
         self.order = int(order)
@@ -176,6 +183,7 @@ class TorquedMotion:
             list(torques),
             step=step,
             order=order,
+            wheel_momentum=wheel_momentum,
         )
         # The run's estimated error within this segment (attitude.trajectory.steps).
         self.error_estimate: float | None = None
@@ -207,7 +215,10 @@ class TorquedMotion:
 
     def angular_velocity(self, t: ArrayLike) -> NDArray[np.float64]:
         m = self._states(t)[0]
-        return np.linalg.solve(self.state.inertia.tensor, m[..., None])[..., 0]
+        if self.wheel_momentum is not None:  # a gyrostat: ω = I⁻¹(M − h)
+            m = m - self.wheel_momentum
+        ω = np.linalg.solve(self.state.inertia.tensor, m[..., None])[..., 0]
+        return ω.astype(np.float64, copy=False)
 
     def inertial_angular_momentum_at(self, t: ArrayLike) -> NDArray[np.float64]:
         """R(t) m(t), N m s, inertial axes: it changes under the torques."""
@@ -219,8 +230,11 @@ class TorquedMotion:
         )
 
     def kinetic_energy_at(self, t: ArrayLike) -> NDArray[np.float64]:
-        """½ m(t)·ω(t), J."""
-        return 0.5 * np.sum(self.angular_momentum(t) * self.angular_velocity(t), axis=-1)
+        """½ ω(t)·Iω(t), J: ½ m·ω, the body's with spinning wheels (m − h = Iω)."""
+        m = self.angular_momentum(t)
+        if self.wheel_momentum is not None:
+            m = m - self.wheel_momentum
+        return 0.5 * np.sum(m * self.angular_velocity(t), axis=-1)
 
     def principal_momentum(self, t: ArrayLike) -> NDArray[np.float64]:
         """The body momentum at ``t`` in principal axes (N m s), the order of
@@ -288,16 +302,17 @@ class TorquedMotion:
             t = self.t0 + spacing * np.arange(first, stop, dtype=np.float64)
             if stop == count:
                 t[-1] = self.end_s
-            m = self.principal_momentum(t)
-            chunk = (t, m, self.angular_velocity(t))
+            m, ω = self.principal_momentum(t), self.angular_velocity(t)
+            chunk = (t, m, ω)
             if count <= _SURVEY_KEPT:
-                kept.append(chunk if first == 0 else tuple(a[2:] for a in chunk))
+                kept.append(chunk if first == 0 else (t[2:], m[2:], ω[2:]))
             yield chunk
             if stop == count:
                 break
             first = stop - 2
         if kept:
-            self._survey = tuple(np.concatenate(parts) for parts in zip(*kept, strict=True))
+            times, momenta, rates = (np.concatenate(parts) for parts in zip(*kept, strict=True))
+            self._survey = (times, momenta, rates)
 
     def flip_times(self, t_start: float, t_end: float) -> NDArray[np.float64]:
         """The flips in [t_start, t_end] on the propagated motion (TT s): the times at
@@ -376,6 +391,9 @@ class TorquedMotion:
 
     @property
     def initial_kinetic_energy(self) -> float:
+        if self.wheel_momentum is not None:
+            ω = self.angular_velocity(np.array([self.t0, self.t0]))[0]
+            return 0.5 * float(ω @ self.state.inertia.tensor @ ω)
         return self.state.kinetic_energy
 
     @property

@@ -25,6 +25,7 @@ from scipy.spatial.transform import Rotation
 from attitude.base.errors import InputError
 from attitude.environment.timescales import SAME_INSTANT_S, tt_seconds
 from attitude.scenario.scenario import Scenario
+from attitude.trajectory.guided import GuidedMotion
 from attitude.trajectory.segments import Breakpoint, Segment, segments
 from attitude.trajectory.steps import (
     CHECK_BUDGET_S,
@@ -224,7 +225,7 @@ class Trajectory:
         """Angular momentum in inertial axes, N m s (constant within a torque-free segment)."""
 
         def evaluate(solver, τ):
-            if isinstance(solver, TorquedMotion):
+            if isinstance(solver, TorquedMotion | GuidedMotion):
                 return solver.inertial_angular_momentum_at(τ)
             return np.tile(solver.inertial_angular_momentum, (τ.size, 1))
 
@@ -234,7 +235,7 @@ class Trajectory:
         """Rotational kinetic energy, J (constant within a torque-free segment)."""
 
         def evaluate(solver, τ):
-            if isinstance(solver, TorquedMotion):
+            if isinstance(solver, TorquedMotion | GuidedMotion):
                 return solver.kinetic_energy_at(τ)[:, None]
             return np.full((τ.size, 1), solver.kinetic_energy)
 
