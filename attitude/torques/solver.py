@@ -131,9 +131,11 @@ class _Engine:
         self.kicks = [j for j, b in enumerate(method.kicks) if b != 0.0]
         self.flows = 0  # free-flow calls made (for benchmarks)
         self.unit_batch: UnitBatch | None = None  # the batch's free flow (see flow)
-        # One spacecraft under gravity gradient alone: steps by the compiled loop.
+        # One rigid spacecraft under gravity gradient alone: steps by the compiled loop
+        # (which has no gyroscopic flow: spinning wheels take the Python loop).
         self.compiled = (
             self.moment_floats is not None
+            and gyroscope is None
             and len(torques) == 1
             and isinstance(torques[0], GravityGradient)
         )
