@@ -39,6 +39,17 @@ _FIRST_WORDS_S = 2.0
 
 _OVERHEAD_PROBES = 40
 
+# What a worker imports before its first sample: with a fork server (below), once for
+# every worker.
+WORKER_MODULES = (
+    "distributed",
+    "numpy",
+    "astropy.time",
+    "astropy.utils.iers",
+    "attitude.montecarlo.plan",
+    "attitude.pointing.search",
+)
+
 
 def _noop(index: int) -> int:
     return index
@@ -237,13 +248,17 @@ def _read_some(connection: socket.socket, timeout_s: float, enough: int = 256) -
 
 @contextlib.contextmanager
 def connect(
-    scheduler: str | None = None, workers: int | None = None, probed: bool = False
+    scheduler: str | None = None,
+    workers: int | None = None,
+    probed: bool = False,
+    preload: tuple[str, ...] = WORKER_MODULES,
 ) -> Iterator[Any]:
     """A ``distributed.Client``: to the scheduler at ``scheduler``, or to a local cluster
     of ``workers`` processes (default: every core), one thread each, on 127.0.0.1,
     closed on exit (with its processes and ports) whatever ends the block.
     ``probed``: the caller has already checked the options and the scheduler's address
-    (:func:`check_where`)."""
+    (:func:`check_where`); ``preload``: the modules a local worker imports before its
+    first task (:func:`_forked_workers`)."""
     import logging
 
     from distributed import Client, LocalCluster
@@ -263,7 +278,10 @@ def connect(
             with held_signals():
                 client.close()
         return
-    with tempfile.TemporaryDirectory(prefix="attitude-dask-") as scratch:
+    with (
+        tempfile.TemporaryDirectory(prefix="attitude-dask-") as scratch,
+        _forked_workers(preload),
+    ):
         received: list[int] = []
         with _start_deferring_stops(received):
             cluster = LocalCluster(
@@ -287,6 +305,40 @@ def connect(
         finally:
             with held_signals():
                 cluster.close()
+
+
+@contextlib.contextmanager
+def _forked_workers(modules: tuple[str, ...]) -> Iterator[None]:
+    """Local worker processes forked from one fork server that has imported ``modules``
+    (multiprocessing's "forkserver" start method, Dask's
+    ``distributed.worker.multiprocessing-method``), instead of each started afresh
+    (Dask's default, "spawn"), which imports Dask and the package again in every
+    worker: about 1 s of CPU a worker.  The server is started with the cluster (inside
+    :func:`_start_deferring_stops`: it holds SIGINT blocked, as the workers do) and
+    stopped with it.  Where there is no fork server (Windows), workers are spawned."""
+    import multiprocessing
+
+    if "forkserver" not in multiprocessing.get_all_start_methods():
+        yield
+        return
+    import dask
+    from distributed.utils import get_mp_context
+
+    with dask.config.set({"distributed.worker.multiprocessing-method": "forkserver"}):
+        get_mp_context().set_forkserver_preload(list(modules))
+        try:
+            yield
+        finally:
+            _stop_fork_server()
+
+
+def _stop_fork_server() -> None:
+    """End multiprocessing's fork server (it would otherwise live as long as this
+    process: the cluster leaves no process behind); the next use starts another."""
+    from multiprocessing import forkserver
+
+    with contextlib.suppress(Exception):  # a private method: absent, the server stays
+        forkserver._forkserver._stop()  # type: ignore[attr-defined]
 
 
 def task_overhead_s(client) -> float:

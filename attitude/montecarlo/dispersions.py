@@ -195,6 +195,12 @@ class Dispersions:
     # Nominal values, SI (from the loaded scenario, as the reader computed them).
     nominal: dict[str, Any] = field(default_factory=dict, repr=False)
 
+    def distributions(self) -> list[Distribution]:
+        """Every distribution the draws use."""
+        found = [self.moments, self.axes, self.attitude, self.rate, self.tle_epoch]
+        found += [d for e in self.events for d in (e.time, e.magnitude, e.direction)]
+        return [d for d in found if d is not None]
+
     def parameter_names(self) -> list[str]:
         """The table's columns for the drawn parameters, in the order drawn."""
         names = []

@@ -312,10 +312,12 @@ def _plot_histograms(result: MonteCarloResult, names, stats, path: Path) -> str:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
+    from attitude.report.plots import PNG_OPTIONS
+
     ok = result.table[result.table["status"] == "ok"]
     columns = min(4, len(names))
     rows = math.ceil(len(names) / columns)
-    figure = Figure(figsize=(3.4 * columns, 2.7 * rows + 0.5), layout="constrained")
+    figure = _grid_figure(Figure, columns, rows, 3.4, 2.7, left_in=0.55)
     panels = np.atleast_1d(figure.subplots(rows, columns, squeeze=False).ravel())
     for axes, name in zip(panels, names, strict=False):
         values = drawn_spread(ok[name].to_numpy(float), stated_precision(name, result.plan, ok))
@@ -336,15 +338,43 @@ def _plot_histograms(result: MonteCarloResult, names, stats, path: Path) -> str:
         f"{len(ok)} samples: percentiles 1, 50, 99 (black), nominal (red)", fontsize="medium"
     )
     FigureCanvasAgg(figure)
-    figure.savefig(path, dpi=100)
+    figure.savefig(path, dpi=100, **PNG_OPTIONS)
     return path.name
+
+
+def _grid_figure(
+    figure_class,
+    columns: int,
+    rows: int,
+    width_in: float,
+    height_in: float,
+    left_in: float,
+    bottom_in: float = 0.35,
+):
+    """A figure for ``rows`` × ``columns`` panels of ``width_in`` × ``height_in`` each
+    (with their labels), a title above, fixed margins in inches: a layout engine
+    (constrained) measures every text and draws twice, most of a figure's time."""
+    width, height = width_in * columns, height_in * rows + 0.6
+    figure = figure_class(figsize=(width, height))
+    gap_x, gap_y = 0.55, 0.5  # between panels: tick labels, the next panel's title
+    axes_w = (width - left_in - 0.15 - gap_x * (columns - 1)) / columns
+    axes_h = (height - bottom_in - 0.7 - gap_y * (rows - 1)) / rows
+    figure.subplots_adjust(
+        left=left_in / width,
+        right=1.0 - 0.15 / width,
+        bottom=bottom_in / height,
+        top=1.0 - 0.7 / height,
+        wspace=gap_x / axes_w,
+        hspace=gap_y / axes_h,
+    )
+    return figure
 
 
 def _plot_envelopes(result: MonteCarloResult, path: Path) -> str:
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    from attitude.report.plots import time_axis
+    from attitude.report.plots import PNG_OPTIONS, time_axis
 
     envelope = result.envelope
     values = envelope.percentiles_deg(PERCENTILES)  # (p, vectors, 2, bins)
@@ -354,7 +384,7 @@ def _plot_envelopes(result: MonteCarloResult, path: Path) -> str:
         v.name: v.sun_exclusion_half_angle_deg for v in result.plan.loaded.pointing.body_vectors
     }
     count = len(envelope.vectors)
-    figure = Figure(figsize=(9.0, 2.8 * count + 0.6), layout="constrained")
+    figure = _grid_figure(Figure, 1, count, 9.0, 2.8, left_in=0.7, bottom_in=0.5)
     panels = figure.subplots(count, 1, squeeze=False)[:, 0]
     ran = int((result.table["status"] == "ok").sum())
     for v, (axes, name) in enumerate(zip(panels, envelope.vectors, strict=True)):
@@ -365,7 +395,7 @@ def _plot_envelopes(result: MonteCarloResult, path: Path) -> str:
         fontsize="medium",
     )
     FigureCanvasAgg(figure)
-    figure.savefig(path, dpi=100)
+    figure.savefig(path, dpi=100, **PNG_OPTIONS)
     return path.name
 
 

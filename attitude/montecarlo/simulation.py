@@ -46,7 +46,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from attitude.base.errors import InputError
-from attitude.montecarlo.cluster import check_where, check_workers, connect, task_overhead_s
+from attitude.montecarlo.cluster import (
+    WORKER_MODULES,
+    check_where,
+    check_workers,
+    connect,
+    task_overhead_s,
+)
 from attitude.montecarlo.dispersions import draw_sample
 from attitude.montecarlo.metrics import (
     ANGLE_STEP_DEG,
@@ -182,7 +188,10 @@ def simulate(
     job = Job.of(mc)
     if scheduler is None:
         stage(f"starting a local Dask cluster of {count} worker processes")
-    with connect(scheduler, workers, probed=True) as client:
+    # scipy.stats draws the truncated laws: imported once for every worker, when used.
+    truncated = any(d.kind == "truncated_normal" for d in mc.dispersions.distributions())
+    preload = WORKER_MODULES + (("scipy.stats",) if truncated else ())
+    with connect(scheduler, workers, probed=True, preload=preload) as client:
         threads = check_workers(client)
         overhead = task_overhead_s(client)
         size = batch_size or choose_batch_size(mc.samples, threads, sample_s, overhead)

@@ -54,21 +54,35 @@ def order_statistic_rank(
     quantile from above with that confidence, for the largest such r (the tightest
     bound); (None, the confidence of the largest sample) if even r = 1 falls short.
     By symmetry the r-th smallest bounds the 1 − coverage quantile from below."""
-    from scipy.stats import binom
-
+    sf, ppf = _binomial_sf_ppf()
     tail = 1.0 - coverage
     if n < 1:
         return None, 0.0
-    if binom.sf(0, n, tail) < confidence:
-        return None, float(binom.sf(0, n, tail))
+    if sf(0, n, tail) < confidence:
+        return None, float(sf(0, n, tail))
     # sf(r - 1) = P(B ≥ r) falls as r grows: the first k with cdf(k) > 1 − confidence
     # fails, so r = k is the last that holds (checked on either side for rounding).
-    r = max(1, int(binom.ppf(1.0 - confidence, n, tail)))
-    while r > 1 and binom.sf(r - 1, n, tail) < confidence:
+    r = max(1, int(ppf(1.0 - confidence, n, tail)))
+    while r > 1 and sf(r - 1, n, tail) < confidence:
         r -= 1
-    while r < n and binom.sf(r, n, tail) >= confidence:
+    while r < n and sf(r, n, tail) >= confidence:
         r += 1
-    return r, float(binom.sf(r - 1, n, tail))
+    return r, float(sf(r - 1, n, tail))
+
+
+def _binomial_sf_ppf() -> tuple[Any, Any]:
+    """The binomial law's survival function and quantile (k, n, p): the ufuncs that
+    ``scipy.stats.binom`` evaluates (Boost's), taken from scipy.special without
+    importing scipy.stats (about 1 s of a job's start); ``binom`` itself where a scipy
+    does not have them."""
+    try:
+        from scipy.special import _ufuncs
+
+        return _ufuncs._binom_sf, _ufuncs._binom_ppf
+    except (ImportError, AttributeError):  # another scipy
+        from scipy.stats import binom
+
+        return binom.sf, binom.ppf
 
 
 def _ordinal(r: int) -> str:

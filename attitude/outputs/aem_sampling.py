@@ -125,7 +125,15 @@ def _peaks(degree: int) -> NDArray[np.float64]:
 # PEAKS[d][j]: where the interpolation error of degree d peaks in the window's interval
 # j (the error of a polynomial through smooth data is f^(d+1)(ξ)/(d+1)! times the node
 # polynomial, whose extremum this is): ½ in the centred interval, off-centre at the ends.
-PEAKS = {degree: _peaks(degree) for degree in range(1, INTERPOLATION_DEGREE + 1)}
+class _Peaks(dict):
+    """PEAKS, each degree computed when first asked for (not at import: 30 ms)."""
+
+    def __missing__(self, degree: int) -> NDArray[np.float64]:
+        self[degree] = peaks = _peaks(degree)
+        return peaks
+
+
+PEAKS: dict[int, NDArray[np.float64]] = _Peaks()
 
 
 @dataclass(frozen=True)

@@ -137,6 +137,21 @@ def trajectory_columns(samples: Samples) -> list[Column]:
     ]
 
 
+def arrow_numbers(values: NDArray, kind: Any = None) -> Any:
+    """A numeric numpy array as an Arrow array of ``kind`` (float64 when None; any
+    integer type, or a timestamp of int64 ``values``).
+
+    Wrapped from the array's own buffer: ``pa.array`` would do the same, but its first
+    call imports pandas (0.3 s) to ask whether the array is a pandas object.
+    """
+    import pyarrow as pa
+
+    kind = pa.float64() if kind is None else kind
+    dtype = np.float64 if pa.types.is_floating(kind) else np.dtype(f"int{kind.bit_width}")
+    values = np.ascontiguousarray(values, dtype=dtype)
+    return pa.Array.from_buffers(kind, values.size, [None, pa.py_buffer(values)])
+
+
 def arrow_texts(epochs: NDArray) -> Any:
     """ASCII texts (numpy ``S`` or ``U`` arrays) as an Arrow string array; ``S`` arrays
     (:class:`attitude.environment.epoch_texts.EpochTexts`) are wrapped without a copy."""
@@ -184,7 +199,7 @@ class CsvWriter:
         elif names != self._names:
             raise ValueError(f"{self.path.name}: the columns changed between chunks")
         arrays = [arrow_texts(epochs)]
-        arrays += [pa.array(np.asarray(c.values, dtype=np.float64)) for c in columns]
+        arrays += [arrow_numbers(c.values) for c in columns]
         table = pa.Table.from_arrays(arrays, names=[self.time_label, *names])
         if self._writer is None:
             options = pa_csv.WriteOptions(include_header=False, quoting_style="none")

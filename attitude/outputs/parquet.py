@@ -42,7 +42,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from attitude.base.errors import InputError
-from attitude.outputs.csv import Column, arrow_texts
+from attitude.outputs.csv import Column, arrow_numbers, arrow_texts
 
 __all__ = [
     "MAX_SPAN_S",
@@ -177,13 +177,15 @@ class ParquetWriter:
             if item.name == self.time_label:
                 arrays.append(arrow_texts(epochs))
             elif item.name == "tt_ns":
-                arrays.append(pa.array(_nanoseconds(seconds)))
+                arrays.append(arrow_numbers(_nanoseconds(seconds), item.type))
             elif item.name == "timestamp_tt" and self._epoch_ns is not None:
-                arrays.append(pa.array(_timestamps(self._epoch_ns, seconds, self._unit), item.type))
+                arrays.append(
+                    arrow_numbers(_timestamps(self._epoch_ns, seconds, self._unit), item.type)
+                )
             elif item.name == "segment":
-                arrays.append(pa.array(np.asarray(by_name["segment"]).astype(np.int32)))
+                arrays.append(arrow_numbers(by_name["segment"], item.type))
             else:
-                arrays.append(pa.array(np.asarray(by_name[item.name], dtype=np.float64)))
+                arrays.append(arrow_numbers(by_name[item.name], item.type))
         self._writer.write_table(pa.Table.from_arrays(arrays, schema=self._schema))
 
     def close(self) -> None:

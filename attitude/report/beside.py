@@ -1,9 +1,9 @@
 """One computation in a forked process beside the run, on the machine's other core.
 
 A report's validity horizon (:func:`attitude.trajectory.horizon.validity_horizon`: the scenario
-propagated again under gravity gradient, 20 000 splitting steps of exact free flows)
-takes as long as the rest of a one-day run and needs none of it; it is a few numbers
-to the summary at the end.  :class:`Beside` computes such a function in a child
+propagated again under gravity gradient over the span, splitting steps of exact free
+flows) takes a fifth of a one-day run's CPU and needs none of the rest; it is a few
+numbers to the summary at the end.  :class:`Beside` computes such a function in a child
 process made by ``fork`` (nothing to import again, nothing to send but the result)
 while the parent streams the outputs, and hands the result, or the exception the
 function raised, back through a pipe (pickled) when it is asked for.
@@ -26,6 +26,7 @@ does not exist, the function runs in the parent when its result is asked for.
 from __future__ import annotations
 
 import contextlib
+import gc
 import os
 import pickle
 import signal
@@ -63,9 +64,14 @@ class Beside(Generic[T]):
         sys.stderr.flush()
         # No signal between the fork and the child's default handlers: blocked meanwhile.
         blocked = signal.pthread_sigmask(signal.SIG_BLOCK, STOPPING)
+        # The parent's objects out of the garbage collector's reach in the child: its
+        # collections would otherwise write into every one of them and copy every page
+        # they share with the parent (0.15 s of CPU for a run's horizon).
+        gc.freeze()
         try:
             pid = os.fork()
         except OSError:
+            gc.unfreeze()
             signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
             os.close(read)
             os.close(write)
@@ -79,6 +85,7 @@ class Beside(Generic[T]):
                 _send(write, _outcome(self._function, self._args))
             finally:
                 os._exit(0)
+        gc.unfreeze()
         signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
         os.close(write)
         self._pid, self._read = pid, read

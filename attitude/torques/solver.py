@@ -134,6 +134,14 @@ class _Engine:
         self.kicks = [j for j, b in enumerate(method.kicks) if b != 0.0]
         self.flows = 0  # free-flow calls made (for benchmarks)
         self.unit_batch: UnitBatch | None = None  # the batch's free flow (see flow)
+        # One rigid spacecraft under gravity gradient alone: steps by the compiled loop
+        # (which has no gyroscopic flow: spinning wheels take the Python loop).
+        self.compiled = (
+            self.moment_floats is not None
+            and gyroscope is None
+            and len(torques) == 1
+            and isinstance(torques[0], GravityGradient)
+        )
 
     # ---- the two maps
 
@@ -195,6 +203,31 @@ class _Engine:
         return gyroscope.turn(m, q, 0.5 * w)
 
     # ---- one step
+
+    def compiled_steps(self, m, q, pending, sizes, data, largest, out_m, out_q, out_p) -> int:
+        """Steps of ``sizes`` from (m, q, pending) by the compiled loop
+        (:mod:`attitude.torques.compiled_steps`) into the ``out_*`` rows, stopping before
+        a state beyond ``largest`` (|m1| + |m2| + |m3|, N m s); the number done (0 when
+        this engine has no compiled loop)."""
+        if not self.compiled:
+            return 0
+        from attitude.torques.compiled_steps import gravity_gradient_steps
+
+        method = self.method
+        done = gravity_gradient_steps(
+            np.asarray(method.flows, dtype=np.float64),
+            np.asarray(method.kicks, dtype=np.float64),
+            np.asarray(self.moment_floats, dtype=np.float64),
+            np.array([*m, *q, pending], dtype=np.float64),
+            np.ascontiguousarray(sizes, dtype=np.float64),
+            np.ascontiguousarray(data[0], dtype=np.float64),
+            float(largest),
+            out_m,
+            out_q,
+            out_p,
+        )
+        self.flows += int(done) * sum(1 for b in method.kicks if b != 0.0)
+        return int(done)
 
     def step(self, m, q, pending, h, data_by_kick):
         """One step of size h (float or array); data_by_kick[j]: per torque, its row."""
@@ -455,12 +488,17 @@ class _Propagation:
             starts, sizes = _grid_steps(
                 self.t_end, t_max, self.step, self.breakpoints, _CHUNK_STEPS
             )
-            data = [d.tolist() for d in e.time_data(starts, sizes)]
+            arrays = e.time_data(starts, sizes)
             m, q, pending = self._state
             K = len(starts)
             out_m, out_q, out_p = np.empty((K, 3)), np.empty((K, 4)), np.empty(K)
             largest = largest_momentum(e.moments, float(starts[-1] + sizes[-1]))
-            for k in range(K):
+            done = e.compiled_steps(m, q, pending, sizes, arrays, largest, out_m, out_q, out_p)
+            if done:
+                m, q = tuple(out_m[done - 1].tolist()), tuple(out_q[done - 1].tolist())
+                pending = float(out_p[done - 1])
+            data = [d.tolist() for d in arrays] if done < K else []
+            for k in range(done, K):
                 m, q, pending = e.step(m, q, pending, float(sizes[k]), e.rows_for_step(data, k))
                 norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
                 if not (abs(m[0]) + abs(m[1]) + abs(m[2]) <= largest and norm > 0.0):

@@ -6,54 +6,77 @@ Earth.  Its validity horizon is the time until that neglected torque would have 
 the attitude by a threshold (1° by default, ``[torques] horizon_threshold``): the same
 scenario (the same events, the same burns) is propagated under gravity gradient too
 (``attitude.trajectory.torqued``) alongside the scenario's own trajectory, their
-attitudes are compared every step, and the first crossing is refined by bisection to
-a millisecond (:func:`attitude.torques.solver.first_crossing`, which
-``departure_time`` uses for one solver).  An attitude reset puts both on the same
-attitude again; the horizon is the first crossing.  With burns, both runs are
-splittings at the scenario's step (or accuracy): the comparison also holds their
-difference in splitting error, at most the sum of their errors, which the summary
-states beside it.
+attitudes are compared at every step of that run, over the whole span, a block of
+steps at a time, and the first crossing is refined by bisection to a millisecond
+(:func:`attitude.torques.solver.first_crossing`, which ``departure_time`` uses for one
+solver); the run goes no further than the block of the crossing.  An attitude reset
+puts both on the same attitude again; the horizon is the first crossing.  With burns,
+both runs are splittings at the scenario's step (or accuracy): the comparison also
+holds their difference in splitting error, at most the sum of their errors, which the
+summary states beside it.
 
-The torqued run uses the scenario's ``[torques]`` step or accuracy and order when it
-states one; otherwise order 4 at a step of a fifth of the body's fastest turn (at the
-bound √(2T/I_min) of its rate), at most a fortieth of the orbit period: a degree needs
-far less accuracy than the splitting gives there (docs/torques.md, "The scenario
-route", measures the horizon against a run at a quarter of that step).  The
-search covers the span, but at most :data:`MAX_HORIZON_STEPS` steps of that run: when
-the span is longer, the horizon is stated as beyond the time searched.
+The accuracy is that of an estimate, stated with it: :data:`HORIZON_RELATIVE_ACCURACY`
+of the horizon.  The run alongside uses the scenario's ``[torques]`` step or accuracy
+and order when it states one; otherwise order 4 at a step of a fifth of the body's
+fastest turn (at the bound √(2T/I_min) of its rate), at most a fortieth of the orbit
+period, where its own error is far below the threshold (1e-8 rad over the one-day
+spinner, against a run at an eighth of that step; docs/torques.md measures the
+tumbler's horizon at a quarter of the step).  What limits the estimate is the
+sampling: the angle between the runs wobbles within a turn, and a peak between two
+steps can cross first; the time the angle takes to grow by that wobble is 6e-4 of
+the horizon on the spinner of ``tests/test_validity_horizon_against_dop853.py`` (a
+crossing after 31 550 s, 28 000 steps), 4e-6 on its tumbler.  The orbit's position is
+interpolated (cubic Hermite, checked against the orbit within
+:data:`ORBIT_TOLERANCE_M`), and with gravity gradient as its only torque the run
+takes the compiled splitting loop (:mod:`attitude.torques.compiled_steps`): the whole
+day of a 5 rpm spinner (43 000 steps) costs about 0.3 s of CPU.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
+from attitude.environment.timescales import offline_time
 from attitude.scenario.scenario import Scenario
 from attitude.scenario.torques import ScenarioTorques
 from attitude.torques.models import MU_EARTH_M3_S2, GravityGradient
 from attitude.torques.solver import angles_between, first_crossing
-from attitude.trajectory.torqued import scenario_torque_models
+from attitude.trajectory.segments import Segment, segments
+from attitude.trajectory.torqued import TorquedMotion, scenario_torque_models
 from attitude.trajectory.trajectory import Trajectory, propagate
 
-__all__ = ["MAX_HORIZON_STEPS", "ValidityHorizon", "validity_horizon"]
+__all__ = ["HORIZON_RELATIVE_ACCURACY", "ORBIT_TOLERANCE_M", "ValidityHorizon", "validity_horizon"]
 
-# The torqued run alongside costs about 8 free flows a step: 20,000 steps are ~1.5 s of
-# CPU for the one-day 5 rpm spinner with the compiled free flow (docs/torques.md).
-MAX_HORIZON_STEPS = 20_000
+# The horizon is an estimate to this fraction of itself (module docstring).
+HORIZON_RELATIVE_ACCURACY = 1e-3
+
 _TURN_FRACTION = 0.2
 _ORBIT_FRACTION = 1.0 / 40.0
+# The orbit's position is interpolated (cubic Hermite on its positions and velocities)
+# between nodes at most this far apart (s), closer if needed to keep the interpolation
+# within ORBIT_TOLERANCE_M (m), checked at the middle of the intervals: 0.1 m is 1.5e-8
+# of a low orbit's radius, a change of the torque's direction far below what a 1°
+# threshold can see, and of the order of the orbit's own roughness (a TLE's TEME → GCRS
+# rotation, interpolated between hourly nodes, moves it by centimetres).
+_ORBIT_NODES_S = 60.0
+ORBIT_TOLERANCE_M = 0.1
+# The run alongside is compared with the scenario's this many of its steps at a time.
+_BLOCK_STEPS = 2048
 
 
 @dataclass(frozen=True)
 class ValidityHorizon:
     """When the neglected gravity gradient moves the attitude by ``threshold_rad``.
 
-    ``horizon_s``: TT seconds after the epoch, or ``math.inf`` if not within
-    ``searched_s`` (the span, or less when the search was capped); ``step_s``,
-    ``order``: the torqued run alongside.
+    ``horizon_s``: TT seconds after the epoch (to :data:`HORIZON_RELATIVE_ACCURACY`),
+    or ``math.inf`` beyond the span; ``searched_s``: how far the comparison went (the
+    crossing, or the whole span); ``step_s``, ``order``: the torqued run alongside.
     """
 
     threshold_rad: float
@@ -73,18 +96,13 @@ class ValidityHorizon:
         if self.within_span:
             return (
                 f"the neglected gravity gradient moves the attitude by {angle} after "
-                f"{self.horizon_s:.6g} s, at {format_epoch(self.horizon_s)}: the motion without it "
-                "is valid until then"
-            )
-        if self.searched_s >= self.span_s:
-            return (
-                f"the neglected gravity gradient moves the attitude by less than {angle} "
-                f"over the whole span ({self.span_s:g} s): the horizon is beyond the span"
+                f"{self.horizon_s:.6g} s, at {format_epoch(self.horizon_s)} (to "
+                f"{100.0 * HORIZON_RELATIVE_ACCURACY:g} %): the motion without it is valid "
+                "until then"
             )
         return (
-            f"the neglected gravity gradient moves the attitude by less than {angle} over "
-            f"the first {self.searched_s:.6g} s searched (of {self.span_s:g} s): the horizon "
-            f"is beyond {format_epoch(self.searched_s)}"
+            f"the neglected gravity gradient moves the attitude by less than {angle} "
+            f"over the whole span ({self.span_s:g} s): the horizon is beyond the span"
         )
 
     def as_dict(self, format_epoch) -> dict[str, Any]:
@@ -92,7 +110,8 @@ class ValidityHorizon:
             "threshold_deg": math.degrees(self.threshold_rad),
             "horizon_s": self.horizon_s if self.within_span else None,
             "horizon": format_epoch(self.horizon_s) if self.within_span else None,
-            "beyond_span": not self.within_span and self.searched_s >= self.span_s,
+            "relative_accuracy": HORIZON_RELATIVE_ACCURACY,
+            "beyond_span": not self.within_span,
             "searched_s": self.searched_s,
             "torqued_run": {
                 "model": "gravity gradient (point-mass Earth)",
@@ -133,38 +152,113 @@ def validity_horizon(trajectory: Trajectory, orbit: Any) -> ValidityHorizon:
     threshold = settings.horizon_threshold
     given = settings.step is not None or settings.accuracy is not None
     step = settings.step if settings.step is not None else _step(trajectory, orbit)
-    searched = min(scenario.stop_s, MAX_HORIZON_STEPS * step)
     torques = ScenarioTorques(
-        gravity_gradient=orbit,
+        gravity_gradient=_interpolated(orbit, scenario),
         burns=settings.burns,
         step=step if not given or settings.step is not None else None,
         accuracy=settings.accuracy,
         order=settings.order if given else 4,
         horizon_threshold=threshold,
     )
-    torqued = propagate(_truncated(scenario, searched).with_torques(torques))
-    # (Segments under a law have no step: their attitude is the law's in both runs.)
-    run_step = max(s.solver.step for s in torqued.segments if hasattr(s.solver, "step"))
-
-    def angle(t):
-        return angles_between(torqued.attitude_quaternion(t), trajectory.attitude_quaternion(t))
-
-    crossing = first_crossing(angle, 0.0, searched, run_step, threshold)
-    return ValidityHorizon(threshold, crossing, searched, scenario.stop_s, run_step, torques.order)
-
-
-def _truncated(scenario: Scenario, stop_s: float) -> Scenario:
-    """``scenario`` over [epoch, stop_s] only (its events up to there)."""
-    if stop_s >= scenario.stop_s:
-        return scenario
-    events = [event for offset, event in scenario.events if offset <= stop_s]
-    return Scenario(
-        scenario.name,
-        scenario.spacecraft,
-        scenario.epoch,
-        scenario.initial_state,
-        events,
-        duration=stop_s,
-        torques=scenario.torques,
-        orbit=getattr(scenario, "orbit", None),
+    alongside = scenario.with_torques(torques)
+    if torques.step is not None:  # built segment by segment, as far as the comparison goes
+        runs: Iterable[Segment] = segments(
+            alongside, scenario_torque_models(alongside), torques.step, checked=False
+        )
+    else:  # the step the scenario's accuracy needs: the run-level search, over the span
+        runs = propagate(alongside).segments
+    steps: list[float] = []
+    crossing = _first_crossing(runs, trajectory, threshold, steps)
+    searched = min(crossing, scenario.stop_s)
+    return ValidityHorizon(
+        threshold, crossing, searched, scenario.stop_s, max(steps, default=step), torques.order
     )
+
+
+def _first_crossing(
+    runs: Iterable[Segment], trajectory: Trajectory, threshold: float, steps: list[float]
+) -> float:
+    """The first time (TT s) the attitudes of the run alongside (its segments ``runs``)
+    and ``trajectory`` differ by ``threshold``, or ``math.inf``: compared at every grid
+    point of the run (a step apart, where its state costs one free flow, not a step), a
+    block of :data:`_BLOCK_STEPS` at a time, so that no more of the run is computed than
+    the crossing needs; then refined by bisection to a millisecond between the last point
+    below and the first at or above.  Each segment is compared with the trajectory's
+    segment of the same events (at an event's epoch, both before it).  ``steps``: each
+    segment's step is appended to it."""
+    earlier = 0.0
+    for segment, free in zip(runs, trajectory.segments, strict=False):
+        if not isinstance(segment.solver, TorquedMotion):
+            # A segment under a law: its attitude is the law's in both runs.
+            earlier = segment.end_s
+            continue
+        grid = segment.solver.solver
+        steps.append(grid.step)
+
+        def angle(t, torqued=segment.solver, free=free.solver):
+            return angles_between(torqued.attitude_quaternion(t), free.attitude_quaternion(t))
+
+        start, end = segment.start_s, segment.end_s
+        while start < end:
+            block_end = min(end, start + _BLOCK_STEPS * grid.step)
+            times = grid.grid_invariants(block_end)[0]
+            times = times[(times > start) & (times <= block_end)]
+            if times.size == 0:  # the end, a rounding beyond the grid's last point
+                times = np.array([block_end])
+            beyond = np.flatnonzero(angle(times) >= threshold)
+            if beyond.size:
+                low = float(times[beyond[0] - 1]) if beyond[0] > 0 else max(start, earlier)
+                high = float(times[beyond[0]])
+                return first_crossing(angle, low, high, high - low, threshold)
+            start = earlier = float(times[-1])
+    return math.inf
+
+
+def _interpolated(orbit: Any, scenario: Scenario) -> Any:
+    """The orbit's inertial position at TT seconds since the epoch, interpolated over the
+    span (module docstring), for an orbit of ``attitude.environment.orbit`` (which has
+    ``state_tt``); any other orbit as it is."""
+    if not hasattr(orbit, "state_tt"):
+        return orbit
+    from scipy.interpolate import CubicHermiteSpline
+
+    with offline_time():
+        tt = scenario.epoch.tt
+    jd1, jd2 = float(tt.jd1), float(tt.jd2)
+
+    def exact(t: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        return orbit.state_tt(np.full(t.shape, jd1), jd2 + t / 86400.0)
+
+    # Kick clocks may fall a step outside the span (negative coefficients): a margin.
+    low, high = scenario.start_s - 2.0 * _ORBIT_NODES_S, scenario.stop_s + 2.0 * _ORBIT_NODES_S
+
+    def fit(spacing: float, end: float) -> tuple[Any, float]:
+        """The interpolant on nodes ``spacing`` apart from ``low`` to ``end``, and its
+        largest error at the middle of every interval (of every 8th past the first 64)."""
+        nodes = np.linspace(low, end, max(2, math.ceil((end - low) / spacing)) + 1)
+        r, v = exact(nodes)
+        spline = CubicHermiteSpline(nodes, r, v, axis=0)
+        middles = 0.5 * (nodes[1:] + nodes[:-1])
+        middles = np.concatenate([middles[:64], middles[64::8]])
+        error = float(np.max(np.linalg.norm(spline(middles) - exact(middles)[0], axis=-1)))
+        return spline, error
+
+    # A probe over at most 200 nodes sets the spacing (the error goes as its fourth
+    # power), with a margin; the interpolant over the span is checked in turn.
+    _, probe = fit(_ORBIT_NODES_S, min(high, low + 200.0 * _ORBIT_NODES_S))
+    spacing = _ORBIT_NODES_S * min(1.0, 0.7 * (ORBIT_TOLERANCE_M / max(probe, 1e-300)) ** 0.25)
+    spline, error = fit(spacing, high)
+    if not error <= ORBIT_TOLERANCE_M:
+        return orbit  # rougher than the probe said: the orbit as it is
+
+    def position(t: NDArray[np.float64]) -> NDArray[np.float64]:
+        t = np.asarray(t, dtype=np.float64)
+        inside = (t >= low) & (t <= high)
+        if inside.all():
+            return spline(t)
+        r = np.empty((*t.shape, 3))
+        r[inside] = spline(t[inside])
+        r[~inside] = exact(t[~inside])[0]
+        return r
+
+    return position

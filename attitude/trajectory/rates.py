@@ -28,7 +28,6 @@ import math
 
 import numpy as np
 from numpy.typing import NDArray
-from scipy.optimize import brentq
 
 from attitude.solver.euler_solver import EulerSolver
 from attitude.trajectory.segments import Segment
@@ -139,6 +138,8 @@ def _first_zero(
 
     def f(τ: float) -> float:
         return float(_principal(segment, np.array([τ]))[0, component])
+
+    from scipy.optimize import brentq  # here: scipy.optimize is 0.2 s of a run's start
 
     return float(brentq(f, t[k], t[k + 1], xtol=4.0 * float(np.spacing(max(abs(t[k + 1]), 1.0)))))
 
