@@ -2,9 +2,12 @@
 
 The case of the issue: a 3U CubeSat spinning with a 31 s period, written every 10 s.
 The output grid sees a few points per turn, and its least Sun angle on the star
-tracker is off by 0.7°; ``pointing_analysis`` searches the exact motion on its own grid
-(64 points per turn of the fastest rotation) and narrows every bracket by golden-section
-search.  The reference samples every 0.1 s (100× the output step) over the same span.
+tracker is off by 0.7°; ``pointing_analysis`` searches the exact motion on its own
+nodes (attitude.pointing.free_search: bounds from the motion's structure, then Newton's
+method or golden-section search in every cell that could beat the best value), or on a
+grid of 64 points a turn of the fastest rotation (the search of segments under
+torques; the chunks' test runs this case both ways).  The reference samples every
+0.1 s (100× the output step) over the same span.
 
 A sampled extremum is never more extreme than the true one, so the analysis must be at
 least as extreme as every sample.  And within 0.01° of the reference: the extreme sample
@@ -150,6 +153,19 @@ def test_the_times_are_where_the_values_are(cubesat):
         )
 
 
+def test_mean_incidence_against_dense_sampling(cubesat):
+    # The time average of each vector's Sun incidence (max(cos, 0) times the lit
+    # fraction) against the trapezoid rule on the 0.1 s sampling: within 1e-4, the
+    # trapezoid's own error across the kinks (the search integrates the quintic through
+    # its cells' ends, cut at the crossings, to ~1e-6: test_search_against_grid_search).
+    analysis, _, dense, _, _ = cubesat
+    for found, sampled in zip(analysis.vectors, dense.vectors, strict=True):
+        reference = np.trapezoid(sampled.cos_incidence, dense.seconds) / 6000.0
+        assert abs(found.mean_cos_incidence - reference) <= 1e-4, found.vector.name
+    reference = np.trapezoid(dense.sunlit_fraction, dense.seconds) / 6000.0
+    assert abs(analysis.sunlit_fraction_mean - reference) <= 1e-6
+
+
 def test_the_output_grid_alone_would_be_wrong(cubesat):
     # What the summary reported before: the 10 s grid's least Sun angle on the tracker.
     analysis, grid, dense, _, _ = cubesat
@@ -159,15 +175,27 @@ def test_the_output_grid_alone_would_be_wrong(cubesat):
     assert math.degrees(dense.vectors[0].sun_angle_rad.min() - found) < 0.01
 
 
-def test_nothing_depends_on_the_chunks(cubesat, monkeypatch):
-    # The search runs in chunks of CHUNK_POINTS grid points: with chunks of 1000 the
-    # intervals are the same (joined at the chunks' ends), and so are the extrema.
+@pytest.mark.parametrize("search", ["torque-free", "grid"])
+def test_nothing_depends_on_the_chunks(cubesat, monkeypatch, search):
+    # The torque-free search runs in windows of WINDOW_NODES nodes, the grid search in
+    # chunks of CHUNK_POINTS points: with windows of 150 nodes (chunks of 1000 points)
+    # the intervals are the same (joined at the windows' ends), and so are the extrema.
+    import dataclasses
+
+    import attitude.pointing.free_search as free_search
     import attitude.pointing.search as pointing_search
 
     analysis, _, _, trajectory, spec = cubesat
+    grid = analysis.grid
+    if search == "grid":
+        grid = dataclasses.replace(grid, plans=())
+        analysis = pointing_analysis(trajectory, spec, grid=grid)
+        assert grid.stop_s / grid.grid_step_s > 10_000  # so that there are a dozen chunks
+    else:
+        assert grid.count > 1500  # so that there are a dozen windows
     monkeypatch.setattr(pointing_search, "CHUNK_POINTS", 1000)
-    chunked = pointing_analysis(trajectory, spec)
-    assert analysis.grid.count > 10_000  # so that there are a dozen chunks
+    monkeypatch.setattr(free_search, "WINDOW_NODES", 150)
+    chunked = pointing_analysis(trajectory, spec, grid=grid)
     for one, other in zip(analysis.vectors, chunked.vectors, strict=True):
         for kind in ("sun_visible", "sun_exclusion", "moon_exclusion", "earth_limb_exclusion"):
             a, b = getattr(one, kind), getattr(other, kind)
@@ -179,6 +207,7 @@ def test_nothing_depends_on_the_chunks(cubesat, monkeypatch):
             other_low, other_high = other.extrema[quantity]
             assert abs(low.value - other_low.value) < 1e-8, quantity
             assert abs(high.value - other_high.value) < 1e-8, quantity
+        assert abs(one.mean_cos_incidence - other.mean_cos_incidence) < 1e-6
     assert len(analysis.shadow) == len(chunked.shadow) and len(analysis.umbra) == 1
 
 

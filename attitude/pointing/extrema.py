@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["Extremum", "Problem", "least", "least_of_each"]
+__all__ = ["Extremum", "Problem", "least", "least_in_brackets", "least_of_each"]
 
 _GOLDEN = (np.sqrt(5.0) - 1.0) / 2.0  # 0.618...
 
@@ -195,6 +195,34 @@ def least_of_each(
         brackets[name] = _Brackets(
             a, b, values[lo], values[hi], b - _GOLDEN * (b - a), a + _GOLDEN * (b - a)
         )
+    return _narrow(evaluate, brackets, best, problems, tolerance, precision_s)
+
+
+def least_in_brackets(
+    evaluate: Callable[[NDArray[np.float64]], dict[str, NDArray[np.float64]]],
+    brackets: dict[str, tuple[NDArray[np.float64], ...]],
+    problems: dict[str, Problem],
+    best: dict[str, Extremum],
+    tolerance: float,
+    precision_s: float,
+) -> dict[str, Extremum]:
+    """:func:`least_of_each` on brackets found otherwise (by
+    :mod:`attitude.pointing.free_search`, from bounds between nodes): ``brackets[name]``
+    is (a, b, f(a), f(b)), arrays of the brackets' ends and of f there; ``best``: the
+    least value known of each (every evaluated point, and the incumbent).  Each bracket
+    is narrowed by golden-section search, and dropped on ``problems[name].lipschitz``
+    as in :func:`least_of_each`; ``problems[name].grid_values`` is not used."""
+    out = dict(best)
+    narrowing: dict[str, _Brackets] = {}
+    for name, (a, b, fa, fb) in brackets.items():
+        if a.size:
+            narrowing[name] = _Brackets(a, b, fa, fb, b - _GOLDEN * (b - a), a + _GOLDEN * (b - a))
+    return _narrow(evaluate, narrowing, out, problems, tolerance, precision_s)
+
+
+def _narrow(evaluate, brackets: dict[str, _Brackets], best, problems, tolerance, precision_s):
+    """Golden-section steps on every bracket at once, one call of ``evaluate`` a step,
+    until none is left (each dropped on its bound, or narrower than ``precision_s``)."""
     while brackets:
         names = list(brackets)
         points = [brackets[name].points() for name in names]

@@ -26,9 +26,11 @@ from numpy.typing import NDArray
 
 __all__ = [
     "Interval",
+    "append_across",
     "difference",
     "find_all_intervals",
     "find_intervals",
+    "isolate",
     "join",
     "total_duration",
     "union",
@@ -63,6 +65,7 @@ def _refine(
     precision_s: float,
     fa: NDArray[np.float64] | None = None,
     fb: NDArray[np.float64] | None = None,
+    estimate: NDArray[np.float64] | None = None,
 ) -> NDArray[np.float64]:
     """The sign changes of f in the brackets [a, b], to ``precision_s``.
 
@@ -73,9 +76,15 @@ def _refine(
     0.49 ``precision_s`` on either side of its estimate, which closes the bracket with
     four calls of f where bisection takes eight; a bracket not closed that way (a
     kink, a flat end) goes on by bisection (Press et al., *Numerical Recipes*, 3rd
-    ed., §9.2).  Each bracket's result depends on its own evaluations only."""
+    ed., §9.2).  With an ``estimate`` of each crossing (the root of a cubic through the
+    ends' values and slopes: :mod:`attitude.pointing.free_search`), the regula falsi is
+    skipped and the probes go either side of it.  Each bracket's result depends on its
+    own evaluations only."""
     a, b = a.copy(), b.copy()
-    if fa is not None and fb is not None and a.size:
+    if estimate is not None and a.size:
+        x = np.where(np.isfinite(estimate), estimate, 0.5 * (a + b))
+        _probe(f, a, b, inside_at_a, precision_s, x)
+    elif fa is not None and fb is not None and a.size:
         fa, fb = np.asarray(fa, dtype=np.float64).copy(), np.asarray(fb, dtype=np.float64).copy()
         for _ in range(2):
             which = np.flatnonzero(b - a > precision_s)
@@ -93,14 +102,7 @@ def _refine(
         with np.errstate(divide="ignore", invalid="ignore"):
             x = (a * fb - b * fa) / (fb - fa)
         x = np.where(np.isfinite(x), x, 0.5 * (a + b))
-        for probe in (x - 0.49 * precision_s, x + 0.49 * precision_s):
-            probe = np.clip(probe, a, b)
-            which = np.flatnonzero((b - a > precision_s) & (probe > a) & (probe < b))
-            if which.size == 0:
-                continue
-            same_as_a = (f(probe[which], which) > 0.0) == inside_at_a[which]
-            a[which] = np.where(same_as_a, probe[which], a[which])
-            b[which] = np.where(same_as_a, b[which], probe[which])
+        _probe(f, a, b, inside_at_a, precision_s, x)
     while True:
         which = np.flatnonzero(b - a > precision_s)
         if which.size == 0:
@@ -112,6 +114,19 @@ def _refine(
         a[which] = np.where(same_as_a, mid, a[which])
         b[which] = np.where(same_as_a, b[which], mid)
     return 0.5 * (a + b)
+
+
+def _probe(f, a, b, inside_at_a, precision_s: float, x) -> None:
+    """Close the brackets [a, b] (in place) with f at 0.49 ``precision_s`` either side of
+    the estimates ``x``, where that lands inside them."""
+    for probe in (x - 0.49 * precision_s, x + 0.49 * precision_s):
+        probe = np.clip(probe, a, b)
+        which = np.flatnonzero((b - a > precision_s) & (probe > a) & (probe < b))
+        if which.size == 0:
+            continue
+        same_as_a = (f(probe[which], which) > 0.0) == inside_at_a[which]
+        a[which] = np.where(same_as_a, probe[which], a[which])
+        b[which] = np.where(same_as_a, b[which], probe[which])
 
 
 def find_intervals(
@@ -136,12 +151,16 @@ def find_all_intervals(
     grid_s: NDArray[np.float64],
     precision_s: float,
     grid_values: dict[str, NDArray[np.float64]],
+    lipschitz: dict[str, float] | None = None,
 ) -> dict[str, list[Interval]]:
     """:func:`find_intervals` for several conditions at once: ``evaluate(τ)`` gives
     every condition's function at τ (a dict by name; > 0 where it holds), and each
     refinement step calls it once for the crossings of all of them.  ``grid_values``:
-    each condition's function on the grid."""
+    each condition's function on the grid.  With ``lipschitz`` (a bound on |df/dτ| of
+    each condition), no interval is missed however short: see :func:`isolate`."""
     grid_s = np.asarray(grid_s, dtype=np.float64)
+    if lipschitz is not None:
+        grid_s, grid_values = isolate(evaluate, grid_s, grid_values, lipschitz)
     names = list(grid_values)
     inside = {name: np.asarray(grid_values[name]) > 0.0 for name in names}
     changes = {name: np.flatnonzero(inside[name][1:] != inside[name][:-1]) for name in names}
@@ -173,6 +192,43 @@ def find_all_intervals(
     return found
 
 
+def isolate(
+    evaluate: Callable[[NDArray[np.float64]], dict[str, NDArray[np.float64]]],
+    grid_s: NDArray[np.float64],
+    grid_values: dict[str, NDArray[np.float64]],
+    lipschitz: dict[str, float],
+) -> tuple[NDArray[np.float64], dict[str, NDArray[np.float64]]]:
+    """The grid with points added until no condition can change sign twice between
+    two neighbours unseen: with |df/dτ| ≤ L, f cannot reach 0 between points h apart
+    where it is fa and fb of one sign if |fa| + |fb| > L h (the two steepest slopes
+    from the ends meet before 0).  Every step between points where that is not proved
+    is halved, all at once, one call of ``evaluate`` a round, down to the spacing of
+    floats there (4 ulps): an interval between two points closer than that is below
+    what a time in seconds resolves.  Returns the grid and each condition's values."""
+    values = {name: np.asarray(v, dtype=np.float64) for name, v in grid_values.items()}
+    while grid_s.size > 1:
+        width = np.diff(grid_s)
+        resolvable = width > 4.0 * np.spacing(np.maximum(abs(grid_s[:-1]), abs(grid_s[1:])))
+        unproved = np.zeros(width.size, dtype=bool)
+        for name, rate in lipschitz.items():
+            f = values[name]
+            same = (f[:-1] > 0.0) == (f[1:] > 0.0)
+            with np.errstate(invalid="ignore"):
+                unproved |= same & ~(np.abs(f[:-1]) + np.abs(f[1:]) > rate * width)
+        split = np.flatnonzero(unproved & resolvable)
+        if split.size == 0:
+            break
+        middle = 0.5 * (grid_s[split] + grid_s[split + 1])
+        more = evaluate(middle)
+        order = np.argsort(np.concatenate([grid_s, middle]), kind="stable")
+        grid_s = np.concatenate([grid_s, middle])[order]
+        values = {
+            name: np.concatenate([values[name], np.asarray(more[name], dtype=np.float64)])[order]
+            for name in values
+        }
+    return grid_s, values
+
+
 def _assemble(grid_s, inside, crossings, entering) -> list[Interval]:
     """The intervals from the crossings (in time order) and whether each enters."""
     intervals = []
@@ -191,6 +247,8 @@ def _assemble(grid_s, inside, crossings, entering) -> list[Interval]:
 def difference(a: list[Interval], b: list[Interval]) -> list[Interval]:
     """The parts of the intervals ``a`` outside the intervals ``b`` (each sorted and
     disjoint), in one sweep: O(len(a) + len(b))."""
+    if not b:
+        return list(a)
     out = []
     first = 0  # the first cut that can still overlap an interval of a
     for interval in a:
@@ -253,6 +311,17 @@ def join(intervals: list[Interval], more: list[Interval], boundary_s: float) -> 
         last = intervals.pop()  # the condition ended exactly at the boundary
         intervals.append(Interval(last.start_s, last.end_s, last.starts_before, False))
     intervals.extend(more)
+
+
+def append_across(intervals: list[Interval], more: list[Interval], boundary_s: float) -> None:
+    """:func:`join` across a boundary where the condition's value may jump (an event
+    that resets the attitude): an interval of ``more`` that starts at the boundary
+    without one of ``intervals`` continuing it started there, not before the span."""
+    continued = bool(intervals) and intervals[-1].ends_after and intervals[-1].end_s == boundary_s
+    if more and more[0].starts_before and more[0].start_s == boundary_s and not continued:
+        first = more[0]
+        more = [Interval(first.start_s, first.end_s, False, first.ends_after), *more[1:]]
+    join(intervals, more, boundary_s)
 
 
 def total_duration(intervals: list[Interval]) -> float:

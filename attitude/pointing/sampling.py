@@ -20,8 +20,9 @@ from numpy.typing import NDArray
 
 from attitude.base.errors import InputError
 from attitude.environment.frames import euler_angles_deg, lvlh_to_icrf
+from attitude.pointing.shared_surroundings import exact_surroundings
 from attitude.pointing.spec import BodyVector, PointingSpec, for_scenario
-from attitude.pointing.surroundings import SunMoonEarth, Surroundings, moon_hidden, vector_angles
+from attitude.pointing.surroundings import Surroundings, moon_hidden, vector_angles
 from attitude.trajectory.trajectory import Trajectory
 
 __all__ = ["PointingSamples", "VectorSamples", "pointing_samples"]
@@ -132,7 +133,11 @@ def pointing_samples(
         # take another path (gemv), which can differ in the last bit, and a stream's
         # chunk of one epoch must give what the whole grid gives.
         return _first_row(pointing_samples(trajectory, spec, np.repeat(seconds, 2)))
-    env = SunMoonEarth(trajectory, spec, float(seconds.min()), float(seconds.max())).at(seconds)
+    # The exact surroundings; their ephemeris from the shared surroundings of a search
+    # over the span, when one was made (the same values).
+    env = exact_surroundings(trajectory, spec, float(seconds.min()), float(seconds.max())).at(
+        seconds
+    )
     attitude = trajectory.attitude(seconds)
     result = PointingSamples(
         seconds=seconds,

@@ -6,31 +6,46 @@ Sun hidden, all of it), the Moon behind the Earth, and for each body vector of t
 when any of them blinds it, and when its Sun inclusion cone holds the Sun (intervals),
 the least and greatest of its Sun, Moon, nadir and limb angles and of its Sun
 incidence (extrema), and the time averages of the incidence and of the lit fraction.
-It finds them on the exact motion, whatever the output step, and in bounded memory:
-the span is searched in chunks of :data:`CHUNK_POINTS` points, and only what was
-found is kept between chunks.  The values it searches are those of
-:mod:`attitude.pointing.surroundings`, the same as :func:`attitude.pointing.sampling
-.pointing_samples` gives at the same times.
+It finds them on the exact motion, whatever the output step, and in bounded memory.
+The surroundings (orbit, Sun, Moon, shadow) come from
+:class:`attitude.pointing.shared_surroundings.SharedSurroundings`, computed once for the
+span and shared (within their stated bound of the exact ones, which
+:mod:`attitude.pointing.surroundings` and :func:`attitude.pointing.sampling
+.pointing_samples` compute); every extremum's value is then computed exactly at its
+time, as a sample there gives it.
 
-**The search grid** (:func:`search_grid`): each quantity is sampled with a step that
-comes from the motion and the geometry, not from the output step: 64 samples per 2π
-radians of the fastest rate any direction here can turn at, the body's fastest
-rotation (bounded by √(2T/I_min) over the segments) plus the orbit's (the nadir's
-angular rate, the rate of the Earth's angular radius, the Moon's parallax), and at
-most 30 s on an orbit (600 s at the Earth's centre).
+**Eclipses and the Moon behind the Earth** depend on the orbit alone: searched once
+for the span on a 10 s grid with the geometry's rate bound, so that none is missed
+however short (:func:`attitude.pointing.intervals.isolate`), and kept with the shared
+surroundings for every later search of the same span.
 
-**Intervals**: a condition's sign changes on the grid are refined on the exact
-motion (:func:`attitude.pointing.intervals.find_all_intervals`: regula falsi, then bisection
-where needed) to ``interval_precision``.  **Extrema**: each grid minimum or maximum
-brackets an extremum, narrowed by golden-section search on the exact motion
-(:func:`attitude.pointing.extrema.least_of_each`) to 1 µs, with brackets that cannot hold the
-answer dropped on a rate bound: each body vector's own (:func:`_vector_rates`) plus
-the sky's.
-``tests/test_extrema_against_dense_sampling.py`` compares them with a sampling 100×
-denser than a 10 s output grid.
+**Torque-free segments** (:mod:`attitude.pointing.free_search`): the structure of the
+closed-form motion bounds how fast each body vector's cosines with the Sun, the Moon
+and nadir can bend; values and rates at nodes spaced by that bound, rigorous bounds
+between nodes, and refinement only of the cells where something can happen: no
+interval is missed however short, each crossing costs a few evaluations.
+
+**Other segments** (torques, attitude laws): the search grid (:func:`search_grid`):
+each quantity is sampled with a step that comes from the motion and the geometry, not
+from the output step: 64 samples per 2π radians of the fastest rate any direction here
+can turn at, the body's fastest rotation (√(2T/I_min), or the segment's own bound,
+``angular_rate_bound``) plus the orbit's (the nadir's angular rate, the rate of the
+Earth's angular radius, the Moon's parallax), and at most 30 s on an orbit (600 s at
+the Earth's centre).  Wherever a condition could change sign twice between grid points
+unseen (its rate bound allows it), the step is halved until it could not
+(:func:`attitude.pointing.intervals.isolate`), so that none is missed there either;
+each sign change is refined on the exact motion (regula falsi, then bisection where
+needed) to ``interval_precision``.  Each grid minimum or maximum brackets an
+extremum, narrowed by golden-section search (:func:`attitude.pointing.extrema
+.least_of_each`) to 1 µs, with brackets that cannot hold the answer dropped on a rate
+bound: each body vector's own (:func:`_vector_rates`) plus the sky's.
+
+``tests/test_extrema_against_dense_sampling.py`` compares the extrema with a sampling
+100× denser than a 10 s output grid, and ``tests/test_search_against_grid_search.py``
+the torque-free search with the grid search on every example and hostile cases.
 
 :func:`check_pointing` checks, before anything is sampled, what the search and the
-samples need: the ephemeris and the orbit over the span, and the size of the grid.
+samples need: the ephemeris and the orbit over the span, and the size of the search.
 """
 
 from __future__ import annotations
@@ -48,9 +63,18 @@ from attitude.environment.orbit import Orbit
 from attitude.environment.timescales import SECONDS_PER_DAY
 from attitude.pointing.eclipse import SUN_RADIUS_M
 from attitude.pointing.extrema import Extremum, Problem, least_of_each
-from attitude.pointing.intervals import Interval, difference, find_all_intervals, join, union
+from attitude.pointing.free_search import FreePiece, FreePlan, free_plan, search_free
+from attitude.pointing.intervals import (
+    Interval,
+    append_across,
+    difference,
+    find_all_intervals,
+    join,
+    union,
+)
+from attitude.pointing.shared_surroundings import SharedSurroundings, shared_surroundings
 from attitude.pointing.spec import BodyVector, PointingSpec, for_scenario, interval_precision
-from attitude.pointing.surroundings import SunMoonEarth, moon_hidden, scenario_jd, vector_angles
+from attitude.pointing.surroundings import moon_hidden, scenario_jd, vector_angles
 from attitude.solver.euler_solver import EulerSolver
 from attitude.trajectory.trajectory import Trajectory
 
@@ -71,6 +95,8 @@ __all__ = [
 _SAMPLES_PER_TURN = 64
 _LONGEST_STEP_ON_ORBIT_S = 30.0
 _LONGEST_STEP_S = 600.0
+# The eclipses and the Moon behind the Earth: searched on a grid this fine.
+_ORBIT_STEP_S = 10.0
 # The orbit is sampled this often to bound its angular rates (and checked above ground).
 _ORBIT_CHECK_STEP_S = 60.0
 # Bounds on how fast the Sun and the Moon move across the sky of a spacecraft near
@@ -81,11 +107,10 @@ _MOON_SKY_RATE = 1.1e3 / 3.56e8
 # The Sun's least angular radius from near the Earth (at aphelion): the fastest the
 # lit fraction can change is (2/π a) per radian of the discs' relative motion.
 _SUN_LEAST_RADIUS_RAD = SUN_RADIUS_M / 1.53e11
-# The search grid is evaluated this many points at a time (bounded memory: about 26 MB
-# more at the search's peak than 32 768, which cost 13 % more time in the one-day spinner,
-# each chunk paying its own ~30 refinement calls of ~0.8 ms fixed cost), and a run
-# searches at most this many points: about 20 µs a point with the refinements (the
-# spinner scenario, 2-core machine), so half an hour.
+# The search grid of segments searched on a grid is evaluated this many points at a
+# time (bounded memory), and a run searches a span of at most this many points at 64 a
+# turn of its fastest rotation (SearchGrid.turn_points: the torque-free search needs
+# about a seventh of them).
 CHUNK_POINTS = 65_536
 MAX_SEARCH_POINTS = 100_000_000
 # Extrema: refined to 1 µs, and a bracket that could improve the best by less than
@@ -97,19 +122,27 @@ _EXTREMUM_TOLERANCE = 5e-9
 _RATE_SAMPLES = 16384
 _RATE_SAMPLES_IN_ALL = 2_000_000
 _RATE_SAMPLES_LEAST = 64
+# The lit fraction's mean: Gauss–Legendre points on each stretch of penumbra.
+_PENUMBRA_POINTS = 16
 
 
 @dataclass(frozen=True)
 class SearchGrid:
-    """The search grid of :func:`pointing_analysis` and the rate bounds behind it.
+    """How :func:`pointing_analysis` searches [start_s, stop_s], and the rate bounds.
 
-    ``step_s``: the grid step; ``count``: its points over the span;
+    ``step_s``: the finest step between the points the search evaluates first (the
+    nodes of a torque-free segment, :mod:`attitude.pointing.free_search`, or the grid
+    of the others); ``count``: how many such points over the span (the search adds
+    its refinements); ``grid_step_s``: the grid's step on segments searched on a grid
+    (64 points a turn); ``plans``: for each segment of the trajectory, its
+    :class:`~attitude.pointing.free_search.FreePlan` when it is searched as torque-free
+    (None otherwise, or outside the span).
     ``body_rate_rad_s``: a bound on the body's rotation rate (√(2T/I_min));
-    ``orbit_rate_rad_s``: the
-    fastest turn of the nadir (|r × v|/r²) plus the rate of the Earth's angular radius;
-    ``orbit_speed_m_s``: the greatest orbital speed; ``vector_rates_rad_s``: for each
-    body vector by name, a bound on how fast it turns (:func:`_vector_rates`; never
-    above ``body_rate_rad_s``, which stands for a vector not listed).
+    ``orbit_rate_rad_s``: the fastest turn of the nadir (|r × v|/r²) plus the rate of
+    the Earth's angular radius; ``orbit_speed_m_s``: the greatest orbital speed;
+    ``vector_rates_rad_s``: for each body vector by name, a bound on how fast it turns
+    (:func:`_vector_rates`; never above ``body_rate_rad_s``, which stands for a vector
+    not listed).
     """
 
     start_s: float
@@ -120,6 +153,17 @@ class SearchGrid:
     orbit_rate_rad_s: float
     orbit_speed_m_s: float
     vector_rates_rad_s: dict[str, float] = field(default_factory=dict, compare=False)
+    grid_step_s: float = 0.0
+    plans: tuple[FreePlan | None, ...] = field(default=(), compare=False)
+
+    @property
+    def turn_points(self) -> int:
+        """Points at 64 a turn of the fastest rotation over the span (every
+        ``grid_step_s``): the measure of what a span holds (about two intervals a turn of
+        each vector) that the limit of a run (:data:`MAX_SEARCH_POINTS`) and the output
+        budget (``attitude.outputs.budget``) count, whichever way it is searched."""
+        step = self.grid_step_s if self.grid_step_s > 0.0 else self.step_s
+        return max(math.ceil((self.stop_s - self.start_s) / step) + 1, 2)
 
     @property
     def _geometry_rate(self) -> float:
@@ -155,24 +199,33 @@ def _segment_rate(solver) -> float:
     )
 
 
+def _in_span(trajectory: Trajectory, start_s: float, stop_s: float):
+    """(index, segment) of the segments that meet [start_s, stop_s]."""
+    return [
+        (k, segment)
+        for k, segment in enumerate(trajectory.segments)
+        if segment.end_s >= start_s and segment.start_s <= stop_s
+    ]
+
+
 def _body_rate(trajectory: Trajectory, start_s: float, stop_s: float) -> float:
     """A bound on the body's rotation rate over [start_s, stop_s], rad/s: the largest
     over the segments of :func:`_segment_rate`."""
-    rates = [
-        _segment_rate(segment.solver)
-        for segment in trajectory.segments
-        if segment.end_s >= start_s and segment.start_s <= stop_s
-    ]
+    rates = [_segment_rate(segment.solver) for _, segment in _in_span(trajectory, start_s, stop_s)]
     return max(rates, default=0.0)
 
 
 def _vector_rates(
-    trajectory: Trajectory, spec: PointingSpec, start_s: float, stop_s: float
+    trajectory: Trajectory,
+    spec: PointingSpec,
+    start_s: float,
+    stop_s: float,
+    segments: list | None = None,
 ) -> dict[str, float]:
     """For each body vector b, a bound on its inertial rate |ω × b| over [start_s,
-    stop_s], rad/s: the pointing's extrema are pruned with it (a vector near the spin
-    axis turns far slower than the body, and :func:`_body_rate` would keep every
-    bracket of its Sun angle).
+    stop_s] on ``segments`` (those meeting the span by default), rad/s: the pointing's
+    extrema are pruned with it (a vector near the spin axis turns far slower than the
+    body, and :func:`_body_rate` would keep every bracket of its Sun angle).
 
     Per segment, ω(t) (body axes) is sampled :data:`_RATE_SAMPLES` times (fewer when
     many segments share :data:`_RATE_SAMPLES_IN_ALL`) over one body period of its
@@ -186,11 +239,8 @@ def _vector_rates(
     """
     vectors = [(v.name, v.vector) for v in spec.body_vectors]
     rates = dict.fromkeys((name for name, _ in vectors), 0.0)
-    segments = [
-        segment
-        for segment in trajectory.segments
-        if segment.end_s >= start_s and segment.start_s <= stop_s
-    ]
+    if segments is None:
+        segments = [segment for _, segment in _in_span(trajectory, start_s, stop_s)]
     if not vectors or not segments:
         return rates
     # Thousands of events share the samples (the bound stays rigorous, only looser).
@@ -257,17 +307,44 @@ def search_grid(
         speed = float(np.max(np.linalg.norm(v, axis=-1)))
     longest = _LONGEST_STEP_ON_ORBIT_S if spec.orbit is not None else _LONGEST_STEP_S
     rate = body + orbit_rate + _SUN_SKY_RATE + _MOON_SKY_RATE
-    step = min(longest, 2.0 * math.pi / (_SAMPLES_PER_TURN * rate))
-    count = max(math.ceil((stop_s - start_s) / step) + 1, 2)
+    grid_step = min(longest, 2.0 * math.pi / (_SAMPLES_PER_TURN * rate))
+    segments = _in_span(trajectory, start_s, stop_s)
+    plans: list[FreePlan | None] = [None] * len(trajectory.segments)
+    shared = shared_surroundings(trajectory, spec, start_s, stop_s) if spec.body_vectors else None
+    count, steps = 0, []
+    for k, segment in segments:
+        a, b = max(segment.start_s, start_s), min(segment.end_s, stop_s)
+        plan = None
+        if shared is not None and isinstance(segment.solver, EulerSolver):
+            plan = free_plan(segment.solver, spec, shared, a, b)
+        if plan is not None:
+            plans[k] = plan
+            count += plan.count
+            steps.append(plan.step_s)
+        elif spec.body_vectors:
+            count += math.ceil((b - a) / grid_step) + 1
+            steps.append(grid_step)
+    if spec.orbit is not None:
+        count += math.ceil((stop_s - start_s) / _ORBIT_STEP_S) + 1
+        steps.append(_ORBIT_STEP_S)
+    # Each vector's rate bound: the free plans' own, the sampled one elsewhere.
+    others = [segment for k, segment in segments if plans[k] is None]
+    rates = _vector_rates(trajectory, spec, start_s, stop_s, others)
+    for plan in plans:
+        if plan is not None:
+            for name, motion in plan.motion.items():
+                rates[name] = max(rates[name], motion.rate)
     return SearchGrid(
         start_s,
         stop_s,
-        (stop_s - start_s) / (count - 1),
-        count,
+        min(steps, default=grid_step),
+        max(count, 2),
         body,
         orbit_rate,
         speed,
-        _vector_rates(trajectory, spec, start_s, stop_s),
+        rates,
+        grid_step,
+        tuple(plans),
     )
 
 
@@ -322,11 +399,11 @@ def check_pointing(
                 key=orbit.key,
             )
     grid = search_grid(trajectory, spec)
-    if grid.count > MAX_SEARCH_POINTS:
+    if grid.turn_points > MAX_SEARCH_POINTS:
         raise InputError(
-            f"the pointing's search needs {grid.count:.3g} points over the span "
-            f"(every {grid.step_s:.3g} s: 64 a turn of the fastest rotation), more than the "
-            f"{MAX_SEARCH_POINTS:.0e} one run searches (about 20 µs a point): use a shorter span",
+            f"the pointing's search needs {grid.turn_points:.3g} points over the span "
+            f"(every {grid.grid_step_s:.3g} s: 64 a turn of the fastest rotation), more than "
+            f"the {MAX_SEARCH_POINTS:.0e} one run searches: use a shorter span",
             key=scenario.end_key,
         )
     return notes, grid
@@ -391,86 +468,73 @@ class PointingAnalysis:
 
 
 class _Quantities:
-    """Every quantity the analysis searches, at any times of one chunk."""
+    """Every body vector's quantity the grid search looks at, at any times of a span:
+    the exact attitude and the shared surroundings."""
 
-    def __init__(self, trajectory: Trajectory, spec: PointingSpec, start_s: float, stop_s: float):
+    def __init__(self, trajectory: Trajectory, spec: PointingSpec, shared: SharedSurroundings):
         self.trajectory = trajectory
         self.spec = spec
-        self.env = SunMoonEarth(trajectory, spec, start_s, stop_s)
+        self.shared = shared
 
     def __call__(self, seconds: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
-        env = self.env.at(seconds)
+        env = self.shared.at(seconds)
         attitude = self.trajectory.attitude(seconds)
         values = {"sunlit_fraction": env.sunlit_fraction}
-        if env.shadow_angles is not None:
-            a, b, c = env.shadow_angles
-            values["shadow"] = (a + b) - c
-            values["umbra"] = (b - a) - c
-            values["moon_hidden"] = moon_hidden(env)
         for v in self.spec.body_vectors:
             for quantity, value in vector_angles(attitude.apply(v.vector), env).items():
                 values[f"{v.name}.{quantity}"] = value
         return values
 
 
+def _orbit_conditions(env) -> dict[str, NDArray[np.float64]]:
+    """The eclipses' and the hidden Moon's functions (> 0 where each holds)."""
+    a, b, c = env.shadow_angles
+    return {"shadow": (a + b) - c, "umbra": (b - a) - c, "moon_hidden": moon_hidden(env)}
+
+
 def _conditions(spec: PointingSpec) -> dict[str, tuple[str, float, float]]:
-    """Each interval condition: (quantity, scale, offset), true where scale·q − offset > 0."""
+    """Each body vector's interval condition: (quantity, scale, offset), true where
+    scale·q − offset > 0."""
     conditions: dict[str, tuple[str, float, float]] = {}
-    if spec.orbit is not None:
-        conditions["shadow"] = ("shadow", 1.0, 0.0)
-        conditions["umbra"] = ("umbra", 1.0, 0.0)
-        conditions["moon_hidden"] = ("moon_hidden", 1.0, 0.0)
     for v in spec.body_vectors:
         name = v.name
         conditions[f"{name}.sun_visible"] = (f"{name}.sun_cosine", 1.0, 0.0)
-        if v.sun_exclusion_half_angle_rad is not None:
-            conditions[f"{name}.sun_exclusion"] = (
-                f"{name}.sun_angle",
-                -1.0,
-                -v.sun_exclusion_half_angle_rad,
-            )
-        if v.moon_exclusion_half_angle_rad is not None:
-            conditions[f"{name}.moon_exclusion"] = (
-                f"{name}.moon_angle",
-                -1.0,
-                -v.moon_exclusion_half_angle_rad,
-            )
-        if v.earth_limb_exclusion_angle_rad is not None:
-            conditions[f"{name}.earth_limb_exclusion"] = (
-                f"{name}.earth_limb_angle",
-                -1.0,
-                -v.earth_limb_exclusion_angle_rad,
-            )
-        if v.sun_inclusion_half_angle_rad is not None:
-            conditions[f"{name}.sun_in_view"] = (
-                f"{name}.sun_angle",
-                -1.0,
-                -v.sun_inclusion_half_angle_rad,
-            )
+        for kind, quantity, angle in (
+            ("sun_exclusion", "sun_angle", v.sun_exclusion_half_angle_rad),
+            ("moon_exclusion", "moon_angle", v.moon_exclusion_half_angle_rad),
+            ("earth_limb_exclusion", "earth_limb_angle", v.earth_limb_exclusion_angle_rad),
+            ("sun_in_view", "sun_angle", v.sun_inclusion_half_angle_rad),
+        ):
+            if angle is not None and (kind != "earth_limb_exclusion" or spec.orbit is not None):
+                conditions[f"{name}.{kind}"] = (f"{name}.{quantity}", -1.0, -angle)
     return conditions
 
 
-def _grid_points(
-    grid: SearchGrid, first: int, last: int, events_s: NDArray[np.float64]
-) -> NDArray[np.float64]:
-    """Points first..last of the search grid, with the event epochs between them."""
-    span = grid.stop_s - grid.start_s
-    index = np.arange(first, last + 1, dtype=np.float64)
-    τ = grid.start_s + span * index / (grid.count - 1)
-    τ[-1] = grid.stop_s if last == grid.count - 1 else τ[-1]
-    inside = events_s[(events_s > τ[0]) & (events_s < τ[-1])]
-    return np.unique(np.concatenate([τ, inside])) if inside.size else τ
+def _grid_points(start_s: float, stop_s: float, step_s: float) -> NDArray[np.float64]:
+    """The grid over [start_s, stop_s], at most ``step_s`` apart, both ends included."""
+    count = max(math.ceil((stop_s - start_s) / step_s), 1) + 1
+    τ = start_s + (stop_s - start_s) * np.arange(count, dtype=np.float64) / (count - 1)
+    τ[-1] = stop_s
+    return τ
 
 
 class _Search:
-    """The intervals, extrema and averages of the analysis, accumulated chunk by chunk."""
+    """The intervals, extrema and averages of the analysis, accumulated segment by
+    segment (and window by window)."""
 
-    def __init__(self, trajectory: Trajectory, spec: PointingSpec, grid: SearchGrid) -> None:
-        self.trajectory, self.spec, self.grid = trajectory, spec, grid
+    def __init__(
+        self,
+        trajectory: Trajectory,
+        spec: PointingSpec,
+        grid: SearchGrid,
+        shared: SharedSurroundings,
+    ) -> None:
+        self.trajectory, self.spec, self.grid, self.shared = trajectory, spec, grid, shared
         self.precision = interval_precision(spec, trajectory.scenario.stop_s)[0]
         self.extremum_precision = max(_EXTREMUM_PRECISION_S, 4.0 * float(np.spacing(grid.stop_s)))
         self.conditions = _conditions(spec)
         self.found: dict[str, list[Interval]] = {name: [] for name in self.conditions}
+        self.orbit: dict[str, list[Interval]] = {}
         # (vector, quantity) pairs, and the least and greatest of each found so far.
         self.wanted = [
             (v.name, quantity)
@@ -480,9 +544,10 @@ class _Search:
         ]
         self.lows: dict[tuple[str, str], Extremum | None] = dict.fromkeys(self.wanted)
         self.highs: dict[tuple[str, str], Extremum | None] = dict.fromkeys(self.wanted)
-        self.sums = {"sunlit_fraction": 0.0} | {
-            f"{v.name}.cos_incidence": 0.0 for v in spec.body_vectors
-        }
+        self.sums = {f"{v.name}.cos_incidence": 0.0 for v in spec.body_vectors}
+        self.sunlit_integral = grid.stop_s - grid.start_s
+        self.searched_to: float | None = None  # the end of what was searched so far
+        self.evaluations = 0
 
     def _rate(self, name: str, quantity: str) -> float:
         """A bound on the rate of change of a vector's quantity (the incidence adds the
@@ -491,6 +556,112 @@ class _Search:
         if quantity == "cos_incidence":
             return rate + self.grid.fraction_rate_bound
         return rate
+
+    # ------------------------------------------------------------ the orbit alone
+
+    def orbit_only(self) -> None:
+        """The eclipses and the Moon behind the Earth over the span, and the lit
+        fraction's integral: computed once per span and precision, and kept with the
+        shared surroundings (``memo``)."""
+        if self.spec.orbit is None:
+            return
+        grid = self.grid
+        key = ("orbit_only", grid.start_s, grid.stop_s, self.precision, grid._geometry_rate)
+        found = self.shared.memo.get(key)
+        if found is None:
+            found = _orbit_only(self.shared, grid, self.precision)
+            self.shared.memo[key] = found
+        self.orbit, self.sunlit_integral = found
+
+    # --------------------------------------------------------- torque-free segments
+
+    def free(self, pieces: list[FreePiece]) -> None:
+        """Search consecutive torque-free segments together (free_search)."""
+        problems, incumbents = {}, {}
+        for name, quantity in self.wanted:
+            rate = self._rate(name, quantity)
+            low, high = self.lows[(name, quantity)], self.highs[(name, quantity)]
+            problems[f"{name}.{quantity}.low"] = Problem(np.empty(0), rate, low)
+            problems[f"{name}.{quantity}.high"] = Problem(np.empty(0), rate, None)
+            incumbents[f"{name}.{quantity}.low"] = low
+            incumbents[f"{name}.{quantity}.high"] = (
+                None if high is None else Extremum(high.time_s, -high.value)
+            )
+        result = search_free(
+            pieces,
+            self.spec,
+            self.shared,
+            self.precision,
+            self.extremum_precision,
+            _EXTREMUM_TOLERANCE,
+            problems,
+            incumbents,
+            self.orbit.get("shadow", []),
+            self.orbit.get("umbra", []),
+        )
+        self.evaluations += result.evaluations
+        start_s = pieces[0].start_s
+        self._add(result.intervals, start_s)
+        for name, quantity in self.wanted:
+            low = result.extrema[f"{name}.{quantity}.low"]
+            high = result.extrema[f"{name}.{quantity}.high"]
+            if quantity == "cos_incidence" and result.dark[name]:
+                # No light: 0 is the least incidence, placed from the intervals (result).
+                low = Extremum(float(start_s), 0.0)
+            self.lows[(name, quantity)] = low
+            self.highs[(name, quantity)] = Extremum(high.time_s, -high.value)
+        for name, value in result.incidence_integral.items():
+            self.sums[f"{name}.cos_incidence"] += value
+
+    def _add(self, intervals: dict[str, list[Interval]], start_s: float) -> None:
+        """Fold a segment's (or a window's) intervals in: joined to the previous ones
+        across ``start_s``, where an event may make a value jump."""
+        for name in self.conditions:
+            if self.searched_to is None:
+                join(self.found[name], intervals[name], start_s)
+            else:
+                append_across(self.found[name], intervals[name], start_s)
+        self.searched_to = start_s
+
+    # ------------------------------------------------------------- the grid search
+
+    def gridded(self, start_s: float, end_s: float) -> None:
+        """Search [start_s, end_s] (consecutive segments under torques or laws) on the
+        grid, with the events' epochs within it as points (the trajectory gives each
+        point its segment: the later one at an event)."""
+        step = self.grid.grid_step_s if self.grid.grid_step_s > 0.0 else self.grid.step_s
+        τ_all = _grid_points(start_s, end_s, step)
+        events = np.array([t for t, _ in self.trajectory.scenario.events], dtype=np.float64)
+        inside = events[(events > start_s) & (events < end_s)]
+        if inside.size:
+            τ_all = np.unique(np.concatenate([τ_all, inside]))
+        first = 0
+        while first < τ_all.size - 1:
+            last = min(first + CHUNK_POINTS, τ_all.size - 1)
+            self.chunk(τ_all[first : last + 1], first == 0)
+            first = last
+
+    def chunk(self, τ: NDArray[np.float64], segment_start: bool = True) -> None:
+        """Search the grid points τ (one chunk) and fold what they hold into the totals."""
+        quantities = _Quantities(self.trajectory, self.spec, self.shared)
+        values = quantities(τ)
+        self.evaluations += τ.size
+        pieces = find_all_intervals(
+            lambda t: self._condition_values(quantities(t)),
+            τ,
+            self.precision,
+            self._condition_values(values),
+            {name: self._rate(name.split(".")[0], "sun_angle") for name in self.conditions},
+        )
+        if segment_start:
+            self._add(pieces, float(τ[0]))
+        else:
+            for name in self.conditions:
+                join(self.found[name], pieces[name], float(τ[0]))
+        self._extrema(quantities, τ, values)
+        widths = np.diff(τ)
+        for key in self.sums:  # the trapezoid rule on the search grid
+            self.sums[key] += float(np.sum(0.5 * (values[key][1:] + values[key][:-1]) * widths))
 
     def _condition_values(self, values: dict[str, NDArray]) -> dict[str, NDArray]:
         return {
@@ -506,26 +677,6 @@ class _Search:
             out[f"{key}.low"] = values[key]
             out[f"{key}.high"] = -values[key]
         return out
-
-    def chunk(self, τ: NDArray[np.float64]) -> None:
-        """Search the grid points τ (one chunk) and fold what they hold into the totals."""
-        quantities = _Quantities(self.trajectory, self.spec, float(τ[0]), float(τ[-1]))
-        values = quantities(τ)
-        self._intervals(quantities, τ, values)
-        self._extrema(quantities, τ, values)
-        widths = np.diff(τ)
-        for key in self.sums:  # the trapezoid rule on the search grid
-            self.sums[key] += float(np.sum(0.5 * (values[key][1:] + values[key][:-1]) * widths))
-
-    def _intervals(self, quantities: _Quantities, τ, values) -> None:
-        pieces = find_all_intervals(
-            lambda t: self._condition_values(quantities(t)),
-            τ,
-            self.precision,
-            self._condition_values(values),
-        )
-        for name in self.conditions:
-            join(self.found[name], pieces[name], float(τ[0]))
 
     def _extrema(self, quantities: _Quantities, τ, values) -> None:
         on_grid = self._extremum_values(values)
@@ -561,12 +712,40 @@ class _Search:
             high = best[f"{key}.high"]
             self.highs[(name, quantity)] = Extremum(high.time_s, -high.value)
 
+    # ------------------------------------------------------------------ the result
+
+    def _exact_values(self) -> None:
+        """Each extremum's value computed at its time as a sample there gives it (the
+        exact surroundings), so that the values reported are the samples' values."""
+        found = [
+            (which, key, extremum)
+            for which in (self.lows, self.highs)
+            for key, extremum in which.items()
+            if extremum is not None
+        ]
+        if not found:
+            return
+        times = np.array([extremum.time_s for _, _, extremum in found])
+        # As pointing_samples computes them: the exact surroundings (the shared ones'
+        # exact path: the same ephemeris nodes), the trajectory's attitude.
+        env = self.shared.exact(times)
+        attitude = self.trajectory.attitude(times)
+        angles = {
+            v.name: vector_angles(attitude.apply(v.vector), env) for v in self.spec.body_vectors
+        }
+        for k, (which, (name, quantity), extremum) in enumerate(found):
+            if quantity == "cos_incidence" and extremum.value == 0.0:
+                continue  # the dark's 0, placed from the intervals
+            value = angles[name][quantity][k]
+            which[(name, quantity)] = Extremum(extremum.time_s, float(value))
+
     def result(self) -> PointingAnalysis:
         """The analysis: the accumulated intervals (each condition less what hides it),
         extrema and averages."""
+        self._exact_values()
         grid, spec, found = self.grid, self.spec, self.found
         span = max(grid.stop_s - grid.start_s, 1e-300)
-        umbra = found.get("umbra", [])
+        umbra = self.orbit.get("umbra", [])
         analysis = PointingAnalysis(
             start_s=grid.start_s,
             stop_s=grid.stop_s,
@@ -575,10 +754,10 @@ class _Search:
             orbit="Earth centre" if spec.orbit is None else spec.orbit.describe(),
             grid=grid,
             vectors=[],
-            shadow=found.get("shadow", []),
+            shadow=self.orbit.get("shadow", []),
             umbra=umbra,
-            moon_hidden=found.get("moon_hidden", []),
-            sunlit_fraction_mean=self.sums["sunlit_fraction"] / span,
+            moon_hidden=self.orbit.get("moon_hidden", []),
+            sunlit_fraction_mean=self.sunlit_integral / span,
         )
         for v in spec.body_vectors:
             name = v.name
@@ -589,7 +768,7 @@ class _Search:
             }
             item = VectorAnalysis(
                 vector=v,
-                extrema=extrema,
+                extrema=extrema,  # type: ignore[arg-type]
                 sun_visible=difference(found[f"{name}.sun_visible"], umbra),
                 sun_exclusion=difference(found.get(f"{name}.sun_exclusion", []), umbra),
                 moon_exclusion=difference(
@@ -601,9 +780,36 @@ class _Search:
             )
             item.blinded = union(*(getattr(item, kind) for kind in v.exclusions))
             low, high = extrema["cos_incidence"]
-            item.extrema["cos_incidence"] = (_first_dark(item, grid) or low, high)
+            item.extrema["cos_incidence"] = (_first_dark(item, grid) or low, high)  # type: ignore[assignment]
             analysis.vectors.append(item)
         return analysis
+
+
+def _orbit_only(
+    shared: SharedSurroundings, grid: SearchGrid, precision: float
+) -> tuple[dict[str, list[Interval]], float]:
+    """The eclipses and the Moon behind the Earth over the span of ``grid`` (each
+    interval found however short: the geometry's rate bounds each function, 1 + the
+    Sun's and Moon's rates for the angles' sums), and the integral of the lit fraction
+    (the span less, in the shadow, the umbra's length and the penumbra's unlit part by
+    Gauss–Legendre on each stretch)."""
+    τ = _grid_points(grid.start_s, grid.stop_s, _ORBIT_STEP_S)
+
+    def evaluate(t: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
+        return _orbit_conditions(shared.at(t))
+
+    rate = 2.0 * grid._geometry_rate
+    found = find_all_intervals(
+        evaluate, τ, precision, evaluate(τ), dict.fromkeys(("shadow", "umbra", "moon_hidden"), rate)
+    )
+    x, w = np.polynomial.legendre.leggauss(_PENUMBRA_POINTS)
+    unlit = 0.0
+    for piece in difference(found["shadow"], found["umbra"]):
+        half = 0.5 * (piece.end_s - piece.start_s)
+        t = piece.start_s + half * (1.0 + x)
+        unlit += half * float(np.sum(w * (1.0 - shared.at(t).sunlit_fraction)))
+    unlit += sum(i.end_s - i.start_s for i in found["umbra"])
+    return found, (grid.stop_s - grid.start_s) - unlit
 
 
 def pointing_analysis(
@@ -612,25 +818,53 @@ def pointing_analysis(
     start_s: float | None = None,
     stop_s: float | None = None,
     grid: SearchGrid | None = None,
+    surroundings: SharedSurroundings | None = None,
 ) -> PointingAnalysis:
     """Every interval and extremum of ``spec``'s pointing over [start_s, stop_s] (TT s
     since the epoch; the output span by default), on the exact motion.
 
-    The span is searched in chunks of :data:`CHUNK_POINTS` grid points (see the
-    module notes for the grid): memory does not grow with the span, only the list of
-    intervals found.  Interval ends are refined to ``spec.interval_precision_s``,
-    extrema to 1 µs.
+    Torque-free segments are searched on their structure
+    (:mod:`attitude.pointing.free_search`), the others on a grid, both in windows of
+    bounded size (see the module notes): memory does not grow with the span, only the
+    list of intervals found.  Interval ends are refined to
+    ``spec.interval_precision_s``, extrema to 1 µs.  ``surroundings``: the
+    :class:`~attitude.pointing.shared_surroundings.SharedSurroundings` to use (one
+    covering the span, for the same epoch, orbit and limb height); by default the
+    process's cached one (:func:`~attitude.pointing.shared_surroundings
+    .shared_surroundings`).
     """
     spec = for_scenario(spec, trajectory.scenario)  # the scenario's orbit, if the spec has none
     if grid is None:
         grid = search_grid(trajectory, spec, start_s, stop_s)
-    search = _Search(trajectory, spec, grid)
-    events_s = np.array([t for t, _ in trajectory.scenario.events], dtype=np.float64)
-    first = 0
-    while first < grid.count - 1:
-        last = min(first + CHUNK_POINTS, grid.count - 1)
-        search.chunk(_grid_points(grid, first, last, events_s))
-        first = last
+    shared = surroundings
+    if shared is None or not shared.covers(grid.start_s, grid.stop_s):
+        shared = shared_surroundings(trajectory, spec, grid.start_s, grid.stop_s)
+    search = _Search(trajectory, spec, grid, shared)
+    search.orbit_only()
+    if spec.body_vectors:
+        # Consecutive torque-free segments are searched together, and so are
+        # consecutive other ones, on the grid.
+        run: list[FreePiece] = []
+        gridded: list[float] = []  # the start and end of the segments to grid
+        for k, segment in _in_span(trajectory, grid.start_s, grid.stop_s):
+            a, b = max(segment.start_s, grid.start_s), min(segment.end_s, grid.stop_s)
+            if b <= a and not (a == b == grid.start_s == grid.stop_s):
+                continue  # an event at the span's end, or two at one epoch
+            plan = grid.plans[k] if k < len(grid.plans) else None
+            if plan is not None and isinstance(segment.solver, EulerSolver):
+                if gridded:
+                    search.gridded(gridded[0], gridded[-1])
+                    gridded = []
+                run.append(FreePiece(segment.solver, plan, a, b, b < grid.stop_s))
+                continue
+            if run:
+                search.free(run)
+                run = []
+            gridded = [gridded[0] if gridded else a, b]
+        if run:
+            search.free(run)
+        if gridded:
+            search.gridded(gridded[0], gridded[-1])
     return search.result()
 
 

@@ -34,6 +34,7 @@ from attitude.trajectory.trajectory import Trajectory
 __all__ = [
     "SunMoonEarth",
     "Surroundings",
+    "assemble",
     "moon_hidden",
     "norm",
     "scenario_jd",
@@ -80,10 +81,16 @@ class SunMoonEarth:
     """
 
     def __init__(
-        self, trajectory: Trajectory, spec: PointingSpec, start_s: float, stop_s: float
+        self,
+        trajectory: Trajectory | None,
+        spec: PointingSpec,
+        start_s: float,
+        stop_s: float,
+        jd: tuple[float, float] | None = None,
     ) -> None:
         self.spec = spec
-        self._jd1, self._jd2 = scenario_jd(trajectory)
+        # The scenario epoch's TT Julian date: the trajectory's, or ``jd`` when given.
+        self._jd1, self._jd2 = scenario_jd(trajectory) if jd is None else jd
         self._bodies = SunMoonFromEarth(
             self._jd1,
             self._jd2 + start_s / SECONDS_PER_DAY,
@@ -91,6 +98,14 @@ class SunMoonEarth:
         )
 
     def at(self, seconds: NDArray[np.float64]) -> Surroundings:
+        return assemble(self.spec, self.fields(seconds))
+
+    def fields(self, seconds: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
+        """What :func:`assemble` builds the surroundings from, at TT ``seconds``: the
+        apparent unit directions of the Sun (``sun``) and the Moon (``moon``) from the
+        spacecraft and, on an orbit, its position ``r`` and velocity ``v`` (GCRS, from
+        the Earth's centre, the orbit's source at every epoch) and the apparent Sun
+        from the Earth's centre, ``sun_from_earth`` (metres: the shadow's axis)."""
         seconds = np.asarray(seconds, dtype=np.float64)
         jd2 = self._jd2 + seconds / SECONDS_PER_DAY
         bodies = self._bodies.at(jd2)
@@ -110,7 +125,7 @@ class SunMoonEarth:
         sun /= np.linalg.norm(sun, axis=-1, keepdims=True)
         moon /= np.linalg.norm(moon, axis=-1, keepdims=True)
         if orbit is None:
-            return Surroundings(sun, moon, np.ones(seconds.size))
+            return {"sun": sun, "moon": moon}
         # The shadow's axis is the apparent Sun from the Earth's centre (attitude.pointing.eclipse).
         zeros = np.zeros_like(r)
         sun_from_earth = apparent_from_observer(
@@ -121,19 +136,29 @@ class SunMoonEarth:
             zeros,
             np.linalg.norm(bodies["sun_m"], axis=-1),
         )
-        a, b, c = shadow_angles(r, sun_from_earth)
-        height = self.spec.earth_limb_atmosphere_height_m
-        return Surroundings(
-            sun,
-            moon,
-            fraction_from_angles(a, b, c),
-            r,
-            v,
-            b,
-            b if height == 0.0 else angular_radius(r, height),
-            (a, b, c),
-            -r / norm(r)[:, None],
-        )
+        return {"sun": sun, "moon": moon, "r": r, "v": v, "sun_from_earth": sun_from_earth}
+
+
+def assemble(spec: PointingSpec, fields: dict[str, NDArray[np.float64]]) -> Surroundings:
+    """The :class:`Surroundings` from the ``fields`` of :meth:`SunMoonEarth.fields` (or
+    of an interpolation of them: :mod:`attitude.pointing.shared_surroundings`)."""
+    sun, moon = fields["sun"], fields["moon"]
+    if "r" not in fields:
+        return Surroundings(sun, moon, np.ones(sun.shape[0]))
+    r, v = fields["r"], fields["v"]
+    a, b, c = shadow_angles(r, fields["sun_from_earth"])
+    height = spec.earth_limb_atmosphere_height_m
+    return Surroundings(
+        sun,
+        moon,
+        fraction_from_angles(a, b, c),
+        r,
+        v,
+        b,
+        b if height == 0.0 else angular_radius(r, height),
+        (a, b, c),
+        -r / norm(r)[:, None],
+    )
 
 
 def moon_hidden(env: Surroundings) -> NDArray[np.float64] | None:

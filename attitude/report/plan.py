@@ -149,7 +149,7 @@ def plan_run(
         )
     budget = estimate(
         samples,
-        0 if search is None else search.count,
+        0 if search is None else search.turn_points,
         vectors,
         on_orbit,
         outputs.formats,
