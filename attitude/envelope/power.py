@@ -1,0 +1,101 @@
+"""The panels' sunlit power after a loss, and the first time it falls below a threshold.
+
+The power fraction of the panels p (body vectors of kind ``panel``) is
+
+    P(t) = λ(t) · (1/n) Σ_p max(cos θ_p(t), 0),
+
+θ_p the angle between the panel's normal and the Sun, λ the lit fraction of the Sun's
+disc (0 in umbra, between 0 and 1 in penumbra: :mod:`attitude.pointing.eclipse`):
+1 when every panel faces the Sun squarely in full light.
+
+:func:`first_below` finds the first time P ≤ c on [a, b] without a grid that could miss
+a dip: P is Lipschitz, |P'| ≤ L with L = λ_max + (1/n) Σ_p max|θ_p'| (each angle's rate
+bound from the search, :meth:`attitude.pointing.search.SearchGrid.vector_angle_rate_bound`,
+and the lit fraction's, :attr:`~attitude.pointing.search.SearchGrid.fraction_rate_bound`,
+which counts only inside the Earth's shadow), so on a cell [t₀, t₁] of width h,
+P ≥ (P(t₀) + P(t₁) − L h)/2.  A cell whose bound exceeds c is settled; the others, in
+time order up to the first node where P ≤ c, are halved until the first is narrower
+than the precision: its left end is the first instant P can reach c (an early answer
+by at most the precision, never a late one).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["first_below", "power_fraction"]
+
+# The first nodes are spaced so that the Lipschitz bound sags at most this much
+# between two of them (a power fraction), and a run of nodes holds at most this many.
+_SAG = 0.05
+_CHUNK_NODES = 8192
+# Halvings at most (a cell of a week halved 60 times is 5e-13 s wide).
+_MAX_HALVINGS = 80
+
+
+def power_fraction(
+    attitude: Callable, sun: Callable, panels: NDArray[np.float64], t: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """P(t) (module notes): ``attitude(t)`` the body → ICRF Rotation, ``sun(t)`` the
+    Sun's unit direction (n, 3) and the lit fraction (n,), ``panels`` (k, 3) unit
+    normals in body axes."""
+    rotation = attitude(t)
+    direction, lit = sun(t)
+    cosines = np.stack([np.einsum("ij,ij->i", rotation.apply(p), direction) for p in panels])
+    return lit * np.mean(np.maximum(cosines, 0.0), axis=0)
+
+
+def first_below(
+    f: Callable[[NDArray[np.float64]], NDArray[np.float64]],
+    a: float,
+    b: float,
+    lipschitz: float,
+    threshold: float,
+    precision: float,
+) -> float | None:
+    """The first t in [a, b] where ``f`` (vectorized, |f'| ≤ ``lipschitz``) may reach
+    ``threshold``, within ``precision`` (s), or None if f stays above it (module notes)."""
+    if f(np.array([a]))[0] <= threshold:
+        return a
+    if b <= a:
+        return None
+    step = 2.0 * _SAG / lipschitz if lipschitz > 0.0 else b - a
+    cells = max(1, math.ceil((b - a) / step))
+    chunk = max(1, math.ceil(cells / math.ceil(cells / _CHUNK_NODES)))
+    edges = np.linspace(a, b, cells + 1)
+    for start in range(0, cells, chunk):
+        t = edges[start : start + chunk + 1]
+        found = _first_in(lambda x: f(x) - threshold, t, lipschitz, precision)
+        if found is not None:
+            return found
+    return None
+
+
+def _first_in(g, t, lipschitz: float, precision: float) -> float | None:
+    """The first cell of nodes ``t`` where g = f − c may reach 0, halved down to
+    ``precision``: its left end, or None."""
+    v = g(t)
+    left, right, v_left, v_right = t[:-1], t[1:], v[:-1], v[1:]
+    for _ in range(_MAX_HALVINGS):
+        below = np.flatnonzero(v_right <= 0.0)
+        last = below[0] + 1 if below.size else left.size
+        left, right, v_left, v_right = left[:last], right[:last], v_left[:last], v_right[:last]
+        open_ = 0.5 * (v_left + v_right - lipschitz * (right - left)) <= 0.0
+        left, right, v_left, v_right = left[open_], right[open_], v_left[open_], v_right[open_]
+        if left.size == 0:
+            return None
+        if right[0] - left[0] <= precision:
+            return float(left[0])
+        middle = 0.5 * (left + right)
+        v_middle = g(middle)
+        left = np.ravel(np.column_stack([left, middle]))
+        right = np.ravel(np.column_stack([middle, right]))
+        v_left, v_right = (
+            np.ravel(np.column_stack([v_left, v_middle])),
+            np.ravel(np.column_stack([v_middle, v_right])),
+        )
+    return float(left[0])  # halved to the limit: the earliest instant it may reach
