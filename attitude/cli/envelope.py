@@ -29,7 +29,7 @@ def command(args, loaded: ScenarioFile, stage: Progress | None = None) -> int:
     stage("checking the scenario and the [envelope] table")
     plan = plan_envelope(loaded)
     check_folder(plan, args.out)
-    bar = None if args.quiet else ProgressBar(sys.stderr)
+    bar = None if args.quiet else ProgressBar(sys.stderr, noun="failures")
     result = simulate(plan, args.scheduler, args.workers, args.batch_size, bar, stage, probed=True)
     failed = result.table[result.table["status"] != "ok"]
     if len(failed) == plan.count:

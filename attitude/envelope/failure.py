@@ -20,10 +20,13 @@ The metrics (columns of the table; times in s after τ; ``inf``: not within the 
 - ``{panel}_least_sun_angle_deg``: the least angle between each panel's normal and the
   Sun over the window;
 - ``power_at_loss``, ``power_mean``: the panels' power fraction at τ and its mean over
-  the window (:mod:`attitude.envelope.power`), ``power_lost_s``: the first time it is at
-  or below the threshold;
-- ``rate_at_loss_deg_s``, ``rate_max_deg_s``, ``rate_max_at_s``: the body rate |ω|
-  (:func:`attitude.trajectory.rates.largest_rate`, on the motion);
+  the window (:mod:`attitude.envelope.power`: the energy the panels collect, as a
+  fraction of full power over the window), ``power_lost_s``: the first time it is at or
+  below the threshold (eclipses included: the Earth's shadow takes the power to 0);
+- ``rate_at_loss_deg_s``, ``rate_max_deg_s``, ``rate_max_at_s``: the body rate |ω| just
+  after the loss (with locked wheels, I⁻¹(I ω_law + h): their momentum passes to the
+  body), and its largest over the window, on the motion
+  (:func:`attitude.trajectory.rates.largest_rate`);
 - ``flips``, ``first_flip_s``: the body's flips (Джанибеков) within the window;
 - ``first_violation_s``: the least of the exclusion times (the first instant any body
   vector is blinded).
@@ -40,7 +43,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-from attitude.envelope.power import first_below, power_fraction
+from attitude.envelope.power import first_below, integral, power_fraction
 from attitude.pointing.search import pointing_analysis
 from attitude.pointing.shared_surroundings import shared_surroundings
 from attitude.pointing.spec import PointingSpec
@@ -176,19 +179,14 @@ def failure_metrics(job: EnvelopeJob, k: int) -> dict[str, Any]:
         grid = analysis.grid
         turning = float(np.mean([grid.vector_angle_rate_bound(i.vector.name) for i in panels]))
         row["power_at_loss"] = float(power(np.array([τ]))[0])
-        row["power_mean"] = float(np.mean([i.mean_cos_incidence for i in panels]))
-        row["power_lost_s"] = _power_lost(
-            power,
-            analysis,
-            τ,
-            end,
-            turning,
-            grid.fraction_rate_bound,
-            job.threshold,
-            analysis.precision_s,
-        )
+        pieces = _pieces(analysis, τ, end, turning, grid.fraction_rate_bound)
+        energy = sum(integral(power, a, b, lipschitz) for a, b, lipschitz in pieces)
+        row["power_mean"] = energy / job.window
+        row["power_lost_s"] = _power_lost(power, pieces, τ, job.threshold, analysis.precision_s)
     segment = trajectory.segments[0]
-    rate0 = float(np.linalg.norm(job.angular_velocities[k]))
+    # The body's rate just after the loss: the law's with spinning wheels, I⁻¹(Iω + h)
+    # with locked ones (their momentum passes to the body).
+    rate0 = float(np.linalg.norm(trajectory.angular_velocity(np.array([τ, τ]))[0]))
     rate, at = largest_rate(segment, τ, end)
     row["rate_at_loss_deg_s"] = math.degrees(rate0)
     row["rate_max_deg_s"] = math.degrees(max(rate, rate0))
@@ -200,10 +198,10 @@ def failure_metrics(job: EnvelopeJob, k: int) -> dict[str, Any]:
     return row
 
 
-def _power_lost(power, analysis, τ, end, turning, fraction_rate, threshold, precision) -> float:
-    """The first time the panels' power fraction reaches ``threshold`` (s after τ):
-    outside the Earth's shadow the lit fraction is 1, and only the panels' turning
-    bounds |P'|; within a shadow the lit fraction's rate adds to it."""
+def _pieces(analysis, τ: float, end: float, turning: float, fraction_rate: float):
+    """[τ, end] cut at the shadow's edges, each piece with its bound on |P'|: outside
+    the Earth's shadow the lit fraction is 1, and only the panels' turning bounds it;
+    within a shadow the lit fraction's rate adds to it."""
     pieces: list[tuple[float, float, float]] = []
     cursor = τ
     for shadow in analysis.shadow:
@@ -216,6 +214,11 @@ def _power_lost(power, analysis, τ, end, turning, fraction_rate, threshold, pre
         cursor = b
     if cursor < end:
         pieces.append((cursor, end, turning))
+    return pieces
+
+
+def _power_lost(power, pieces, τ: float, threshold: float, precision: float) -> float:
+    """The first time the panels' power fraction reaches ``threshold`` (s after τ)."""
     for a, b, lipschitz in pieces:
         found = first_below(power, a, b, lipschitz, threshold, precision)
         if found is not None:

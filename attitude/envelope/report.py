@@ -136,7 +136,7 @@ def _build(result: EnvelopeResult, tmp: Path) -> list[str]:
 def _groups(plan: EnvelopePlan) -> list[tuple[str, list[str]]]:
     """The panels of the figure: metrics of one unit together."""
     metrics = plan.metrics
-    times = [m for m in metrics if m.endswith("_s") and m not in ("rate_max_at_s",)]
+    times = [m for m in metrics if m.endswith("_s") and not m.startswith("rate_")]
     pairs: list[tuple[str, list[str]]] = [
         ("time to first violation, power loss, flip (s after the loss)", times),
         ("least Sun angle of each panel (deg)", [m for m in metrics if m.endswith("_deg")]),
