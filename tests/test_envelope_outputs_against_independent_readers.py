@@ -53,11 +53,11 @@ def test_parquet_and_csv_read_back_by_duckdb_and_csv_agree_with_two_workers(writ
         assert np.allclose(from_csv, theirs, rtol=1e-15, atol=0.0, equal_nan=True), name
     assert list(parquet["epoch_utc"]) == list(two["epoch_utc"])
     assert parquet["epoch_utc"][0].startswith("2025-05-01T10:05:00")
-    assert list(parquet["mode"])[0] == "nadir"
+    assert next(iter(parquet["mode"])) == "nadir"
 
 
 def test_summary_names_the_worst_failure_time_of_the_table(written):
-    path, out = written
+    _path, out = written
     summary = json.loads((out / "summary.json").read_text())
     table = duckdb.sql(f"SELECT * FROM read_parquet('{out / 'envelope.parquet'}')").df()
     soonest = table["first_violation_s"].min()

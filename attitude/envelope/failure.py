@@ -50,6 +50,7 @@ from attitude.pointing.spec import PointingSpec
 from attitude.scenario.events import State
 from attitude.scenario.modes import Wheels
 from attitude.scenario.scenario import Scenario
+from attitude.solver.euler_solver import EulerSolver
 from attitude.trajectory.handoff import hand_off
 from attitude.trajectory.rates import largest_rate
 from attitude.trajectory.segments import Segment
@@ -169,20 +170,36 @@ def failure_metrics(job: EnvelopeJob, k: int) -> dict[str, Any]:
     if panels:
         normals = np.array([item.vector.vector for item in panels])
 
-        def sun(t):
-            around = shared.at(t)
-            return around.sun_direction, around.sunlit_fraction
+        def power_in(shadow: bool):
+            """P(t); outside the Earth's shadow the lit fraction is 1 (only the Sun's
+            direction is needed there, from the interpolated targets)."""
 
-        def power(t):
-            return power_fraction(trajectory.attitude, sun, normals, np.asarray(t, dtype=float))
+            def sun(t):
+                if shadow:
+                    around = shared.at(t)
+                    return around.sun_direction, around.sunlit_fraction
+                return shared.targets(t).sun, 1.0
 
+            def power(t):
+                t = np.asarray(t, dtype=float)
+                return power_fraction(segment.solver.attitude, sun, normals, t)
+
+            return power
+
+        segment = trajectory.segments[0]
         grid = analysis.grid
         turning = float(np.mean([grid.vector_angle_rate_bound(i.vector.name) for i in panels]))
-        row["power_at_loss"] = float(power(np.array([τ]))[0])
+        row["power_at_loss"] = float(power_in(True)(np.array([τ, τ]))[0])
         pieces = _pieces(analysis, τ, end, turning, grid.fraction_rate_bound)
-        energy = sum(integral(power, a, b, lipschitz) for a, b, lipschitz in pieces)
-        row["power_mean"] = energy / job.window
-        row["power_lost_s"] = _power_lost(power, pieces, τ, job.threshold, analysis.precision_s)
+        if isinstance(segment.solver, EulerSolver):
+            # The free search integrates the incidence exactly on each cell's quintic.
+            row["power_mean"] = float(np.mean([i.mean_cos_incidence for i in panels]))
+        else:  # the grid search's trapezoid is coarse: Gauss–Legendre between the edges
+            energy = sum(
+                integral(power_in(shadow), a, b, lipschitz) for a, b, lipschitz, shadow in pieces
+            )
+            row["power_mean"] = energy / job.window
+        row["power_lost_s"] = _power_lost(power_in, pieces, τ, job.threshold, analysis.precision_s)
     segment = trajectory.segments[0]
     # The body's rate just after the loss: the law's with spinning wheels, I⁻¹(Iω + h)
     # with locked ones (their momentum passes to the body).
@@ -202,25 +219,25 @@ def _pieces(analysis, τ: float, end: float, turning: float, fraction_rate: floa
     """[τ, end] cut at the shadow's edges, each piece with its bound on |P'|: outside
     the Earth's shadow the lit fraction is 1, and only the panels' turning bounds it;
     within a shadow the lit fraction's rate adds to it."""
-    pieces: list[tuple[float, float, float]] = []
+    pieces: list[tuple[float, float, float, bool]] = []
     cursor = τ
     for shadow in analysis.shadow:
         a, b = max(shadow.start_s, τ), min(shadow.end_s, end)
         if b < a:
             continue
         if a > cursor:
-            pieces.append((cursor, a, turning))
-        pieces.append((a, b, turning + fraction_rate))
+            pieces.append((cursor, a, turning, False))
+        pieces.append((a, b, turning + fraction_rate, True))
         cursor = b
     if cursor < end:
-        pieces.append((cursor, end, turning))
+        pieces.append((cursor, end, turning, False))
     return pieces
 
 
-def _power_lost(power, pieces, τ: float, threshold: float, precision: float) -> float:
+def _power_lost(power_in, pieces, τ: float, threshold: float, precision: float) -> float:
     """The first time the panels' power fraction reaches ``threshold`` (s after τ)."""
-    for a, b, lipschitz in pieces:
-        found = first_below(power, a, b, lipschitz, threshold, precision)
+    for a, b, lipschitz, shadow in pieces:
+        found = first_below(power_in(shadow), a, b, lipschitz, threshold, precision)
         if found is not None:
             return found - τ
     return math.inf

@@ -48,7 +48,7 @@ def power_fraction(
     attitude: Callable, sun: Callable, panels: NDArray[np.float64], t: NDArray[np.float64]
 ) -> NDArray[np.float64]:
     """P(t) (module notes): ``attitude(t)`` the body → ICRF Rotation, ``sun(t)`` the
-    Sun's unit direction (n, 3) and the lit fraction (n,), ``panels`` (k, 3) unit
+    Sun's unit direction (n, 3) and the lit fraction (n,) or 1, ``panels`` (k, 3) unit
     normals in body axes."""
     rotation = attitude(t)
     direction, lit = sun(t)
