@@ -155,7 +155,8 @@ def main() -> None:
         f"{1e3 * ours_a.max():.1f}); Basilisk RK4 {STEP_S} s median "
         f"{1e3 * np.median(theirs_a):.0f} ms (range {1e3 * theirs_a.min():.0f}-"
         f"{1e3 * theirs_a.max():.0f}); ratio of medians "
-        f"{np.median(theirs_a) / np.median(ours_a):.0f}x, of sums {theirs_a.sum() / ours_a.sum():.0f}x"
+        f"{np.median(theirs_a) / np.median(ours_a):.0f}x, "
+        f"of sums {theirs_a.sum() / ours_a.sum():.0f}x"
     )
     print(
         f"Basilisk's attitude error over the hour (against the exact motion): max "
