@@ -324,3 +324,22 @@ def test_a_target_that_never_rises_is_stated(tmp_path, capsys):
     target = [s for s in summary["guidance"]["segments"] if s.get("law") == "target"]
     assert [s["ground_site_visible"] for s in target if "ground_site_visible" in s] == [False]
     assert math.isfinite(target[-1]["rate_bound_deg_s"])
+
+
+def test_the_hand_off_refuses_absurd_wheel_momentum_in_python():
+    # The functions the envelope calls refuse what a scenario's control_loss refuses:
+    # 2e7 N m s about y would turn the body at 1.9e4 rad/s (|I⁻¹h|).
+    from scipy.spatial.transform import Rotation
+
+    from attitude import Wheels, hand_off, hand_off_states
+
+    inertia = [820.0, 1040.0, 610.0]
+    for case in ("locked", "spinning"):
+        wheels = Wheels(case, [0.0, 2.0e7, 0.0])
+        with pytest.raises(InputError, match=r"1\.92e\+04 rad/s .*no reaction wheel") as caught:
+            hand_off(Rotation.identity(), [0.0, 1e-3, 0.0], inertia, wheels=wheels)
+        assert caught.value.key == "wheels.momentum"
+        bound = SunLaw("+z", "+x").bind(Time("2025-05-01T10:00:00", scale="utc"), 0.0, 60.0, None)
+        with pytest.raises(InputError, match=r"no reaction wheel") as caught:
+            hand_off_states(bound.state([0.0, 30.0]), inertia, wheels)
+        assert caught.value.key == "wheels.momentum"

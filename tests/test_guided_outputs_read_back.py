@@ -17,10 +17,14 @@ with a star tracker and a panel.
    extreme than a sample, and within 1e-4 deg of the refined sampled extremum.
 4. summary.json states each slew's angle and duration, the law of each segment and
    the control loss.
+5. The search of the mixed run (the free segment after the loss on the motion's
+   structure, the guided and slewing ones on the grid with their rate bounds) against
+   the grid search of every segment: the same intervals and extrema.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 
@@ -47,6 +51,7 @@ from attitude.environment.timescales import tt_seconds
 from attitude.laws.slews import SlewLimits
 from attitude.outputs.formats import OutputChoice
 from attitude.pointing.sampling import pointing_samples
+from attitude.pointing.search import pointing_analysis, search_grid
 from attitude.scenario.modes import ControlLoss, ControlResume, ModeChange, Wheels
 
 EPOCH = Time("2025-05-01T10:00:00", scale="utc")
@@ -205,3 +210,15 @@ def test_summary_states_the_slews_laws_and_control_loss(run):
     jump = np.radians(np.array(loss["rate_after_deg_s"]) - np.array(loss["rate_before_deg_s"]))
     assert np.allclose(jump * [820.0, 1040.0, 610.0], [0.0, 2.0, 0.0], atol=1e-12)
     assert on_disk["motion"]["segments"][3]["motion"] in ("periodic", "steady spin")
+
+
+def test_the_mixed_runs_search_against_the_grid_search(run):
+    from test_search_against_grid_search import assert_same
+
+    _, trajectory, _, _ = run
+    grid = search_grid(trajectory, SPEC)
+    # Only the segment after the loss (locked wheels: torque-free) has a structural plan.
+    assert [plan is not None for plan in grid.plans] == [False, False, False, True, False, False]
+    structural = pointing_analysis(trajectory, SPEC, grid=grid)
+    gridded = pointing_analysis(trajectory, SPEC, grid=dataclasses.replace(grid, plans=()))
+    assert_same(structural, gridded)

@@ -37,6 +37,7 @@ from attitude.report.beside import Beside
 from attitude.scenario.scenario import Scenario
 from attitude.trajectory.guided import GUIDED
 from attitude.trajectory.horizon import ValidityHorizon, validity_horizon
+from attitude.trajectory.modes import uses_laws
 from attitude.trajectory.motion import SegmentMotion, analyze, undersampling_note
 from attitude.trajectory.steps import CHECK_BUDGET_S
 from attitude.trajectory.trajectory import Trajectory, propagate
@@ -178,6 +179,9 @@ def _propagating(scenario: Scenario, check: bool) -> str:
     way: ``attitude.trajectory.steps``)."""
     segments = len(scenario.events) + 1
     text = f"propagating {segments} segment{'s' if segments > 1 else ''}"
+    if uses_laws(scenario):  # a slew adds a segment of its own, known once it is made
+        count = len(scenario.events)
+        text = f"propagating the modes through {count} event{'s' if count != 1 else ''}"
     what = []
     if scenario.torques.gravity_gradient is not None:
         what.append("gravity gradient")

@@ -90,9 +90,10 @@ class Wheels:
     def momentum_vector(self) -> NDArray[np.float64]:
         return np.asarray(self.momentum, dtype=np.float64)
 
-    def check_against(self, inertia_tensor: NDArray[np.float64], key: str) -> None:
+    def check_against(self, inertia_tensor: NDArray[np.float64], key: str = "") -> None:
         """Refuse a momentum that would turn the body beyond :data:`MAX_WHEEL_RATE_RAD_S`
-        (|I⁻¹h|): no wheel holds it; ``key`` names the event."""
+        (|I⁻¹h|): no wheel holds it; ``key`` names the event (none: the wheels alone,
+        ``wheels.momentum``)."""
         rate = float(np.linalg.norm(np.linalg.solve(inertia_tensor, self.momentum_vector)))
         if not rate <= MAX_WHEEL_RATE_RAD_S:
             raise InputError(
@@ -100,7 +101,7 @@ class Wheels:
                 f"the body at {rate:.3g} rad/s ({rate * 30.0 / math.pi:.3g} rpm, |I⁻¹h|): no "
                 f"reaction wheel holds that much (at most {MAX_WHEEL_RATE_RAD_S:g} rad/s is "
                 "accepted); give the wheels' momentum in N m s",
-                key=f"{key}.wheels.momentum",
+                key=f"{key}.wheels.momentum" if key else "wheels.momentum",
                 value=self.momentum_vector,
             )
 

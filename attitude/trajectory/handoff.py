@@ -69,7 +69,8 @@ def hand_off(
     """The motion from a control loss at ``t0`` (s): ``attitude`` (body → ICRF) and
     ``angular_velocity`` (body axes, rad/s) are the law's state there; ``inertia``: 3
     principal moments, a 3×3 tensor (body axes, kg m²) or a ``PrincipalAxes``;
-    ``wheels``: :class:`~attitude.scenario.modes.Wheels` (None: no stored momentum).
+    ``wheels``: :class:`~attitude.scenario.modes.Wheels` (None: no stored momentum;
+    a momentum no wheel holds, |I⁻¹h| > 100 rad/s, is refused as in a scenario).
 
     Returns the exact :class:`EulerSolver` for locked wheels without torques, else a
     :class:`TorquedSolver` (spinning wheels: a gyrostat; ``torques``: torque models of
@@ -80,6 +81,8 @@ def hand_off(
     """
     tensor = _tensor(inertia)
     ω = as_vector3(angular_velocity, "angular_velocity", "angular_velocity")
+    if wheels is not None:  # the refusal a scenario's control_loss gets
+        wheels.check_against(tensor)
     h = np.zeros(3) if wheels is None else wheels.momentum_vector
     M = tensor @ ω + h
     spinning = wheels is not None and wheels.case == "spinning"
@@ -128,5 +131,7 @@ def hand_off_states(
     ω = np.asarray(state.angular_velocity, dtype=np.float64)
     if ω.ndim != 2 or ω.shape[1] != 3:
         raise InputError(f"state.angular_velocity must be (n, 3), got {ω.shape}")
+    if wheels is not None:
+        wheels.check_against(tensor)
     h = np.zeros(3) if wheels is None else wheels.momentum_vector
     return state.attitude, ω @ tensor.T + h

@@ -23,9 +23,10 @@ attitude, its controller absorbs them.  Every segment boundary is a non-smooth
 instant of the attitude or its rate (a mode change, a slew's start and end, a control
 loss or resume), and each is a segment of the AEM.
 
-:func:`mode_segments` returns the segments as tuples for
-:mod:`attitude.trajectory.trajectory`, which hands in its own builder of free and
-torqued solvers (so that both paths make them alike).  A ground site a law tracks is
+:func:`mode_segments` returns the segments for :mod:`attitude.trajectory.segments`,
+which hands in its own makers of free and torqued solvers and of checked
+:class:`~attitude.trajectory.segments.Segment` objects (so that scenarios with and
+without laws make them alike, with the same checks and error keys).  A ground site a law tracks is
 checked for visibility over its segment (``GuidedMotion.passes``): one that never rises
 above the horizon is a note of that segment (``GuidedMotion.notes``, with the Earth
 orientation table's coverage), stated by ``check`` and in the summary.
