@@ -206,3 +206,16 @@ def test_a_hostile_file_ends_cleanly(path, tmp_path, capsys, monkeypatch):
     code, err, _ = _call(capsys, ["run", str(scenario), "--out", str(user), "--quiet"])
     assert code == 2 and len(err) == 1, err
     assert _snapshot(user) == before
+
+
+def test_a_runaway_burn_is_refused_before_its_motion_is_analysed(tmp_path, capsys):
+    """The AEM's time-tag limit follows from the segments' rate bounds: `run` refuses
+    the runaway burn at the stage `check` does, before the analysis of 1.5e5 rad/s
+    (flips and the largest rate over 120 000 turns), which would take minutes."""
+    scenario = tmp_path / "runaway_burn.toml"
+    shutil.copyfile(Path(__file__).parent / "hostile" / "runaway_burn.toml", scenario)
+    code = main(["run", str(scenario), "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert "choosing the AEM" not in err and "analysing the motion" not in err, err
+    assert "1 ns time tag" in err

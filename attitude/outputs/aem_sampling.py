@@ -358,23 +358,17 @@ def _test_intervals(
     return np.unique(np.concatenate(picked))
 
 
-def _plan_segment(
-    index: int,
-    segment: Segment,
-    motion: SegmentMotion,
-    start_s: float,
-    end_s: float,
-    tolerance_rad: float,
-    started_by: str | None,
-) -> AemSegmentPlan:
-    length = end_s - start_s
-    most = max(2, int(length / _MIN_STEP_S) + 1)  # records ≥ 2 ns apart
+def _largest_rate(segment: Segment) -> float:
+    """The segment's largest body rate bound, G / I_min (rad/s)."""
     solver = segment.solver
     G = solver.angular_momentum_norm
-    rate = G / float(np.min(solver.moments_of_inertia)) if G > 0.0 else 0.0
-    degree = INTERPOLATION_DEGREE
-    if rate == 0.0 or most <= 2:  # at rest: constant
-        return AemSegmentPlan(index, start_s, end_s, 2, 1, 0.0, 0.0, started_by, None, rate)
+    return G / float(np.min(solver.moments_of_inertia)) if G > 0.0 else 0.0
+
+
+def _time_tags_error(index: int, segment: Segment, end_s: float, tolerance_rad: float) -> float:
+    """The attitude error (rad) of rounding a record's time to the AEM's 1 ns time
+    tag at the segment's largest rate; refused when it takes half the tolerance."""
+    rate = _largest_rate(segment)
     time_tags = rate * (_TIME_TAG_S + float(np.spacing(max(abs(end_s), 1.0))))
     if time_tags >= 0.5 * tolerance_rad:
         # The rate's fault, and the key that set it (a runaway burn, a state's absurd
@@ -392,6 +386,50 @@ def _plan_segment(
             f"segment {index}, which turns at up to {rate:.3g} rad/s ({time_tags:.2g} rad in "
             "the rounding of a time tag): give a larger tolerance"
         )
+    return time_tags
+
+
+def check_time_tags(
+    trajectory: Trajectory,
+    start_s: float,
+    stop_s: float,
+    tolerance_rad: float = DEFAULT_TOLERANCE_RAD,
+    name: str = "aem_tolerance",
+) -> None:
+    """Refuse, as :func:`plan_aem` would, a segment too fast for 1 ns time tags to
+    meet ``tolerance_rad``, from the segments' rate bounds alone: a run checks this
+    before the motion's analysis, which takes minutes on such a motion."""
+    tolerance_rad = check_tolerance(tolerance_rad, name)
+    for index, segment in enumerate(trajectory.segments):
+        if min(segment.end_s, stop_s) - max(segment.start_s, start_s) <= SAME_INSTANT_S:
+            continue
+        if _largest_rate(segment) == 0.0:
+            continue
+        for start, end, _ in _pieces(segment, start_s, stop_s):
+            if int((end - start) / _MIN_STEP_S) + 1 <= 2:
+                continue  # constant in the file: no interpolation to spoil
+            try:
+                _time_tags_error(index, segment, end, tolerance_rad)
+            except InputError as exc:
+                raise (exc if exc.key else exc.located(key=name)) from None
+
+
+def _plan_segment(
+    index: int,
+    segment: Segment,
+    motion: SegmentMotion,
+    start_s: float,
+    end_s: float,
+    tolerance_rad: float,
+    started_by: str | None,
+) -> AemSegmentPlan:
+    length = end_s - start_s
+    most = max(2, int(length / _MIN_STEP_S) + 1)  # records ≥ 2 ns apart
+    rate = _largest_rate(segment)
+    degree = INTERPOLATION_DEGREE
+    if rate == 0.0 or most <= 2:  # at rest: constant
+        return AemSegmentPlan(index, start_s, end_s, 2, 1, 0.0, 0.0, started_by, None, rate)
+    time_tags = _time_tags_error(index, segment, end_s, tolerance_rad)
     target = _TARGET * tolerance_rad - time_tags
     # The first guess: a uniform rotation at the largest rate, end-interval constant.
     constant = 528.0 / math.factorial(degree + 1)  # max |∏(x − i)|, x in the first interval

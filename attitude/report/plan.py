@@ -26,7 +26,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from attitude.base.errors import InputError
-from attitude.outputs.aem_sampling import AemPlan, plan_aem
+from attitude.outputs.aem_sampling import AemPlan, check_time_tags, plan_aem
 from attitude.outputs.budget import OutputBudget, check_fits, estimate
 from attitude.outputs.csv import pointing_column_count
 from attitude.outputs.formats import OutputChoice
@@ -117,6 +117,14 @@ def plan_run(
                 key="torques.step",
                 value=steps.step_s,
             )
+    if "aem" in outputs:  # from the rate bounds: the analysis of a runaway motion is long
+        check_time_tags(
+            trajectory,
+            scenario.start_s,
+            scenario.stop_s,
+            outputs.aem_tolerance_rad,
+            outputs.tolerance_key,
+        )
     say("analysing the motion (flips, nutation, spin, precession)")
     motion = analyze(trajectory, locate=not check)
     if not pointing.is_empty:
