@@ -34,6 +34,7 @@ orientation table's coverage), stated by ``check`` and in the summary.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -52,7 +53,13 @@ from attitude.torques.solver import TorquedSolver
 from attitude.trajectory.guided import GuidedMotion
 from attitude.trajectory.torqued import TorquedMotion
 
-__all__ = ["GYROSTAT_ACCURACY_RAD", "law_initial_state", "mode_segments", "uses_laws"]
+__all__ = [
+    "GYROSTAT_ACCURACY_RAD",
+    "GYROSTAT_SEARCH_MAX_STEPS",
+    "law_initial_state",
+    "mode_segments",
+    "uses_laws",
+]
 
 # The accuracy (rad) a gyrostat's step is chosen for when [torques] states none: the
 # gyroscopic term is not small, and the splitting's dense output bends at each grid
@@ -60,6 +67,11 @@ __all__ = ["GYROSTAT_ACCURACY_RAD", "law_initial_state", "mode_segments", "uses_
 # (Orekit's AEM reader) sees at 3.5 times the accuracy: a tenth of the AEM's default
 # tolerance (1e-6 rad) keeps it within (measured: 3.5e-7 rad on the example).
 GYROSTAT_ACCURACY_RAD = 1e-7
+# A gyrostat segment's step search runs the whole segment at each step it tries (and
+# at twice it): one whose first try would take more steps than this (about 10 s of CPU)
+# is refused before it starts, so that `check` answers in seconds and an absurd span
+# (years of tumbling) is one line, not hours; a given [torques] step has no search.
+GYROSTAT_SEARCH_MAX_STEPS = 2e5
 
 
 def uses_laws(scenario: Scenario) -> bool:
@@ -94,6 +106,8 @@ class _Builder:
         self.segments: list[Any] = []
         self.wheels: Wheels | None = None  # spinning wheels of the free body, or None
         self.law_key = ""
+        # Why the body is free, for refusals: since a control_loss, or from the epoch.
+        self.free_since = "from the epoch: [initial_state] gives no law"
 
     # ---- helpers
 
@@ -330,6 +344,7 @@ class _Builder:
             momentum = before.inertia.tensor @ rate + wheels.momentum_vector
             after = State(before.attitude, momentum, before.inertia)
             self.wheels = wheels if wheels.case == "spinning" else None
+            self.free_since = f"since {self.at(event, offset)}"
             where = (f"{key}.wheels", f"the state after {self.at(event, offset)}")
             return self.free_stretch(after, offset, end, where, event, before), False
         if isinstance(event, ControlResume):
@@ -363,13 +378,13 @@ class _Builder:
             return state, True
         if isinstance(event, ModeChange | ControlLoss):
             advice = (
-                "use control_resume to return to a law"
+                "use control_resume to give the body a law"
                 if isinstance(event, ModeChange)
-                else "it is already lost"
+                else "control is already lost"
             )
             raise InputError(
-                f"{self.at(event, offset)}: control is lost there (since an earlier "
-                f"control_loss): {advice}",
+                f"{self.at(event, offset)}: no law holds the attitude there "
+                f"({self.free_since}): {advice}",
                 key=key,
             )
         after = event.apply(before)
@@ -408,6 +423,20 @@ def _gyrostat_step(
     if span <= SAME_INSTANT_S:
         return max(span, 1.0), 0.0
     accuracy = settings.accuracy if settings.accuracy is not None else GYROSTAT_ACCURACY_RAD
+    # The search's first step (TorquedSolver's): half a quarter turn at the faster of
+    # the body's rate I⁻¹M and the gyroscopic turn |I⁻¹h|.
+    tensor = state.inertia.tensor
+    rate = max(
+        float(np.linalg.norm(np.linalg.solve(tensor, state.angular_momentum))),
+        float(np.linalg.norm(np.linalg.solve(tensor, np.asarray(wheels, dtype=np.float64)))),
+    )
+    first = min(0.5 * span, math.pi / (4.0 * rate)) if rate > 0.0 else 0.5 * span
+    if span / first > GYROSTAT_SEARCH_MAX_STEPS:
+        raise InputError(
+            f"choosing the gyrostat's step for {accuracy:g} rad over its {span:.6g} s would "
+            f"start at {first:.3g} s, {span / first:.3g} steps a try (at most "
+            f"{GYROSTAT_SEARCH_MAX_STEPS:g}): give [torques] step, or a shorter span"
+        )
     chooser = TorquedSolver(
         state.inertia.tensor,
         state.angular_momentum,
