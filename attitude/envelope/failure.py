@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import math
 import time
+import weakref
 from dataclasses import dataclass
 from typing import Any
 
@@ -44,8 +45,8 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from attitude.envelope.power import first_below, integral, power_fraction
-from attitude.pointing.search import pointing_analysis
-from attitude.pointing.shared_surroundings import shared_surroundings
+from attitude.pointing.search import OrbitIntervals, pointing_analysis
+from attitude.pointing.shared_surroundings import SharedSurroundings, shared_surroundings
 from attitude.pointing.spec import PointingSpec
 from attitude.scenario.events import State
 from attitude.scenario.modes import Wheels
@@ -79,7 +80,7 @@ def metric_names(spec: PointingSpec) -> list[str]:
     return names
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class EnvelopeJob:
     """What every task needs (scattered once to each worker).
 
@@ -89,7 +90,9 @@ class EnvelopeJob:
     body → ICRF) and ``momenta`` (N m s, body axes): the hand-off states there, and the nominal
     rates ``angular_velocities`` (rad/s, body axes);
     ``wheels``; ``torques``: (start, stop, model) of the torques acting on the free
-    body; ``step``: the splitting's step (None: the exact solver); ``order``.
+    body; ``step``: the splitting's step (None: the exact solver); ``order``;
+    ``orbit``: the eclipses and the Moon behind the Earth over the whole span, found
+    once and cut to each window (None at the Earth's centre).
     """
 
     scenario: Scenario
@@ -105,6 +108,7 @@ class EnvelopeJob:
     step: float | None
     order: int
     columns: tuple[str, ...]
+    orbit: OrbitIntervals | None = None
 
     @property
     def count(self) -> int:
@@ -145,13 +149,37 @@ def _first(intervals, τ: float) -> float:
     return 0.0 if first.starts_before else max(first.start_s - τ, 0.0)
 
 
+def _surroundings(job: EnvelopeJob, trajectory: Trajectory) -> SharedSurroundings:
+    """The job's shared surroundings in this process: looked up once per job (the
+    lookup hashes the orbit), then kept with it."""
+    found = _SURROUNDINGS.get(job)
+    if found is None:
+        found = shared_surroundings(trajectory, job.spec, 0.0, job.scenario.stop_s)
+        _SURROUNDINGS[job] = found
+    return found
+
+
+# Each job's shared surroundings in this process, for as long as the job lives.
+_SURROUNDINGS: weakref.WeakKeyDictionary[EnvelopeJob, SharedSurroundings] = (
+    weakref.WeakKeyDictionary()
+)
+
+
 def failure_metrics(job: EnvelopeJob, k: int) -> dict[str, Any]:
     """The metrics of failure ``k`` (module notes), as one row of the table."""
     τ = float(job.seconds[k])
     end = τ + job.window
     trajectory = motion_after(job, k)
-    shared = shared_surroundings(trajectory, job.spec, 0.0, job.scenario.stop_s)
-    analysis = pointing_analysis(trajectory, job.spec, τ, end, surroundings=shared)
+    shared = _surroundings(job, trajectory)
+    analysis = pointing_analysis(
+        trajectory,
+        job.spec,
+        τ,
+        end,
+        surroundings=shared,
+        orbit=job.orbit,
+        extrema=[(v.name, "sun_angle") for v in job.spec.body_vectors if v.kind == "panel"],
+    )
     row: dict[str, Any] = {}
     firsts = []
     for item in analysis.vectors:

@@ -12,6 +12,7 @@ burns): a law's controller absorbs them, a free body does not.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
@@ -20,11 +21,12 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from attitude.base.errors import InputError
-from attitude.envelope.failure import EnvelopeJob, metric_names
+from attitude.envelope.failure import EnvelopeJob, metric_names, motion_after
 from attitude.envelope.settings import EnvelopeSettings, failure_times, read_envelope
 from attitude.files.scenario_reader import ScenarioFile
 from attitude.laws.align_constrain import LawState
 from attitude.outputs.formats import OutputChoice
+from attitude.pointing.search import orbit_intervals
 from attitude.pointing.spec import PointingSpec, for_scenario
 from attitude.report.plan import RunPlan, plan_run
 from attitude.scenario.events import State
@@ -196,6 +198,10 @@ def make_job(plan: EnvelopePlan) -> tuple[EnvelopeJob, list[str], list[str]]:
         int(scenario.torques.order),
         tuple(plan.metrics),
     )
+    # The eclipses and the Moon behind the Earth depend on the orbit alone: found once
+    # over the whole span, each window takes its part.
+    orbit = orbit_intervals(motion_after(job, 0), spec, 0.0, span.stop_s)
+    job = dataclasses.replace(job, orbit=orbit)
     index = nominal.segment_index(seconds)
     modes = [_mode(nominal.segments[i]) for i in index]
     epochs = [str(text) for text in np.atleast_1d(scenario.iso(seconds))]
