@@ -23,10 +23,11 @@ from attitude import (
     Scenario,
     Wheels,
     load_scenario,
-    loss_of_control_envelope,
     pointing_samples,
     propagate,
 )
+from attitude.envelope.failure import evaluate_batch
+from attitude.envelope.plan import make_job, plan_envelope
 
 SCENARIO = "scenarios/eo_envelope.toml"
 STEP_S = 0.5
@@ -61,9 +62,12 @@ def test_envelope_metrics_against_a_dense_run_after_each_loss(case):
     loaded = load_scenario(SCENARIO)
     wheels = Wheels(case, [0.0, 2.0, 0.0])
     settings = EnvelopeSettings(window=WINDOW_S, times=TAUS, wheels=wheels, power_threshold=0.3)
-    table = loss_of_control_envelope(loaded, settings=settings, workers=1)
-    assert list(table["status"]) == ["ok"] * len(TAUS)
-    for τ, row in zip(TAUS, table.to_dict("records"), strict=True):
+    # Each failure as a worker computes it, in this process (the Dask engine's table
+    # is compared with this in test_envelope_outputs_against_independent_readers).
+    job, _, _ = make_job(plan_envelope(loaded, settings=settings))
+    rows = evaluate_batch(job, 0, job.count).rows
+    assert [row["status"] for row in rows] == ["ok"] * len(TAUS)
+    for τ, row in zip(TAUS, rows, strict=True):
         trajectory, seconds, samples = _separate_run(loaded, τ, wheels)
         # The same hand-off state: the motions agree (the gyrostat's at its step).
         assert row["tau_s"] == τ

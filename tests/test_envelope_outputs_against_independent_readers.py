@@ -1,6 +1,7 @@
 """The envelope's outputs read back by readers that share no code with the writer
 (duckdb for the Parquet table, the csv module for the CSV one, json for the summary),
-the same table from one worker and from two, and the output folder's rules.
+the same table from a cluster of two workers (one failure a task) as from this process
+alone, and the output folder's rules.  One Dask cluster for the whole file.
 """
 
 import csv
@@ -9,12 +10,15 @@ import math
 
 import duckdb
 import numpy as np
+import pandas
 import pytest
 from cli_lines import said
 from envelope_scenarios import with_envelope
 
-from attitude import loss_of_control_envelope
+from attitude import load_scenario
 from attitude.cli.main import main
+from attitude.envelope.failure import evaluate_batch
+from attitude.envelope.plan import make_job, plan_envelope
 
 TABLE = """[envelope]
 times = [300.0, 1920.0, 3300.0, 5100.0]
@@ -26,32 +30,44 @@ power_threshold = 0.3
 
 @pytest.fixture(scope="module")
 def written(tmp_path_factory):
-    """The command's outputs, with one worker."""
+    """The command's outputs, on a local cluster of two workers, one failure a task."""
     tmp = tmp_path_factory.mktemp("envelope")
     path = with_envelope(tmp, TABLE)
     out = tmp / "out"
-    assert main(["envelope", str(path), "--out", str(out), "--workers", "1", "--quiet"]) == 0
+    argv = ["envelope", str(path), "--out", str(out), "--workers", "2", "--batch-size", "1"]
+    assert main([*argv, "--quiet"]) == 0
     return path, out
 
 
-def test_parquet_and_csv_read_back_by_duckdb_and_csv_agree_with_two_workers(written):
+def _alone(path) -> pandas.DataFrame:
+    """The table computed in this process, failure after failure, as one worker would."""
+    plan = plan_envelope(load_scenario(path))
+    job, epochs, modes = make_job(plan)
+    rows = evaluate_batch(job, 0, job.count).rows
+    for row in rows:
+        row["epoch_utc"], row["mode"] = epochs[row["failure"]], modes[row["failure"]]
+    return pandas.DataFrame(rows, columns=plan.columns)
+
+
+def test_parquet_and_csv_read_back_by_duckdb_and_csv_agree_with_one_process(written):
     path, out = written
-    two = loss_of_control_envelope(path, workers=2, batch_size=1)
-    assert list(two["tau_s"]) == [300.0, 1920.0, 3300.0, 5100.0]
-    assert set(two["status"]) == {"ok"}
+    alone = _alone(path)
+    assert list(alone["tau_s"]) == [300.0, 1920.0, 3300.0, 5100.0]
+    assert set(alone["status"]) == {"ok"}
     parquet = duckdb.sql(f"SELECT * FROM read_parquet('{out / 'envelope.parquet'}')").df()
     with open(out / "envelope.csv", newline="") as stream:
         rows = list(csv.DictReader(stream))
-    assert list(parquet.columns) == list(two.columns)
-    assert len(rows) == len(two) == len(parquet)
-    metrics = [c for c in two.columns if c not in ("epoch_utc", "mode", "status", "error")]
+    assert list(parquet.columns) == list(alone.columns)
+    assert len(rows) == len(alone) == len(parquet)
+    metrics = [c for c in alone.columns if c not in ("epoch_utc", "mode", "status", "error")]
     for name in metrics:
-        theirs = two[name].to_numpy(dtype=float)
-        # One worker and two give the same table, to the last bit.
+        theirs = alone[name].to_numpy(dtype=float)
+        # Two workers and this process alone give the same table, to the last bit.
         assert np.array_equal(parquet[name].to_numpy(dtype=float), theirs), name
         from_csv = np.array([float(row[name]) for row in rows])  # "inf" reads as inf
         assert np.allclose(from_csv, theirs, rtol=1e-15, atol=0.0, equal_nan=True), name
-    assert list(parquet["epoch_utc"]) == list(two["epoch_utc"])
+    assert list(parquet["epoch_utc"]) == list(alone["epoch_utc"])
+    assert list(parquet["mode"]) == list(alone["mode"])
     assert parquet["epoch_utc"][0].startswith("2025-05-01T10:05:00")
     assert next(iter(parquet["mode"])) == "nadir"
 

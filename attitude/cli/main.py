@@ -320,6 +320,10 @@ def _checked_run(args, state: dict) -> int:
         outputs = _outputs(args, loaded.outputs)
         # A run computes the validity horizon beside its outputs (attitude.report.run).
         checking = args.command == "check"
+        if "envelope" in loaded.document:  # the table in a moment, before the long checks
+            from attitude.envelope.plan import check_envelope_table
+
+            check_envelope_table(loaded)
         plan = plan_run(
             loaded.scenario,
             loaded.pointing,

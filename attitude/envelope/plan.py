@@ -37,7 +37,7 @@ from attitude.trajectory.modes import _gyrostat_step, uses_laws
 from attitude.trajectory.torqued import scenario_torque_models
 from attitude.trajectory.trajectory import propagate
 
-__all__ = ["EnvelopePlan", "make_job", "nominal_scenario", "plan_envelope"]
+__all__ = ["EnvelopePlan", "check_envelope_table", "make_job", "nominal_scenario", "plan_envelope"]
 
 # The columns before the metrics, and after them.
 LEADING = ("failure", "tau_s", "epoch_utc", "mode")
@@ -103,8 +103,26 @@ def plan_envelope(
         if settings is None:
             raise InputError("give the envelope's settings (an EnvelopeSettings)", key="settings")
     pointing = pointing or PointingSpec()
+    # The table against the scenario first (a moment), then the scenario as a run
+    # checks it (a propagation of the nominal timeline).
+    seconds, wheels = _settings_against(settings, scenario)
     if plan is None:
         plan_run(scenario, pointing, OutputChoice(formats=("csv",)), horizon=False)
+    return EnvelopePlan(name, file, scenario, pointing, settings, seconds, wheels)
+
+
+def check_envelope_table(loaded: ScenarioFile) -> None:
+    """The file's ``[envelope]`` table read and checked against its scenario, as
+    :func:`plan_envelope` does first: ``attitude check`` says what is wrong with the
+    table before checking the rest of the scenario at length."""
+    _settings_against(read_envelope(loaded), loaded.scenario)
+
+
+def _settings_against(
+    settings: EnvelopeSettings, scenario: Scenario
+) -> tuple[NDArray[np.float64], Wheels]:
+    """The failure instants and the wheels of ``settings`` for ``scenario`` (raises
+    :class:`InputError` naming the key)."""
     if not uses_laws(scenario):
         raise InputError(
             "an envelope of control losses needs a nominal timeline under attitude laws "
@@ -114,7 +132,7 @@ def plan_envelope(
     seconds = failure_times(settings, scenario)
     wheels = settings.wheels_for(scenario)
     wheels.check_against(scenario.spacecraft.principal_axes.tensor, "envelope")
-    return EnvelopePlan(name, file, scenario, pointing, settings, seconds, wheels)
+    return seconds, wheels
 
 
 def nominal_scenario(scenario: Scenario, stop_s: float | None = None) -> Scenario:
