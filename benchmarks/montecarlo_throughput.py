@@ -227,10 +227,10 @@ def main(argv: list[str] | None = None) -> dict:
             "mc_sample_on_1_worker_over_in_process_sample": (1.0 / one["samples_per_s"])
             / report["sample_in_process"]["total_s"],
         }
-        from attitude.montecarlo.report import write_report
+        from attitude.montecarlo.report import write_montecarlo_report
 
         start = time.perf_counter()
-        write_report(two_result, folder / "mc")
+        write_montecarlo_report(two_result, folder / "mc")
         report["report_s"] = time.perf_counter() - start
         report["report_bytes"] = {p.name: p.stat().st_size for p in (folder / "mc").iterdir()}
     report["load_average_1min"] = load.stop()

@@ -20,7 +20,7 @@ import pytest
 from attitude.files.scenario_reader import load_scenario
 from attitude.outputs.formats import OutputChoice
 from attitude.report.plan import plan_run
-from attitude.report.run import output_grid, write_report
+from attitude.report.run import write_report
 
 ROOT = Path(__file__).parents[1]
 
@@ -91,7 +91,10 @@ def test_the_summary_and_the_intervals_are_the_same(runs, chunk):
 
 
 def test_the_grid_in_chunks_is_the_grid(tmp_path):
-    """output_grid gives output_seconds' values, chunk by chunk, the odd stop included."""
+    """Scenario.output_seconds(first, stop), chunk by chunk, gives the whole grid's
+    values, the odd stop included; the whole grid is the definition's: start, then the
+    step (to 1e-12 of it), the last gap no longer than a step, stop last, and as many
+    epochs as output_count counts without building them."""
     text = (ROOT / "scenarios" / "boom_deployment.toml").read_text()
     text = re.sub(r"(?m)^step = .*$", "step = 0.37", text)
     path = Path(__file__).parent / "hostile" / "rest.toml"
@@ -100,8 +103,15 @@ def test_the_grid_in_chunks_is_the_grid(tmp_path):
         tmp.write_text(source)
         scenario = load_scenario(tmp).scenario
         whole = scenario.output_seconds()
+        assert whole.size == scenario.output_count()
+        assert whole[0] == scenario.start_s
+        assert abs(whole[-1] - scenario.stop_s) <= 1e-9 * scenario.step_s
+        gaps = np.diff(whole)
+        assert np.allclose(gaps[:-1], scenario.step_s, rtol=1e-12, atol=0.0)
+        assert 0.0 < gaps[-1] <= scenario.step_s * (1 + 1e-12)
         for chunk in (1, 3, 1000, whole.size):
             pieces = [
-                output_grid(scenario, first, first + chunk) for first in range(0, whole.size, chunk)
+                scenario.output_seconds(first, first + chunk)
+                for first in range(0, whole.size, chunk)
             ]
             assert np.array_equal(np.concatenate(pieces), whole)

@@ -153,7 +153,7 @@ def test_a_step_search_that_would_run_away_is_refused(monkeypatch):
     layer refuses such a burn before any search, test_check_refuses_what_run_refuses)."""
     import attitude.torques.solver as torqued_solver
 
-    monkeypatch.setattr(torqued_solver, "_SEARCH_MAX_STEPS", 2e3)
+    monkeypatch.setattr(torqued_solver, "MAX_STEPS", 2e3)
     spin_up = ConstantTorque([0.0, 0.0, 1e4], 0.0, math.inf)
     message = (
         r"tolerance: 1e-06 rad over 100 s would need a step below [\d.e-]+ s, more than "

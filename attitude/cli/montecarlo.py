@@ -12,7 +12,7 @@ from attitude.base.progress import Progress
 from attitude.files.scenario_reader import ScenarioFile
 from attitude.montecarlo.cluster import check_where
 from attitude.montecarlo.plan import emit_samples, plan_montecarlo
-from attitude.montecarlo.report import check_folder, write_report
+from attitude.montecarlo.report import check_folder, write_montecarlo_report
 from attitude.montecarlo.simulation import simulate
 
 __all__ = ["ProgressBar", "command"]
@@ -49,7 +49,7 @@ def command(args, loaded: ScenarioFile, stage: Progress | None = None) -> int:
     if len(failed) == mc.samples:
         first = failed.iloc[0]
         raise InputError(f"every sample failed; sample {first['sample']}: {first['error']}")
-    write_report(result, args.out)
+    write_montecarlo_report(result, args.out)
     if len(failed):
         print(
             f"attitude: note: {loaded.path.name}: {len(failed)} of {mc.samples} samples "

@@ -22,7 +22,7 @@ from attitude.montecarlo.cluster import check_where, check_workers, connect, tas
 from attitude.montecarlo.simulation import choose_batch_size
 
 if TYPE_CHECKING:
-    import pandas  # type: ignore[import-untyped]
+    import pandas
 
 __all__ = ["EnvelopeResult", "simulate"]
 

@@ -19,7 +19,7 @@ from attitude.pointing.spec import PointingSpec
 from attitude.scenario.scenario import Scenario
 
 if TYPE_CHECKING:
-    import pandas  # type: ignore[import-untyped]
+    import pandas
 
 __all__ = ["envelope_result", "loss_of_control_envelope"]
 

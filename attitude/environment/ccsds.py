@@ -166,6 +166,8 @@ def interpolate(
     rows = [basis]
     right = [values[index]]
     if method == "HERMITE":
+        if derivatives is None:
+            raise ValueError("HERMITE interpolation needs the derivatives at the nodes")
         # d/dx T_k(x) at the nodes, and the slopes in x: dv/dx = dv/dt · half.
         slope_basis = np.stack(
             [chebyshev.chebval(x, chebyshev.chebder(np.eye(order)[k])) for k in range(order)],

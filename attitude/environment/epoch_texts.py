@@ -31,12 +31,15 @@ UTC was not a whole number of seconds and drifted, goes through astropy itself.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from attitude.environment.timescales import iso_texts, offline_time, time_from_tt_seconds
+
+if TYPE_CHECKING:
+    from scipy.interpolate import CubicSpline
 
 __all__ = ["TEXT_LENGTH", "EpochTexts"]
 
@@ -71,7 +74,7 @@ class EpochTexts:
         self._fallback = False
         with offline_time():
             uniform = epoch.tai if self.scale == "utc" else epoch
-            self._fallback = self.scale == "utc" and (
+            self._fallback = self.scale == "utc" and bool(
                 np.datetime64(uniform.isot[:10], "D").astype(np.int64) < _UTC_INTEGER_FROM_DAY + 1
             )
             text = iso_texts(Time(uniform, precision=9))  # four-digit years
@@ -92,7 +95,7 @@ class EpochTexts:
             self._offsets = np.round(table["tai_utc"][keep]).astype(np.int64)
             # The TAI count at which each offset takes effect (00:00 UTC of its day).
             self._changes = first[keep] * _DAY_S + self._offsets
-        self._clock = None
+        self._clock: CubicSpline | None = None
         self._clock_span = (0.0, 0.0)
 
     # --- the uniform count -------------------------------------------------------
@@ -119,11 +122,12 @@ class EpochTexts:
         """(TDB − TT) at ``seconds`` minus its value at the epoch: a cubic spline through
         ERFA's series every 6 h (5e-14 s off it)."""
         low, high = float(np.min(seconds)), float(np.max(seconds))
-        if self._clock is None or low < self._clock_span[0] or high > self._clock_span[1]:
-            self._clock = self._tdb_spline(low, high)
-        return self._clock(seconds) - self._clock_at_epoch
+        clock = self._clock
+        if clock is None or low < self._clock_span[0] or high > self._clock_span[1]:
+            clock = self._clock = self._tdb_spline(low, high)
+        return clock(seconds) - self._clock_at_epoch
 
-    def _tdb_spline(self, low: float, high: float):
+    def _tdb_spline(self, low: float, high: float) -> CubicSpline:
         import erfa
         from scipy.interpolate import CubicSpline
 

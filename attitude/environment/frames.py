@@ -111,4 +111,6 @@ def euler_angles_deg(rotation: Rotation, sequence: str) -> NDArray[np.float64]:
     third angles are not unique: scipy sets the third to 0, silently here."""
     with warnings.catch_warnings():
         warnings.filterwarnings("ignore", message="Gimbal lock detected")
-        return rotation.as_euler(sequence, degrees=True)
+        # scipy-stubs types ``seq`` as a Literal of the 24 sequences; scipy takes any
+        # str and refuses a bad one itself.
+        return rotation.as_euler(sequence, degrees=True)  # type: ignore[call-overload]

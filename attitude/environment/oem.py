@@ -160,6 +160,8 @@ class OemOrbit(Orbit):
         return f"{ends[0]} to {ends[1]} UTC"
 
     def _seconds(self, jd1, jd2) -> NDArray[np.float64]:
+        if self._day is None:
+            raise ValueError("the OEM has no segment yet")
         return ((np.asarray(jd1, dtype=np.float64) - self._day) + jd2) * SECONDS_PER_DAY
 
     def _segment_of(self, seconds: NDArray[np.float64]) -> NDArray[np.intp]:

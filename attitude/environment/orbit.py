@@ -207,18 +207,18 @@ class TleOrbit(Orbit):
         errors, r_km, v_km_s = self.satellite.model.sgp4_array(t.whole, utc_fraction)
         if np.any(errors):
             self._fail(t, np.flatnonzero(errors)[0], errors)
-        rotation = self._teme_to_gcrs(jd1, jd2)
+        rotation = self._teme_to_gcrs(jd1, jd2, self.rotation_step_s)
         position_m = np.einsum("nij,nj->ni", rotation, r_km) * 1e3
         velocity_m_s = np.einsum("nij,nj->ni", rotation, v_km_s) * 1e3
         return position_m, velocity_m_s
 
-    def _teme_to_gcrs(self, jd1, jd2) -> NDArray[np.float64]:
+    def _teme_to_gcrs(self, jd1, jd2, rotation_step_s: float) -> NDArray[np.float64]:
         """The TEME → GCRS matrices at each epoch, (n, 3, 3): skyfield's
         ``TEME.rotation_at`` (transposed) on nodes every ``rotation_step_s`` of TT from
         J2000, joined by cubic Lagrange polynomials through the 4 nodes around each."""
         from skyfield.sgp4lib import TEME
 
-        step_days = self.rotation_step_s / SECONDS_PER_DAY
+        step_days = rotation_step_s / SECONDS_PER_DAY
         position = ((jd1 - _ROTATION_ORIGIN_JD) + jd2) / step_days
         below = np.floor(position)
         x = position - below  # in [0, 1)
@@ -339,7 +339,9 @@ class TleOrbit(Orbit):
         return f"SGP4 fails from {when} UTC on: {SGP4_ERRORS[int(errors[index])]}"
 
 
-def _rebuild_tle_orbit(lines, name, rotation_step_s) -> TleOrbit:
+def _rebuild_tle_orbit(
+    lines: tuple[str, str], name: str | None, rotation_step_s: float | None
+) -> TleOrbit:
     return TleOrbit(*lines, name, rotation_step_s=rotation_step_s)
 
 

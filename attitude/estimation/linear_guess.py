@@ -79,10 +79,10 @@ def measured_rates(telemetry: Telemetry, breaks: tuple[float, ...] = ()) -> Rate
     elif telemetry.attitude is not None and len(telemetry.attitude) >= 8:
         q = telemetry.attitude.values
         R = Rotation.from_quat(q, scalar_first=True)
-        dt = np.diff(telemetry.attitude.t)
+        steps = np.diff(telemetry.attitude.t)
         increments = (R[:-1].inv() * R[1:]).as_rotvec()  # body axes, ≈ ω dt
-        t = telemetry.attitude.t[:-1] + 0.5 * dt
-        ω, source = increments / dt[:, None], "quaternions"
+        t = telemetry.attitude.t[:-1] + 0.5 * steps
+        ω, source = increments / steps[:, None], "quaternions"
     else:
         return None
     # |ω| within a factor √3, and no square to underflow (a norm of 1e-200 rad/s is 0).

@@ -75,6 +75,11 @@ def left_jacobian_inverse(r: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.eye(3) - 0.5 * K + c[:, None, None] * (K @ K)
 
 
+# One solver's stretch of a prediction: m_p (N, 3), Q_p (a Rotation, or None when the
+# attitude is not needed) and ∂(δθ_p, m_p)/∂x (N, 6, n, or None without the Jacobian).
+_Piece = tuple[NDArray[np.float64], Rotation | None, NDArray[np.float64] | None]
+
+
 @dataclass(frozen=True)
 class Impulse:
     """A known angular impulse: at ``t`` (s from t = 0), ``vector`` (N m s) in body axes
@@ -255,7 +260,7 @@ class ExactModel:
         Ar = A.as_matrix()
         need_attitude = t_attitude is not None or any(i.frame != "body" for i in self.impulses)
         rates, attitudes = Prediction(), Prediction()
-        pieces = {"rates": [], "attitude": []}
+        pieces: dict[str, list[tuple[NDArray[np.intp], _Piece]]] = {"rates": [], "attitude": []}
         events = sorted(self.impulses, key=lambda i: i.t)
         # A sample within a nanosecond before an impulse is at it, and after it (the
         # scenarios' rule: an epoch's outputs are the post-event state).
@@ -276,8 +281,11 @@ class ExactModel:
             if k == len(events):
                 break
             event = events[k]
-            at = self._segment(solver, np.array([event.t]), D, J, need_attitude, True)
-            m_end, Q_end, dY = at[0][0], at[1][0] if need_attitude else Q_p, at[2][0]
+            m_at, Q_at, dY_at = self._segment(
+                solver, np.array([event.t]), D, J, need_attitude, True
+            )
+            assert dY_at is not None and (Q_at is not None or not need_attitude)  # asked for
+            m_end, Q_end, dY = m_at[0], Q_at[0] if Q_at is not None else Q_p, dY_at[0]
             D = np.concatenate([dY, D[6:9]], axis=0)
             if event.frame == "body":
                 Δm = Ar.T @ event.vector
@@ -293,13 +301,13 @@ class ExactModel:
             dY_all = np.empty((t_rates.size, 6, L.size)) if jacobian else None
             for inside, (m, _, dY) in pieces["rates"]:
                 m_all[inside] = m
-                if jacobian:
+                if dY_all is not None and dY is not None:
                     dY_all[inside] = dY
             ω_p = m_all * ω_scale
             rates.ω = ω_p @ Ar.T
             if L.bias:  # what the gyro reads: the rate plus its bias
                 rates.ω = rates.ω + x[L.block("b")] * self.rate_unit
-            if jacobian:
+            if dY_all is not None:
                 dJ = D[6:9]  # the moments do not change at an impulse
                 dω_p = (
                     dY_all[:, 3:6, :] * ω_scale[None, :, None]
@@ -315,17 +323,18 @@ class ExactModel:
             quats = np.empty((t_attitude.size, 4))
             dθ = np.empty((t_attitude.size, 3, L.size)) if jacobian else None
             for inside, (_, R, dY) in pieces["attitude"]:
+                assert R is not None  # need_attitude holds with t_attitude
                 quats[inside] = (R * A.inv()).as_quat()
-                if jacobian:
+                if dθ is not None and dY is not None:
                     dθ[inside] = np.einsum("ij,njp->nip", Ar, dY[:, 0:3, :])
             attitudes.attitude = Rotation.from_quat(quats)
-            if jacobian and L.axes:
+            if dθ is not None and L.axes:
                 dθ[:, :, L.block("α")] -= Ar @ right_jacobian(x[L.block("α")])
             attitudes.dθ = dθ
         return rates, attitudes
 
     @staticmethod
-    def _segment(solver: EulerSolver, times, D, J, attitude: bool, jacobian: bool):
+    def _segment(solver: EulerSolver, times, D, J, attitude: bool, jacobian: bool) -> _Piece:
         """m_p (N, 3), Q_p (Rotation, or None) and ∂(δθ_p, m_p)/∂x (N, 6, n) at ``times``."""
         if not jacobian:
             m = solver.angular_momentum(times)

@@ -25,7 +25,7 @@ from scipy.spatial.transform import Rotation
 from attitude.base.errors import InertiaWarning, InputError
 from attitude.environment.timescales import time_from_tt_seconds
 from attitude.estimation.model import ExactModel, Prediction
-from attitude.scenario.events import AngularImpulse
+from attitude.scenario.events import AngularImpulse, Event
 from attitude.scenario.scenario import InitialState, Scenario
 from attitude.scenario.spacecraft import Spacecraft
 from attitude.trajectory.torqued import TorquedMotion
@@ -64,7 +64,7 @@ class ScenarioModel(ExactModel):
         tensor = R @ np.diag(J) @ R.T
         inertia = J if np.array_equal(R, np.eye(3)) else 0.5 * (tensor + tensor.T)
         state = InitialState(self.initial_attitude(x), angular_velocity=self.rate(x))
-        events = [
+        events: list[Event] = [
             AngularImpulse(time_from_tt_seconds(self.epoch, i.t), i.vector, i.frame)
             for i in self.impulses
         ]
@@ -102,19 +102,19 @@ class ScenarioModel(ExactModel):
         if not jacobian:
             return rates, attitude
         n = x.size
-        if rates.ω is not None:
-            rates.dω = np.empty((*rates.ω.shape, n))
-        if attitude.attitude is not None:
-            attitude.dθ = np.empty((len(attitude.attitude), 3, n))
+        dω = rates.dω = None if rates.ω is None else np.empty((*rates.ω.shape, n))
+        dθ = attitude.dθ = (
+            None if attitude.attitude is None else np.empty((len(attitude.attitude), 3, n))
+        )
         for k in range(n):
             h = _STEP  # every parameter is of order one (model.py)
             shifted = x.copy()
             shifted[k] += h
             r, a = self._values(shifted, t_rates, t_attitude, end)
-            if rates.ω is not None:
-                rates.dω[:, :, k] = (r.ω - rates.ω) / h
-            if attitude.attitude is not None:
-                attitude.dθ[:, :, k] = (attitude.attitude.inv() * a.attitude).as_rotvec() / h
+            if dω is not None and rates.ω is not None and r.ω is not None:
+                dω[:, :, k] = (r.ω - rates.ω) / h
+            if dθ is not None and attitude.attitude is not None and a.attitude is not None:
+                dθ[:, :, k] = (attitude.attitude.inv() * a.attitude).as_rotvec() / h
         return rates, attitude
 
     def _values(self, x, t_rates, t_attitude, end: float) -> tuple[Prediction, Prediction]:

@@ -92,14 +92,17 @@ class Data:
             keep = t <= t_end
             return keep & mask if inliers_only else keep
 
-        g = pick(self.t_rates, self.rate_inliers)
-        a = pick(self.t_attitude, self.attitude_inliers)
+        t_rates, rates = self.t_rates, self.rates
+        t_attitude, attitude = self.t_attitude, self.attitude
+        # Times and values are given together (both or neither).
+        g = pick(t_rates, self.rate_inliers)
+        a = pick(t_attitude, self.attitude_inliers)
         return Data(
-            None if g is None else self.t_rates[g],
-            None if g is None else self.rates[g],
+            None if g is None or t_rates is None else t_rates[g],
+            None if g is None or rates is None else rates[g],
             self.σ_rates,
-            None if a is None else self.t_attitude[a],
-            None if a is None else self.attitude[a],
+            None if a is None or t_attitude is None else t_attitude[a],
+            None if a is None or attitude is None else attitude[a],
             self.σ_attitude,
         )
 
@@ -117,7 +120,7 @@ def residuals(model: Any, x: NDArray[np.float64], data: Data, jacobian: bool):
     """Normalized residuals (and their Jacobian): rates then attitudes, flattened."""
     rates, attitude = model.predict(x, data.t_rates, data.t_attitude, jacobian)
     parts, jparts = [], []
-    if data.t_rates is not None:
+    if data.t_rates is not None and data.σ_rates is not None:
         parts.append(((data.rates - rates.ω) / data.σ_rates).ravel())
         if jacobian:
             jparts.append((-rates.dω / data.σ_rates[None, :, None]).reshape(-1, rates.dω.shape[2]))

@@ -107,7 +107,7 @@ def _readings(
             file=source,
         )
     missing = np.isnan(array)
-    present = ~missing.any(axis=1)
+    present: NDArray[np.bool_] = ~np.any(missing, axis=1)
     partial = missing.any(axis=1) & ~missing.all(axis=1)
     if np.any(partial):
         row = int(np.flatnonzero(partial)[0])

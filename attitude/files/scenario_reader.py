@@ -27,7 +27,7 @@ import tomllib
 import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import Any, Literal, NoReturn, TypedDict, overload
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -130,6 +130,10 @@ class _Table:
     def has(self, key: str) -> bool:
         return key in self.data
 
+    @overload
+    def table(self, key: str, required: Literal[True] = True) -> _Table: ...
+    @overload
+    def table(self, key: str, required: bool) -> _Table | None: ...
     def table(self, key: str, required: bool = True) -> _Table | None:
         if key not in self.data:
             if required:
@@ -150,6 +154,12 @@ class _Table:
             return default
         return self.data[key]
 
+    @overload
+    def string(self, key: str, required: Literal[True] = True, default: None = None) -> str: ...
+    @overload
+    def string(self, key: str, required: bool, default: str) -> str: ...
+    @overload
+    def string(self, key: str, required: bool, default: None = None) -> str | None: ...
     def string(self, key: str, required: bool = True, default: str | None = None) -> str | None:
         value = self.raw(key, required, default)
         if value is not None and not isinstance(value, str):
@@ -374,7 +384,14 @@ def _attitude_in_icrf(table: _Table, orbit: Orbit | None, at) -> Rotation | None
     return orbit_frame_to_icrf(frame, r, v) * attitude
 
 
-def _rate(table: _Table, required: bool) -> dict[str, np.ndarray]:
+class _Rate(TypedDict, total=False):
+    """The rate of an initial state or an attitude reset, as InitialState takes it."""
+
+    angular_velocity: np.ndarray
+    angular_momentum: np.ndarray
+
+
+def _rate(table: _Table, required: bool) -> _Rate:
     given = [k for k in ("angular_velocity", "angular_momentum") if table.has(k)]
     if len(given) > 1:
         table.fail("give one of angular_velocity and angular_momentum, not both")
@@ -382,7 +399,10 @@ def _rate(table: _Table, required: bool) -> dict[str, np.ndarray]:
         if required:
             table.fail("missing angular_velocity (rad/s) or angular_momentum (N m s)")
         return {}
-    return {given[0]: table.quantity(given[0], given[0], (3,))}
+    value = table.quantity(given[0], given[0], (3,))
+    if given[0] == "angular_velocity":
+        return {"angular_velocity": value}
+    return {"angular_momentum": value}
 
 
 def _event_epoch(table: _Table, scale: str):

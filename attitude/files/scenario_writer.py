@@ -8,13 +8,14 @@ the job used, to the last bit.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 __all__ = ["scenario_text", "with_absolute_files"]
 
 
-def scenario_text(document: dict[str, Any], comments: list[str] = ()) -> str:
+def scenario_text(document: dict[str, Any], comments: Sequence[str] = ()) -> str:
     """The TOML text of ``document``, after ``comments`` (each a ``#`` line)."""
     import tomli_w
 

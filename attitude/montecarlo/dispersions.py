@@ -82,6 +82,7 @@ from attitude.files.scenario_reader import (
 from attitude.files.scenario_reader import (
     _Table as Table,  # the reader's own errors: file, key, value
 )
+from attitude.scenario.events import AngularImpulse
 from attitude.solver.inertia import violates_triangle_inequality
 
 __all__ = [
@@ -130,8 +131,8 @@ class Distribution:
         else:
             from scipy.stats import truncnorm
 
-            c = self.truncation
-            unit = np.asarray(truncnorm.rvs(-c, c, size=size, random_state=rng), dtype=float)
+            c = self._cut()
+            unit = np.asarray(truncnorm.rvs(-c, c, size=size, random_state=rng), dtype=np.float64)
         return unit * self.scale
 
     def isotropic(self, rng: np.random.Generator, dimension: int) -> NDArray[np.float64]:
@@ -147,7 +148,13 @@ class Distribution:
         from scipy.stats import chi
 
         law = chi(dimension)  # |x|/σ of a Gaussian vector; inverse CDF of its cut part
-        return self.scale * float(law.ppf(u * law.cdf(self.truncation))) * direction
+        return self.scale * float(law.ppf(u * law.cdf(self._cut()))) * direction
+
+    def _cut(self) -> float:
+        """The truncation, in σ, of the truncated normal law."""
+        if self.truncation is None:
+            raise ValueError(f"a {self.kind} law has no truncation")
+        return self.truncation
 
     def describe(self, unit: str = "") -> str:
         scale = np.atleast_1d(self.scale)
@@ -489,7 +496,11 @@ def _event_dispersions(
         if (magnitude or direction) and event.kind != "angular_impulse":
             key = "impulse_magnitude" if magnitude else "impulse_direction"
             item.fail(f"events[{index}] is an {event.kind}, not an angular_impulse", key)
-        if direction is not None and not np.any(event.impulse):
+        if (
+            direction is not None
+            and isinstance(event, AngularImpulse)
+            and not np.any(event.impulse)
+        ):
             item.fail(f"events[{index}].impulse is zero: it has no direction", "impulse_direction")
         nominal[f"events[{index}]"] = {
             "offset": offsets[index],
@@ -647,16 +658,21 @@ def _draw_event(
         parameters[f"{key}.time_shift_s"] = shift
     if item.magnitude is None and item.direction is None:
         return None
-    impulse, ε, draws, tilt, error = values["impulse"], None, None, None, None
+    impulse = values["impulse"]
+    ε: float | None = None
+    draws = 0
+    tilt: NDArray[np.float64] | None = None
+    error: str | None = None
     if item.magnitude is not None:
         rng = _generator(d.seed, index, f"{key}.impulse_magnitude")
         for draws in range(1, MAX_DRAWS + 1):  # noqa: B007 (the count is recorded)
-            ε = float(item.magnitude.components(rng, 1)[0])
-            if 1.0 + ε > 0.0:
+            relative = float(item.magnitude.components(rng, 1)[0])
+            if 1.0 + relative > 0.0:
                 break
         else:
             error = f"{key}.impulse_magnitude: no positive draw in {MAX_DRAWS} tries"
-        impulse = impulse * (1.0 + ε)
+        ε = relative
+        impulse = impulse * (1.0 + relative)
     if item.direction is not None:
         rng = _generator(d.seed, index, f"{key}.impulse_direction")
         tilt = item.direction.isotropic(rng, 2)
@@ -676,7 +692,10 @@ def _draw_tle_epoch(
     d: Dispersions, index: int, pointing: dict[str, Any], parameters: dict[str, float]
 ) -> None:
     """The TLE epoch moved by s seconds (rounded to the 1e-8 day the line writes)."""
-    shift = float(d.tle_epoch.components(_generator(d.seed, index, "pointing.tle_epoch"), 1)[0])
+    law = d.tle_epoch
+    if law is None:
+        raise ValueError("the dispersions move no TLE epoch")
+    shift = float(law.components(_generator(d.seed, index, "pointing.tle_epoch"), 1)[0])
     tle = d.nominal["tle"]
     line1, applied = shifted_tle_epoch(tle[0], shift)
     pointing["tle"] = [line1, tle[1]]

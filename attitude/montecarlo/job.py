@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 from attitude.files.scenario_reader import ScenarioFile, load_scenario
 from attitude.montecarlo.plan import plan_montecarlo
-from attitude.montecarlo.report import check_folder, write_report
+from attitude.montecarlo.report import check_folder, write_montecarlo_report
 from attitude.montecarlo.simulation import simulate
 
 if TYPE_CHECKING:
@@ -60,5 +60,5 @@ def run_montecarlo(
         check_folder(mc, out)
     result = simulate(mc, scheduler, workers, batch_size, progress)
     if out is not None:
-        write_report(result, out)
+        write_montecarlo_report(result, out)
     return result.table

@@ -1,6 +1,6 @@
 """The report of a Monte Carlo job: the table, its statistics, plots and a page.
 
-``write_report(result, out_dir)`` writes, through the output folder's rules
+``write_montecarlo_report(result, out_dir)`` writes, through the output folder's rules
 (``attitude.outputs.folder``: only files attitude wrote are ever replaced, nothing of a
 failed or interrupted write is left):
 
@@ -51,7 +51,7 @@ __all__ = [
     "drawn_spread",
     "stated_precision",
     "statistics",
-    "write_report",
+    "write_montecarlo_report",
 ]
 
 OUTPUT_NAMES = (
@@ -198,7 +198,7 @@ def _envelope_columns(result: MonteCarloResult) -> dict[str, np.ndarray]:
     return columns
 
 
-def write_report(result: MonteCarloResult, out_dir: str | Path) -> list[str]:
+def write_montecarlo_report(result: MonteCarloResult, out_dir: str | Path) -> list[str]:
     """Write the report of ``result`` into ``out_dir`` (see the module docstring)."""
     folder = claim(out_dir, OUTPUT_NAMES)
 
@@ -319,6 +319,8 @@ def _plot_histograms(result: MonteCarloResult, names, stats, path: Path) -> str:
     panels = np.atleast_1d(figure.subplots(rows, columns, squeeze=False).ravel())
     for axes, name in zip(panels, names, strict=False):
         values = drawn_spread(ok[name].to_numpy(float), stated_precision(name, result.plan, ok))
+        if values is None:  # not spread: _histogram_columns leaves such a metric out
+            continue
         axes.hist(values, bins=int(np.clip(np.sqrt(values.size), 10, 60)), color="C0", alpha=0.8)
         entry = stats["metrics"][name]
         for p, style in (("1", ":"), ("50", "-"), ("99", ":")):

@@ -540,7 +540,7 @@ def write_planned_aem(
             "rad of the exact attitude",
         ),
     )
-    measured = []
+    measured: list[AemSegmentPlan] = []
     for item in plan.segments:
         segment = trajectory.segments[item.segment]
         ends = texts(np.array([item.start_s, item.end_s]))

@@ -472,7 +472,7 @@ class AemWriter:
 # --- writing -------------------------------------------------------------------------
 
 
-def _comment_lines(comments: tuple[str, ...]) -> list[str]:
+def _comment_lines(comments: Iterable[str]) -> list[str]:
     return [f"COMMENT {line}" if line else "COMMENT" for line in comments]
 
 

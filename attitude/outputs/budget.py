@@ -9,9 +9,9 @@ Sun and orbit nodes of the pointing, a chunk) and only the disk grows with the s
 on the disk that takes its outputs, with one message that states the sizes.
 
 The work of the pointing's interval search (64 samples a turn of the fastest
-rotation, over the whole span, and an interval per turn) is bounded too: a search of
-more than :data:`MAX_SEARCH_GRID_POINTS` samples (hours of computing, and an
-intervals file of a line or more per turn) is refused with the sizes.
+rotation, over the whole span, and an interval per turn) is bounded where the search
+is planned (:data:`attitude.pointing.search.MAX_SEARCH_POINTS`); here it sizes
+intervals.csv.
 
 The figures are measured (``benchmarks/report_one_day.py`` and
 ``report_outputs.py``, docs/benchmarks.md, on the 2-core development machine, with
@@ -32,7 +32,6 @@ from pathlib import Path
 from attitude.base.errors import InputError
 
 __all__ = [
-    "MAX_SEARCH_GRID_POINTS",
     "OutputBudget",
     "ResourceError",
     "available_memory_bytes",
@@ -57,7 +56,6 @@ _AEM_BYTES_PER_RECORD = 190
 _PLOT_BYTES = 250_000
 _SUMMARY_BYTES = 50_000
 _TRAJECTORY_COLUMNS = 16
-MAX_SEARCH_GRID_POINTS = 2_000_000_000
 # The share of the memory available, and of the free disk, that a run may take.
 MEMORY_SHARE = 0.8
 DISK_SHARE = 0.95
@@ -144,7 +142,7 @@ def estimate(
     return OutputBudget(samples, search_grid_points, memory, files)
 
 
-def available_memory_bytes() -> int:
+def available_memory_bytes() -> float:
     """The memory available to a new allocation now: ``MemAvailable`` from
     /proc/meminfo (Linux: free memory plus the caches that can be dropped), else the
     free physical pages; unbounded if the system says neither."""
@@ -183,18 +181,9 @@ def size_text(count: float) -> str:
 def check_fits(
     budget: OutputBudget, out_dir: str | Path | None = None, shown: str | None = None
 ) -> None:
-    """Refuse (:class:`ResourceError`) a run whose pointing search is beyond
-    :data:`MAX_SEARCH_GRID_POINTS`, that would not fit in :data:`MEMORY_SHARE` of the
-    memory available, or in :data:`DISK_SHARE` of the free space of the disk that
+    """Refuse (:class:`ResourceError`) a run that would not fit in :data:`MEMORY_SHARE`
+    of the memory available, or in :data:`DISK_SHARE` of the free space of the disk that
     holds ``out_dir`` (not checked when None; named ``shown`` in the error if given)."""
-    grid = budget.search_grid_points
-    if grid > MAX_SEARCH_GRID_POINTS:
-        raise ResourceError(
-            f"the pointing's interval search would take {grid} samples (64 a turn "
-            f"of the fastest rotation over the span; at most {MAX_SEARCH_GRID_POINTS} are "
-            "searched: hours of computing, and an interval a turn): use a shorter span",
-            key="output",
-        )
     memory = available_memory_bytes()
     if budget.memory_bytes > MEMORY_SHARE * memory:
         raise ResourceError(
@@ -206,7 +195,7 @@ def check_fits(
         return
     free = free_disk_bytes(out_dir)
     if budget.disk_bytes > DISK_SHARE * free:
-        largest = max(budget.files, key=budget.files.get)
+        largest = max(budget.files, key=budget.files.__getitem__)
         raise ResourceError(
             f"{budget.samples} samples would take about {_size(budget.disk_bytes)} "
             f"({largest} {_size(budget.files[largest])}), and the disk of "

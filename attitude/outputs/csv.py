@@ -168,7 +168,7 @@ class CsvWriter:
         self._stream = open(self.path, "wb")
         self._stream.write("".join(f"# {line}\n" for line in preamble).encode("utf-8"))
         self._names: list[str] | None = None
-        self._writer = None
+        self._writer: Any = None  # a pyarrow.csv.CSVWriter (pyarrow is untyped)
 
     def write(self, epochs: NDArray, columns: list[Column]) -> None:
         """Append one row per epoch: ``epochs`` (ISO texts), then each column's value."""
@@ -305,8 +305,8 @@ def _lvlh_columns(samples: PointingSamples) -> list[Column]:
             "attitude in the orbit's LVLH frame (z nadir, y -orbit normal), quaternion, "
             "scalar first (w >= 0), body -> LVLH",
         )
-    if samples.lvlh_euler_deg is not None:
-        sequence = samples.lvlh_euler_sequence
+    sequence = samples.lvlh_euler_sequence
+    if samples.lvlh_euler_deg is not None and sequence is not None:
         kind = "intrinsic" if sequence.isupper() else "extrinsic"
         columns += [
             Column(

@@ -106,7 +106,7 @@ def _read_manifest(folder: Path, allowed: Collection[str]) -> dict[str, Any] | N
         return None
     if not (isinstance(data, dict) and data.get("format") == _FORMAT):
         return None
-    entries = {}
+    entries: dict[str, list[tuple[int, str]]] = {}
     for key in ("files", "previous"):
         files = data.get(key, {})
         if not isinstance(files, dict):
@@ -321,7 +321,7 @@ def claim(
                 "attitude's: attitude will not replace it; move it or choose another folder"
             )
         digest = None if file.is_symlink() or not file.is_file() else _digest(file)
-        if digest not in accepted[name]:
+        if digest is None or digest not in accepted[name]:
             raise refused(
                 f"{name} was changed after attitude wrote it: attitude will "
                 "not replace it; move it or choose another folder"

@@ -126,8 +126,9 @@ class ParquetWriter:
             for key, value in metadata.items()
         }
         self._time_description = time_description
-        self._writer = None
-        self._schema = None
+        # pyarrow is untyped: a ParquetWriter and a Schema, once the first chunk is seen.
+        self._writer: Any = None
+        self._schema: Any = None
 
     def _make_schema(self, columns: list[Column]):
         import pyarrow as pa
@@ -177,7 +178,7 @@ class ParquetWriter:
                 arrays.append(arrow_texts(epochs))
             elif item.name == "tt_ns":
                 arrays.append(pa.array(_nanoseconds(seconds)))
-            elif item.name == "timestamp_tt":
+            elif item.name == "timestamp_tt" and self._epoch_ns is not None:
                 arrays.append(pa.array(_timestamps(self._epoch_ns, seconds, self._unit), item.type))
             elif item.name == "segment":
                 arrays.append(pa.array(np.asarray(by_name["segment"]).astype(np.int32)))

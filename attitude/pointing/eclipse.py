@@ -122,7 +122,13 @@ def shadow_angles(
     return a, b, c
 
 
-def _outside(distance_m, radius_m: float, vectors, name: str, body: str) -> None:
+def _outside(
+    distance_m: NDArray[np.float64],
+    radius_m: float,
+    vectors: NDArray[np.float64],
+    name: str,
+    body: str,
+) -> None:
     """InputError if a distance from the centre of ``body`` is not above its radius."""
     inside = distance_m <= radius_m
     if np.any(inside):
@@ -161,13 +167,21 @@ def sunlit_fraction(
 def fraction_from_angles(a: ArrayLike, b: ArrayLike, c: ArrayLike) -> NDArray[np.float64]:
     """The visible fraction of the Sun's disc from the angles (a, b, c) of
     :func:`shadow_angles` (radians, broadcast): see :func:`sunlit_fraction`."""
-    a, b, c = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (a, b, c)))
-    fraction = np.ones(c.shape)
-    fraction[c <= b - a] = 0.0
-    annular = c <= a - b  # the Earth's disc inside the Sun's
-    fraction[annular] = 1.0 - (b[annular] / a[annular]) ** 2
-    partial = (c > np.abs(b - a)) & (c < a + b)
-    a, b, c = a[partial], b[partial], c[partial]
+    sun, earth, apart = np.broadcast_arrays(*(np.asarray(x, dtype=np.float64) for x in (a, b, c)))
+    fraction = np.ones(apart.shape)
+    fraction[apart <= earth - sun] = 0.0
+    annular = apart <= sun - earth  # the Earth's disc inside the Sun's
+    fraction[annular] = 1.0 - (earth[annular] / sun[annular]) ** 2
+    partial = (apart > np.abs(earth - sun)) & (apart < sun + earth)
+    fraction[partial] = _penumbra_fraction(sun[partial], earth[partial], apart[partial])
+    return fraction[()] if fraction.ndim == 0 else fraction
+
+
+def _penumbra_fraction(
+    a: NDArray[np.float64], b: NDArray[np.float64], c: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """1 − A/(π a²) where the discs partly overlap (|b − a| < c < a + b): see
+    :func:`sunlit_fraction` for the lens area A."""
     # c² − b² as (c − b)(c + b): no cancellation where c ≈ b ≫ a.
     x = ((c - b) * (c + b) + a * a) / (2.0 * c)
     y = np.sqrt(np.maximum(a * a - x * x, 0.0))
@@ -176,8 +190,7 @@ def fraction_from_angles(a: ArrayLike, b: ArrayLike, c: ArrayLike) -> NDArray[np
         + b * b * np.arccos(np.clip((c - x) / b, -1.0, 1.0))
         - c * y
     )
-    fraction[partial] = np.clip(1.0 - overlap / (np.pi * a * a), 0.0, 1.0)
-    return fraction[()] if fraction.ndim == 0 else fraction
+    return np.clip(1.0 - overlap / (np.pi * a * a), 0.0, 1.0)
 
 
 def eclipse_state(

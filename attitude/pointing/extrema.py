@@ -92,34 +92,53 @@ def _lowest(fp, fq, width, lipschitz: float):
 class _Brackets:
     """The golden-section brackets of one problem: a < x1 < x2 < b and f there."""
 
-    def __init__(self, a, b, fa, fb, x1, x2) -> None:
+    def __init__(
+        self,
+        a: NDArray[np.float64],
+        b: NDArray[np.float64],
+        fa: NDArray[np.float64],
+        fb: NDArray[np.float64],
+        x1: NDArray[np.float64],
+        x2: NDArray[np.float64],
+    ) -> None:
         self.a, self.b, self.fa, self.fb, self.x1, self.x2 = a, b, fa, fb, x1, x2
-        self.f1 = self.f2 = None
-        self.lower = None
+        # f at x1 and x2, and which of them the last step moved: unknown until the
+        # first take().
+        self.f1: NDArray[np.float64] | None = None
+        self.f2: NDArray[np.float64] | None = None
+        self.lower: NDArray[np.bool_] | None = None
+
+    def _interior(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+        """f at x1 and x2 (after the first take())."""
+        if self.f1 is None or self.f2 is None:
+            raise RuntimeError("the brackets' interior values are not taken yet")
+        return self.f1, self.f2
 
     def points(self) -> NDArray[np.float64]:
         """Where f is needed next."""
-        if self.f1 is None:
+        if self.lower is None:
             return np.concatenate([self.x1, self.x2])
         return np.where(self.lower, self.x1, self.x2)
 
     def take(self, values: NDArray[np.float64]) -> None:
         """f at :meth:`points`; then move each bracket one golden step."""
-        if self.f1 is None:
+        if self.lower is None:
             n = self.x1.size
             self.f1, self.f2 = values[:n], values[n:]
         else:
-            self.f1 = np.where(self.lower, values, self.f1)
-            self.f2 = np.where(self.lower, self.f2, values)
+            f1, f2 = self._interior()
+            self.f1 = np.where(self.lower, values, f1)
+            self.f2 = np.where(self.lower, f2, values)
 
     def step(self) -> None:
         """Keep the sub-bracket that holds the lesser interior point; place the new point."""
-        lower = self.f1 <= self.f2
+        f1, f2 = self._interior()
+        lower = f1 <= f2
         self.b = np.where(lower, self.x2, self.b)
-        self.fb = np.where(lower, self.f2, self.fb)
+        self.fb = np.where(lower, f2, self.fb)
         self.a = np.where(lower, self.a, self.x1)
-        self.fa = np.where(lower, self.fa, self.f1)
-        kept_x, kept_f = np.where(lower, self.x1, self.x2), np.where(lower, self.f1, self.f2)
+        self.fa = np.where(lower, self.fa, f1)
+        kept_x, kept_f = np.where(lower, self.x1, self.x2), np.where(lower, f1, f2)
         new_x = np.where(
             lower, self.b - _GOLDEN * (self.b - self.a), self.a + _GOLDEN * (self.b - self.a)
         )
@@ -131,7 +150,7 @@ class _Brackets:
 
     def best(self) -> tuple[float, float] | None:
         x = np.concatenate([self.x1, self.x2])
-        y = np.concatenate([self.f1, self.f2])
+        y = np.concatenate(self._interior())
         if y.size == 0:
             return None
         i = int(np.nanargmin(y))
@@ -140,11 +159,12 @@ class _Brackets:
     def keep(self, best: float, lipschitz: float, tolerance: float, precision_s: float) -> bool:
         """Drop the brackets that cannot beat ``best`` by more than ``tolerance`` and those
         narrower than ``precision_s``; True while any is left."""
+        f1, f2 = self._interior()
         bound = np.minimum.reduce(
             [
-                _lowest(self.fa, self.f1, self.x1 - self.a, lipschitz),
-                _lowest(self.f1, self.f2, self.x2 - self.x1, lipschitz),
-                _lowest(self.f2, self.fb, self.b - self.x2, lipschitz),
+                _lowest(self.fa, f1, self.x1 - self.a, lipschitz),
+                _lowest(f1, f2, self.x2 - self.x1, lipschitz),
+                _lowest(f2, self.fb, self.b - self.x2, lipschitz),
             ]
         )
         alive = (bound < best - tolerance) & (self.b - self.a > precision_s)

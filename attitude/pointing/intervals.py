@@ -229,15 +229,23 @@ def isolate(
     return grid_s, values
 
 
-def _assemble(grid_s, inside, crossings, entering) -> list[Interval]:
+def _assemble(
+    grid_s: NDArray[np.float64],
+    inside: NDArray[np.bool_],
+    crossings: NDArray[np.float64],
+    entering: NDArray[np.bool_],
+) -> list[Interval]:
     """The intervals from the crossings (in time order) and whether each enters."""
     intervals = []
-    start, starts_before = (grid_s[0], True) if inside[0] else (None, False)
+    start: float | None = float(grid_s[0]) if inside[0] else None
+    starts_before = bool(inside[0])
     for time, enters in zip(crossings, entering, strict=True):
         if enters:
-            start, starts_before = time, False
+            start, starts_before = float(time), False
         else:
-            intervals.append(Interval(float(start), float(time), starts_before, False))
+            if start is None:
+                raise ValueError(f"an exit at {time} s without an entry before it")
+            intervals.append(Interval(start, float(time), starts_before, False))
             start = None
     if start is not None:
         intervals.append(Interval(float(start), float(grid_s[-1]), starts_before, True))
@@ -255,16 +263,17 @@ def difference(a: list[Interval], b: list[Interval]) -> list[Interval]:
         while first < len(b) and b[first].end_s <= interval.start_s:
             first += 1
         start, starts_before = interval.start_s, interval.starts_before
+        covered = False  # a cut reaches the interval's end
         for cut in b[first:]:
             if cut.start_s >= interval.end_s:
                 break
             if cut.start_s > start:
                 out.append(Interval(start, cut.start_s, starts_before, False))
             if cut.end_s >= interval.end_s:
-                start = None
+                covered = True
                 break
             start, starts_before = max(start, cut.end_s), False
-        if start is not None:
+        if not covered:
             out.append(Interval(start, interval.end_s, starts_before, interval.ends_after))
     return out
 

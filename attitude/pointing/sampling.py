@@ -103,8 +103,9 @@ def _vector_samples(vector: BodyVector, icrf: NDArray[np.float64], env: Surround
         item.moon_violated = item.moon_angle_rad < vector.moon_exclusion_half_angle_rad
         if hidden is not None:
             item.moon_violated &= hidden <= 0.0
-    if vector.earth_limb_exclusion_angle_rad is not None:
-        item.earth_limb_violated = item.earth_limb_angle_rad < vector.earth_limb_exclusion_angle_rad
+    limb_angle = item.earth_limb_angle_rad  # None at the Earth's centre
+    if vector.earth_limb_exclusion_angle_rad is not None and limb_angle is not None:
+        item.earth_limb_violated = limb_angle < vector.earth_limb_exclusion_angle_rad
     if vector.sun_inclusion_half_angle_rad is not None:
         # In umbra the Sun is hidden: the sensor sees nothing.
         item.sun_in_view = (item.sun_angle_rad < vector.sun_inclusion_half_angle_rad) & (
@@ -148,7 +149,7 @@ def pointing_samples(
         vectors=[_vector_samples(v, attitude.apply(v.vector), env) for v in spec.body_vectors],
         earth_angular_radius_rad=env.earth_angular_radius_rad,
     )
-    if env.position_m is not None:
+    if env.position_m is not None and env.velocity_m_s is not None:
         body_to_lvlh = lvlh_to_icrf(env.position_m, env.velocity_m_s).inv() * attitude
         q = body_to_lvlh.as_quat(canonical=True, scalar_first=True)
         result.q_body_to_lvlh = np.atleast_2d(q)

@@ -177,14 +177,17 @@ class PointingSpec:
     """
 
     body_vectors: list[BodyVector] = field(default_factory=list)
-    orbit: Orbit | tuple[str, str] | None = None
+    # The two lines of a TLE are taken too (made a TleOrbit on construction): after it,
+    # the orbit is an Orbit or None.
+    orbit: Orbit | None = None
     interval_precision_s: float = 1e-3
     earth_limb_atmosphere_height_m: float = 0.0
     lvlh_euler_sequence: str | None = None
 
     def __post_init__(self) -> None:
-        if isinstance(self.orbit, tuple | list):
-            object.__setattr__(self, "orbit", TleOrbit(*self.orbit))
+        given: Any = self.orbit
+        if isinstance(given, tuple | list):
+            object.__setattr__(self, "orbit", TleOrbit(*given))
         if self.orbit is not None and not isinstance(self.orbit, Orbit):
             raise InputError(
                 f"orbit must be an Orbit or the two lines of a TLE, got {self.orbit!r}"

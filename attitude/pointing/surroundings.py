@@ -90,7 +90,11 @@ class SunMoonEarth:
     ) -> None:
         self.spec = spec
         # The scenario epoch's TT Julian date: the trajectory's, or ``jd`` when given.
-        self._jd1, self._jd2 = scenario_jd(trajectory) if jd is None else jd
+        if jd is None:
+            if trajectory is None:
+                raise TypeError("SunMoonEarth needs a trajectory or the epoch's jd")
+            jd = scenario_jd(trajectory)
+        self._jd1, self._jd2 = jd
         self._bodies = SunMoonFromEarth(
             self._jd1,
             self._jd2 + start_s / SECONDS_PER_DAY,
@@ -164,7 +168,7 @@ def assemble(spec: PointingSpec, fields: dict[str, NDArray[np.float64]]) -> Surr
 def moon_hidden(env: Surroundings) -> NDArray[np.float64] | None:
     """> 0 where the Moon's centre is behind the Earth's disc (None at the Earth's
     centre): the Earth's angular radius minus the Moon's angle from nadir."""
-    if env.position_m is None:
+    if env.earth_angular_radius_rad is None or env.nadir is None:
         return None
     return env.earth_angular_radius_rad - unit_angle(env.moon_direction, env.nadir)
 
@@ -189,7 +193,7 @@ def vector_angles(icrf: NDArray[np.float64], env: Surroundings) -> dict[str, NDA
         "cos_incidence": np.maximum(cos_sun, 0.0) * env.sunlit_fraction,
         "moon_angle": unit_angle(icrf, env.moon_direction),
     }
-    if env.position_m is not None:
+    if env.nadir is not None and env.limb_angular_radius_rad is not None:
         angles["nadir_angle"] = unit_angle(icrf, env.nadir)
         angles["earth_limb_angle"] = angles["nadir_angle"] - env.limb_angular_radius_rad
     return angles

@@ -26,8 +26,10 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from attitude.scenario.modes import ControlLoss
 from attitude.trajectory.guided import GuidedMotion
 from attitude.trajectory.modes import uses_laws
+from attitude.trajectory.torqued import TorquedMotion
 
 if TYPE_CHECKING:
     from attitude.report.plan import RunPlan
@@ -98,13 +100,13 @@ def guidance_summary(plan: RunPlan) -> dict[str, Any] | None:
                 )
         else:
             entry["propagation"] = _free_text(solver)
-            if getattr(solver, "formula", None) == "gyrostat":  # its step and error
+            if isinstance(solver, TorquedMotion) and solver.formula == "gyrostat":
                 entry["method"] = solver.method
                 entry["step_s"] = solver.step
                 entry["estimated_error_rad"] = solver.error_estimate
         segments.append(entry)
         event = segment.event
-        if event is not None and event.kind == "control_loss" and segment.before is not None:
+        if isinstance(event, ControlLoss) and segment.before is not None:
             ω = solver.angular_velocity(np.array([segment.start_s, segment.start_s]))[0]
             losses.append(
                 {

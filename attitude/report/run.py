@@ -92,27 +92,13 @@ from attitude.scenario.scenario import Scenario
 from attitude.trajectory.horizon import ValidityHorizon
 from attitude.trajectory.motion import largest_rate_of
 
-__all__ = ["CHUNK_SAMPLES", "OUTPUT_NAMES", "Progress", "output_grid", "write_report"]
+__all__ = ["CHUNK_SAMPLES", "OUTPUT_NAMES", "Progress", "write_report"]
 
 # Output epochs evaluated and written at a time: large enough that the per-chunk
 # overheads vanish, small enough that a chunk with pointing holds tens of MB.
 CHUNK_SAMPLES = 16384
 # A progress line at most this often during the stream (seconds).
 _PROGRESS_EVERY_S = 2.0
-
-
-def output_grid(scenario: Scenario, first: int, stop: int) -> np.ndarray:
-    """Output epochs ``first`` … ``stop`` − 1 of the grid, TT seconds since the epoch:
-    the same values as ``scenario.output_seconds()[first:stop]``, without building the
-    whole grid (start + step × k, and stop itself last when the step does not reach it)."""
-    regular = int(np.floor((scenario.stop_s - scenario.start_s) / scenario.step_s * (1 + 1e-12)))
-    regular += 1
-    stop = min(stop, scenario.output_count())
-    k = np.arange(first, min(stop, regular), dtype=np.float64)
-    τ = scenario.start_s + scenario.step_s * k
-    if stop > regular:
-        τ = np.append(τ, scenario.stop_s)
-    return τ
 
 
 # --- the pointing ------------------------------------------------------------------
@@ -369,7 +355,7 @@ def _stream_output_grid(
     with stream.stack:
         shown = time.perf_counter()
         for first in range(0, count, chunk):
-            τ = output_grid(scenario, first, first + chunk)
+            τ = scenario.output_seconds(first, first + chunk)
             samples = sample(plan.trajectory, τ)
             stream.add(τ, samples, None if pointing is None else pointing.samples(τ))
             # After the first chunk (a stream has started), then every few seconds.
@@ -408,9 +394,12 @@ def _search_pointing(
 ) -> PointingAnalysis:
     """The pointing's intervals and extrema over the span, on the exact motion; the
     intervals written to intervals.csv."""
+    search = plan.search
+    if search is None:
+        raise ValueError("the plan has no pointing search")
     progress(
-        f"pointing: intervals and extrema on the exact motion ({plan.search.count} "
-        f"search points, every {plan.search.step_s:.3g} s); writing intervals.csv"
+        f"pointing: intervals and extrema on the exact motion ({search.count} "
+        f"search points, every {search.step_s:.3g} s); writing intervals.csv"
     )
     analysis = pointing.analysis()
     write_intervals_csv(
@@ -431,6 +420,8 @@ def _write_aem(
     """attitude.aem over the records the plan chose for its tolerance; the plan with
     the error measured on them."""
     scenario, aem = plan.scenario, plan.aem
+    if aem is None:
+        raise ValueError("the plan writes no attitude.aem")
     progress(
         f"writing attitude.aem (CCSDS AEM 2.0): {aem.records} records, "
         f"{INTERPOLATION_METHOD} to {aem.tolerance_rad:g} rad"

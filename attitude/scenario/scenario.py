@@ -54,7 +54,8 @@ from attitude.environment.timescales import (
 )
 from attitude.scenario.events import Event
 from attitude.scenario.spacecraft import Spacecraft
-from attitude.scenario.torques import MAX_STEPS, PlacedBurn, ScenarioTorques
+from attitude.scenario.torques import PlacedBurn, ScenarioTorques
+from attitude.torques.solver import MAX_STEPS
 
 if TYPE_CHECKING:  # astropy loads only when a Time is made
     from astropy.time import Time
@@ -434,21 +435,33 @@ class Scenario:
         """ISO 8601 texts (in the scenario's scale) of TT ``seconds`` after the epoch."""
         return iso_texts(self.times(seconds))
 
+    def _regular_count(self) -> int:
+        """The epochs start + step × k of the output grid that do not pass stop (a step
+        that reaches stop within 1e-12 of the span counts as reaching it)."""
+        steps = (self.stop_s - self.start_s) / self.step_s * (1 + 1e-12)
+        return int(steps) + 1  # steps is finite and ≥ 0: step is checked above
+
     def output_count(self) -> int:
         """The number of output epochs (start, start + step, ..., and stop), without
         building the grid: a span of 1e9 s every 1e-3 s is 1e12 epochs."""
-        steps = (self.stop_s - self.start_s) / self.step_s * (1 + 1e-12)
-        count = int(steps) + 1  # steps is finite and ≥ 0: step is checked above
+        count = self._regular_count()
         last = self.start_s + self.step_s * (count - 1)
+        # stop itself ends the grid when the last regular epoch falls short of it.
         return count + (1 if self.stop_s - last > 1e-9 * self.step_s else 0)
 
-    def output_seconds(self) -> NDArray[np.float64]:
-        """The output grid: start, start + step, ..., and stop (TT s since the epoch)."""
-        count = int(np.floor((self.stop_s - self.start_s) / self.step_s * (1 + 1e-12))) + 1
-        grid = self.start_s + self.step_s * np.arange(count, dtype=np.float64)
-        if self.stop_s - grid[-1] > 1e-9 * self.step_s:
-            grid = np.append(grid, self.stop_s)
-        return grid
+    def output_seconds(self, first: int = 0, stop: int | None = None) -> NDArray[np.float64]:
+        """The output grid, TT s since the epoch: start, start + step, ..., and stop
+        itself last when the step does not reach it.  ``first``, ``stop``: only the
+        epochs ``first`` … ``stop`` − 1, without building the rest (a run streams its
+        outputs a chunk at a time)."""
+        regular = self._regular_count()
+        count = self.output_count()
+        stop = count if stop is None else min(stop, count)
+        k = np.arange(first, min(stop, regular), dtype=np.float64)
+        seconds = self.start_s + self.step_s * k
+        if stop > regular:
+            seconds = np.append(seconds, self.stop_s)
+        return seconds
 
     def __repr__(self) -> str:
         return (

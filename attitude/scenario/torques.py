@@ -49,7 +49,6 @@ from attitude.torques.solver import TOLERANCE_RANGE_RAD
 __all__ = [
     "DEFAULT_ACCURACY_RAD",
     "DEFAULT_HORIZON_THRESHOLD_RAD",
-    "MAX_STEPS",
     "Burn",
     "PlacedBurn",
     "ScenarioTorques",
@@ -59,9 +58,6 @@ DEFAULT_ACCURACY_RAD = 1e-6
 DEFAULT_HORIZON_THRESHOLD_RAD = math.radians(1.0)
 # Accuracies the step search can meet: below 1e-12 rad the estimate is rounding.
 _ACCURACY_RANGE_RAD = TOLERANCE_RANGE_RAD
-# More steps than this over the span is refused as a mistake: at 8 free flows a step
-# and tens of µs a flow, 1e7 steps are about an hour of computing.
-MAX_STEPS = 1e7
 
 
 @dataclass(frozen=True)

@@ -4,7 +4,7 @@ These are the "kick" half of the splitting in :mod:`attitude.torques.solver`: ov
 the attitude and the clock are frozen and the body angular momentum changes by the
 integral of the torque.  For every torque that depends only on the time and the
 attitude (gravity gradient, a constant torque, a user torque of (t, attitude)), the
-torque is then constant over the kick, and m ← m + h τ is the *exact* flow of the
+torque Γ is then constant over the kick, and m ← m + h Γ is the *exact* flow of the
 kick: no approximation enters but the splitting itself.  A torque that depends on the
 angular velocity (a damper) changes during its own kick; its kick is integrated by
 the classical Runge–Kutta method (4 evaluations, local error O(h⁵)), which caps the
@@ -147,10 +147,10 @@ class Torque:
 class GravityGradient(Torque):
     """Gravity-gradient torque of a point-mass central body on the spacecraft.
 
-    τ_body = (3μ/r³) r̂_b × (I r̂_b)   ([Wertz1978] §17.2, [Hughes1986] ch. 8)
+    Γ_body = (3μ/r³) r̂_b × (I r̂_b)   ([Wertz1978] §17.2, [Hughes1986] ch. 8)
 
     with r̂_b the unit vector from the body's centre to the spacecraft, in body axes,
-    and I the inertia tensor.  In principal axes this reads τ1 = (3μ/r³)(I3 − I2) r2 r3
+    and I the inertia tensor.  In principal axes this reads Γ1 = (3μ/r³)(I3 − I2) r2 r3
     and cyclically.  It is the torque of the potential V = (μ/2r³)(3 r̂ᵀ I r̂ − tr I)
     (MacCullagh's formula, the first term of the expansion in the body's size over
     r), so a kick is a symplectic map and the splitting a Poisson integrator.
@@ -240,10 +240,10 @@ class ConstantTorque(Torque):
     of its kicks (negative splitting coefficients put some kick clocks slightly outside
     the step, where the torque continues as it is inside).  An inertial torque changes
     the inertial angular momentum by exactly torque × duration, whatever the step; a
-    body-fixed one by ∫ R(t) τ dt, to the method's order.
+    body-fixed one by ∫ R(t) Γ dt, to the method's order.
     """
 
-    data_width = 4  # (τx, τy, τz, on) with τ in the model's frame, on ∈ {0, 1}
+    data_width = 4  # (Γx, Γy, Γz, on) with Γ in the model's frame, on ∈ {0, 1}
 
     def __init__(self, torque: ArrayLike, start: float, stop: float, frame: str = "body") -> None:
         self.torque = as_vector3(_without_unit(torque, "N m", "torque"), "length", "torque")
@@ -272,10 +272,10 @@ class ConstantTorque(Torque):
     def principal_torque(
         self, data: Components, q: Components, ω: Components, frame: PrincipalFrame
     ) -> Components:
-        τ = data[:3]
+        torque = data[:3]
         if self.frame == "inertial":
-            return rotate_into_principal(q, τ)
-        return frame.to_principal(τ)
+            return rotate_into_principal(q, torque)
+        return frame.to_principal(torque)
 
 
 class ConstantTorqueSchedule(Torque):
@@ -292,7 +292,7 @@ class ConstantTorqueSchedule(Torque):
     midpoint lies in [start, stop).
     """
 
-    data_width = 6  # (body τx, τy, τz, inertial τx, τy, τz), each the sum of those on
+    data_width = 6  # (body Γx, Γy, Γz, inertial Γx, Γy, Γz), each the sum of those on
 
     def __init__(self, torques: Sequence[ConstantTorque]) -> None:
         self.torques = tuple(torques)
@@ -376,7 +376,7 @@ class UserTorque(Torque):
     ``depends_on_angular_velocity``: say False if the torque is a function of (t,
     attitude) only; then each kick is exact and the solver keeps its full order.  If
     True (the default, the safe assumption), the angular velocity changes during the
-    kick, whose own equation dm/dt = τ(t, R, I⁻¹m) at frozen R and t is integrated by
+    kick, whose own equation dm/dt = Γ(t, R, I⁻¹m) at frozen R and t is integrated by
     the classical Runge–Kutta method: the solver's order is then at most 4, and the
     order-6 method, which needs a kick independent of m, is refused.
 
@@ -423,25 +423,26 @@ class UserTorque(Torque):
         attitude = frame.body_attitude(q)
         ω_body = np.stack(np.broadcast_arrays(*frame.to_body(ω)), axis=-1)
         if attitude.single:
-            τ = self._call(float(t), attitude, ω_body)
+            torque = self._call(float(t), attitude, ω_body)
         elif self.vectorized:
-            τ = self._call(t, attitude, ω_body, n=len(attitude))
+            torque = self._call(t, attitude, ω_body, n=len(attitude))
         else:
             times = np.broadcast_to(np.asarray(t, dtype=np.float64), (len(attitude),))
-            τ = np.array(
+            torque = np.array(
                 [self._call(float(times[i]), attitude[i], ω_body[i]) for i in range(len(attitude))]
             )
-        return frame.to_principal(tuple(τ[..., i] for i in range(3)))
+        return frame.to_principal(tuple(torque[..., i] for i in range(3)))
 
     def _call(self, t, attitude: Rotation, ω: NDArray[np.float64], n: int | None = None):
-        τ = np.asarray(self.function(t, attitude, ω), dtype=np.float64)
+        torque = np.asarray(self.function(t, attitude, ω), dtype=np.float64)
         expected = (3,) if n is None else (n, 3)
-        if τ.shape != expected or not np.all(np.isfinite(τ)):
+        if torque.shape != expected or not np.all(np.isfinite(torque)):
+            shown = torque.tolist() if torque.size <= 6 else torque.shape
             raise InputError(
-                f"UserTorque {self.name}: returned {τ.tolist() if τ.size <= 6 else τ.shape} at "
+                f"UserTorque {self.name}: returned {shown} at "
                 f"t = {t!r}; expected a finite torque of shape {expected} (N m, body axes)"
             )
-        return τ
+        return torque
 
 
 def as_torque_list(torques: Any) -> list[Torque]:

@@ -1,12 +1,12 @@
 """Attitude under external torques: splitting with the exact free flow (``TorquedSolver``).
 
-The equations of a rigid body under a torque τ(t, R, ω),
+The equations of a rigid body under a torque Γ(t, R, ω),
 
-    dm/dt = m × ω + τ,   dq/dt = ½ q ⊗ (0, ω),   ω = I⁻¹ m   (body axes),
+    dm/dt = m × ω + Γ,   dq/dt = ½ q ⊗ (0, ω),   ω = I⁻¹ m   (body axes),
 
 are split into the free rigid body, whose flow is exact (:mod:`attitude.solver.free_flow`,
 after Celledoni, Fassò, Säfström and Zanna, whose paper's title names this use), and
-the kick dm/dt = τ with the attitude and the clock frozen, exact for any torque that
+the kick dm/dt = Γ with the attitude and the clock frozen, exact for any torque that
 does not depend on ω (see :mod:`attitude.torques.models`).  A composition of the two
 (:mod:`attitude.torques.splitting`) gives a method whose error is proportional to the torque,
 not to the spin, and which is the exact solver when the torque vanishes.  For
@@ -31,6 +31,7 @@ References: see :mod:`attitude.torques.splitting` and :mod:`attitude.torques.mod
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -54,13 +55,16 @@ from attitude.torques.models import (
 from attitude.torques.splitting import Composition, composition
 
 __all__ = [
+    "MAX_STEPS",
     "TOLERANCE_RANGE_RAD",
     "StepChoice",
     "TorquedSolver",
     "angles_between",
     "departure_time",
     "first_crossing",
+    "next_search_step",
     "propagate_batch",
+    "search_start_step",
 ]
 
 # Steps computed per call of the torques' time functions (orbit positions, vectorized).
@@ -71,14 +75,16 @@ _DENSE_CHUNK = 8192
 # before a breakpoint.
 _SLIVER = 1e-6
 # More steps than this in one request (hours of computing) is refused as a mistake.
-_MAX_STEPS = 1e8
+_MAX_REQUEST_STEPS = 1e8
 # A step search that would try a step with more than this many steps over its span is
 # refused (each try runs the span twice): torques that turn the body faster and faster
-# (a runaway spin-up) would otherwise halve the step for hours before failing.
-_SEARCH_MAX_STEPS = 1e7
+# (a runaway spin-up) would otherwise halve the step for hours before failing.  At 8
+# free flows a step and tens of µs a flow, 1e7 steps are about an hour of computing.
+# The scenario's run-level search (attitude.trajectory.steps) has the same cap.
+MAX_STEPS = 1e7
 # The tolerances a step search can meet (rad): below 1e-12 the Richardson estimate is
 # rounding (16-digit states), and the search would shrink the step until it gives up
-# at _SEARCH_MAX_STEPS; beyond 0.1 rad an estimate from a linear error model means
+# at MAX_STEPS; beyond 0.1 rad an estimate from a linear error model means
 # nothing.  The scenario's ``[torques] accuracy`` has the same range.
 TOLERANCE_RANGE_RAD = (1e-12, 0.1)
 # The body must turn by less than this fraction of a turn in the spacing of float
@@ -156,16 +162,16 @@ class _Engine:
             ω = self.gyroscope.body_rate(m, self.frame.moments)
         total = (0.0, 0.0, 0.0)
         for model, row in zip(self.torques, data, strict=True):
-            τ = model.principal_torque(row, q, ω, self.frame)
-            total = (total[0] + τ[0], total[1] + τ[1], total[2] + τ[2])
+            torque = model.principal_torque(row, q, ω, self.frame)
+            total = (total[0] + torque[0], total[1] + torque[1], total[2] + torque[2])
         return total
 
     def kick(self, data, m, q, w):
         """m after the kick of duration w (s) at frozen attitude and clock."""
         k1 = self.torque(data, m, q)
-        if not self.rk4:  # τ does not depend on m: the kick is exact
+        if not self.rk4:  # Γ does not depend on m: the kick is exact
             return (m[0] + w * k1[0], m[1] + w * k1[1], m[2] + w * k1[2])
-        # Classical Runge–Kutta on dm/dt = τ(t, R, I⁻¹m), R and t frozen.
+        # Classical Runge–Kutta on dm/dt = Γ(t, R, I⁻¹m), R and t frozen.
         h2 = 0.5 * w
         k2 = self.torque(data, tuple(m[i] + h2 * k1[i] for i in range(3)), q)
         k3 = self.torque(data, tuple(m[i] + h2 * k2[i] for i in range(3)), q)
@@ -289,6 +295,53 @@ def _grid_steps(t_from: float, t_to: float, step: float, breakpoints: NDArray, l
     return np.array(starts), np.array(sizes)
 
 
+# ----------------------------------------------------------------- the step search
+# One search for a step that meets an error target, shared by TorquedSolver(tolerance=)
+# and the scenario's run-level search (attitude.trajectory.steps), which estimate the
+# error differently (one solver from its start; the whole run) but move alike.
+
+
+def search_start_step(rate: float, torques: Iterable[Torque], t: float) -> float:
+    """Where a step search starts: a quarter turn at ``rate`` (rad/s), at most a
+    twentieth of the period of the orbit of any gravity gradient among ``torques``
+    (its position at TT ``t``), 60 s with neither."""
+    candidates = [2.0 * math.pi / rate / 4.0] if rate > 0.0 else []
+    for torque in torques:
+        if isinstance(torque, GravityGradient):  # the one torque with an orbit period
+            radius = float(np.linalg.norm(torque.position(np.array([t]))[0]))
+            candidates.append(2.0 * math.pi * math.sqrt(radius**3 / torque.mu) / 20.0)
+    return min(candidates, default=60.0)
+
+
+def next_search_step(
+    step: float,
+    error: float,
+    tolerance: float,
+    order: int,
+    span: float,
+    good: float | None,
+    bad: float,
+) -> float | None:
+    """The step search's next try after ``step`` gave the estimate ``error``, or None
+    when the search is done.  ``good``: the largest step that met ``tolerance`` so far
+    (None: none yet); ``bad``: the smallest that missed it (inf: none yet).
+
+    The error model C h^p (p = ``order``) aims at half the tolerance, moving at most
+    8× down (and at least to 0.8 of the step) or 4× up a try, never past half the
+    ``span``; once a passing and a failing step bracket the answer, it bisects in
+    log h until they are within a factor 1.25."""
+    factor = (0.5 * tolerance / max(error, 1e-300)) ** (1.0 / order)
+    if good is not None and math.isfinite(bad):
+        if bad / good < 1.25:
+            return None
+        return math.sqrt(good * bad)
+    if good is not None:
+        if factor < 1.25 or step >= 0.5 * span:
+            return None
+        return min(0.5 * span, step * min(4.0, factor))
+    return step * min(0.8, max(0.125, factor))
+
+
 # ----------------------------------------------------------------- the solver
 
 
@@ -330,10 +383,10 @@ class _Propagation:
 
     def extend_to(self, t_max: float) -> None:
         e = self.engine
-        if (t_max - self.t_end) / self.step > _MAX_STEPS:
+        if (t_max - self.t_end) / self.step > _MAX_REQUEST_STEPS:
             raise InputError(
                 f"t = {t_max:g} s is {(t_max - self.t_end) / self.step:.3g} steps of "
-                f"{self.step:g} s ahead: more than {_MAX_STEPS:g} steps; use a larger step "
+                f"{self.step:g} s ahead: more than {_MAX_REQUEST_STEPS:g} steps; use a larger step "
                 "or a shorter span"
             )
         while self.t_end < t_max:
@@ -538,7 +591,7 @@ class TorquedSolver:
         bad = math.inf
         tried: list[tuple[float, float]] = []
         for _ in range(10):
-            if span / step > _SEARCH_MAX_STEPS:
+            if span / step > MAX_STEPS:
                 last = (
                     f"; the estimate was {tried[-1][1]:.3g} rad at {tried[-1][0]:.3g} s"
                     if tried
@@ -546,7 +599,7 @@ class TorquedSolver:
                 )
                 raise InputError(
                     f"{tolerance:g} rad over {span:g} s would need a step below "
-                    f"{step:.3g} s, more than {_SEARCH_MAX_STEPS:g} steps{last}: give a step, "
+                    f"{step:.3g} s, more than {MAX_STEPS:g} steps{last}: give a step, "
                     "a looser tolerance or a shorter span",
                     key="tolerance",
                     value=tolerance,
@@ -558,17 +611,12 @@ class TorquedSolver:
                     good = (step, error, propagation)
             else:
                 bad = min(bad, step)
-            factor = (0.5 * tolerance / max(error, 1e-300)) ** (1.0 / p)
-            if good is not None and math.isfinite(bad):
-                if bad / good[0] < 1.25:
-                    break
-                step = math.sqrt(good[0] * bad)
-            elif good is not None:
-                if factor < 1.25 or step >= 0.5 * span:
-                    break
-                step = min(0.5 * span, step * min(4.0, factor))
-            else:
-                step *= min(0.8, max(0.125, factor))
+            following = next_search_step(
+                step, error, tolerance, p, span, None if good is None else good[0], bad
+            )
+            if following is None:
+                break
+            step = following
         if good is None:
             raise InputError(
                 f"{tolerance:g} rad over {span:g} s not reached: the estimate was "
@@ -581,16 +629,11 @@ class TorquedSolver:
         return propagation
 
     def _initial_step(self) -> float:
-        """A quarter of the spin period, at most a twentieth of any orbit period."""
+        """:func:`search_start_step` at the initial rate (the gyroscopic turn's too)."""
         ω = float(np.linalg.norm(self._principal_rate(np.asarray(self._m0))))
         if self._engine.gyroscope is not None:  # the gyroscopic turn, too
             ω = max(ω, float(self._engine.gyroscope.speed))
-        candidates = [2.0 * math.pi / ω / 4.0] if ω > 0.0 else []
-        for torque in self._torques:
-            if isinstance(torque, GravityGradient):  # the one torque with an orbit period
-                radius = float(np.linalg.norm(torque.position(np.array([self._t0]))[0]))
-                candidates.append(2.0 * math.pi * math.sqrt(radius**3 / torque.mu) / 20.0)
-        return min(candidates) if candidates else 60.0
+        return search_start_step(ω, self._torques, self._t0)
 
     # ----------------------------------------------------------------- evaluation
 

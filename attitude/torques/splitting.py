@@ -4,7 +4,7 @@ The motion under a torque is split into two parts whose flows are both exact:
 
 - F, the free flow: the torque-free rigid body (``attitude.solver.free_flow.advance``), which
   also advances the clock;
-- K, the kick: the torque with the attitude and the clock frozen, m ← m + h τ.
+- K, the kick: the torque Γ with the attitude and the clock frozen, m ← m + h Γ.
 
 One step of size h of a composition with flow coefficients a_0 … a_{s−1} and kick
 coefficients b_0 … b_s is, in the order the maps are applied,
@@ -20,7 +20,7 @@ composition of exp(a h A) and exp(b h B), against exp(h(A + B)) for random matri
 60-digit arithmetic, falls with the published order.  The orders of the generalized
 methods are those of a near-integrable problem A + εB: an error O(ε h^{r1} + ε² h^{r2} +
 ε³ h^{r3}).  A torque is such a perturbation of the free rigid body: ε is the ratio of
-the torque to the rate at which the free motion turns the momentum, |τ| / (|m| |ω|)
+the torque to the rate at which the free motion turns the momentum, |Γ| / (|m| |ω|)
 (about 1e-3 for a tumbler at 3°/s on a 7000 km orbit, 4e-6 for a 5 rpm spinner).
 
 References

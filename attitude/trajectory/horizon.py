@@ -33,7 +33,7 @@ import numpy as np
 
 from attitude.scenario.scenario import Scenario
 from attitude.scenario.torques import ScenarioTorques
-from attitude.torques.models import MU_EARTH_M3_S2
+from attitude.torques.models import MU_EARTH_M3_S2, GravityGradient
 from attitude.torques.solver import angles_between, first_crossing
 from attitude.trajectory.torqued import scenario_torque_models
 from attitude.trajectory.trajectory import Trajectory, propagate
@@ -117,6 +117,8 @@ def _step(trajectory: Trajectory, orbit: Any) -> float:
     scenario = trajectory.scenario
     with_orbit = scenario.with_torques(ScenarioTorques(gravity_gradient=orbit))
     gradient = scenario_torque_models(with_orbit)[0][2]
+    if not isinstance(gradient, GravityGradient):
+        raise TypeError(f"the first torque model is the gravity gradient, got {gradient!r}")
     radius = float(np.linalg.norm(gradient.position(np.array([0.0]))[0]))
     candidates.append(2.0 * math.pi * math.sqrt(radius**3 / MU_EARTH_M3_S2) * _ORBIT_FRACTION)
     return min(candidates)

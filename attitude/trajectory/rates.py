@@ -52,6 +52,8 @@ def largest_rate(segment: Segment, start_s: float, end_s: float) -> tuple[float,
     own = getattr(solver, "largest_rate", None)  # under a law: attitude.trajectory.guided
     if own is not None:
         return own(start_s, end_s)
+    if not isinstance(solver, EulerSolver):
+        raise TypeError(f"no largest-rate search for a {type(solver).__name__}")
     return _free(segment, solver, start_s, end_s)
 
 

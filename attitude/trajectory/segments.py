@@ -35,6 +35,7 @@ import numpy as np
 
 from attitude.base.errors import InputError
 from attitude.scenario.events import Event, State
+from attitude.scenario.modes import ModeEvent
 from attitude.scenario.scenario import Scenario
 from attitude.solver.euler_solver import EulerSolver
 from attitude.torques.models import ConstantTorque, Torque
@@ -102,7 +103,7 @@ class Segment:
     end_s: float
     solver: EulerSolver | TorquedMotion | GuidedMotion
     state: State
-    event: Event | None = None
+    event: Event | ModeEvent | None = None
     before: State | None = None
     where: Where | None = None
     burn_key: str | None = None

@@ -49,9 +49,13 @@ from numpy.typing import NDArray
 
 from attitude.base.errors import InputError
 from attitude.scenario.scenario import Scenario
-from attitude.scenario.torques import MAX_STEPS
-from attitude.torques.models import ConstantTorque, GravityGradient, Torque
-from attitude.torques.solver import angles_between
+from attitude.torques.models import ConstantTorque, Torque
+from attitude.torques.solver import (
+    MAX_STEPS,
+    angles_between,
+    next_search_step,
+    search_start_step,
+)
 from attitude.trajectory.segments import Segment, check_resolved, initial_state, segments
 from attitude.trajectory.torqued import TorquedMotion
 
@@ -299,16 +303,13 @@ def _largest_rate(
 def _initial_step(
     scenario: Scenario, models: list[tuple[float, float, Torque, str]], burns: bool = True
 ) -> float:
-    """Half a quarter turn at the body's largest rate over the span
-    (:func:`_largest_rate`; ``burns``: with the burns' impulse), at most a fortieth of
-    the orbit."""
+    """Half the solver's first try (:func:`attitude.torques.solver.search_start_step`:
+    a quarter turn, at most a twentieth of the orbit) at the body's largest rate over
+    the span (:func:`_largest_rate`; ``burns``: with the burns' impulse), at most half
+    the span."""
     rate = _largest_rate(scenario, models, burns)
-    candidates = [2.0 * math.pi / rate / 4.0] if rate > 0.0 else []
-    for _, _, torque, _ in models:
-        if isinstance(torque, GravityGradient):
-            radius = float(np.linalg.norm(torque.position(np.array([0.0]))[0]))
-            candidates.append(2.0 * math.pi * math.sqrt(radius**3 / torque.mu) / 20.0)
-    return 0.5 * min(min(candidates, default=60.0), scenario.stop_s)
+    start = search_start_step(rate, (torque for _, _, torque, _ in models), 0.0)
+    return 0.5 * min(start, scenario.stop_s)
 
 
 def predicted_steps(
@@ -453,17 +454,12 @@ def choose_steps(
                 good = (step, found, run)
         else:
             bad = min(bad, step)
-        factor = (0.5 * tolerance / max(error, 1e-300)) ** (1.0 / order)
-        if good is not None and math.isfinite(bad):
-            if bad / good[0] < 1.25:
-                break
-            step = math.sqrt(good[0] * bad)
-        elif good is not None:
-            if factor < 1.25 or step >= 0.5 * span:
-                break
-            step = min(0.5 * span, step * min(4.0, factor))
-        else:
-            step *= min(0.8, max(0.125, factor))
+        following = next_search_step(
+            step, error, tolerance, order, span, None if good is None else good[0], bad
+        )
+        if following is None:
+            break
+        step = following
     cpu = time.process_time() - started
     if good is None:
         raise InputError(

@@ -18,7 +18,7 @@ they need not care which one propagated it:
   for is a bound on the body rate (|ω| ≤ G/I_min, |ω|² ≤ 2T/I_min), so here they are
   the **largest** |m| and T over the segment: the largest at the solver's grid points
   plus twice the largest change between two of them (both change smoothly, by at most
-  |τ| h over a step);
+  |Γ| h over a step);
 - ``error_estimate``: the run's estimated attitude error within the segment (rad),
   errors carried from earlier segments included, set by the trajectory.
 
@@ -217,7 +217,8 @@ class TorquedMotion:
         m = self._states(t)[0]
         if self.wheel_momentum is not None:  # a gyrostat: ω = I⁻¹(M − h)
             m = m - self.wheel_momentum
-        return np.linalg.solve(self.state.inertia.tensor, m[..., None])[..., 0]
+        ω = np.linalg.solve(self.state.inertia.tensor, m[..., None])[..., 0]
+        return ω.astype(np.float64, copy=False)
 
     def inertial_angular_momentum_at(self, t: ArrayLike) -> NDArray[np.float64]:
         """R(t) m(t), N m s, inertial axes: it changes under the torques."""
@@ -301,16 +302,17 @@ class TorquedMotion:
             t = self.t0 + spacing * np.arange(first, stop, dtype=np.float64)
             if stop == count:
                 t[-1] = self.end_s
-            m = self.principal_momentum(t)
-            chunk = (t, m, self.angular_velocity(t))
+            m, ω = self.principal_momentum(t), self.angular_velocity(t)
+            chunk = (t, m, ω)
             if count <= _SURVEY_KEPT:
-                kept.append(chunk if first == 0 else tuple(a[2:] for a in chunk))
+                kept.append(chunk if first == 0 else (t[2:], m[2:], ω[2:]))
             yield chunk
             if stop == count:
                 break
             first = stop - 2
         if kept:
-            self._survey = tuple(np.concatenate(parts) for parts in zip(*kept, strict=True))
+            times, momenta, rates = (np.concatenate(parts) for parts in zip(*kept, strict=True))
+            self._survey = (times, momenta, rates)
 
     def flip_times(self, t_start: float, t_end: float) -> NDArray[np.float64]:
         """The flips in [t_start, t_end] on the propagated motion (TT s): the times at
