@@ -775,6 +775,16 @@ class _Search:
             value = angles[name][quantity][k]
             which[(name, quantity)] = Extremum(extremum.time_s, float(value))
 
+    def _orbit_description(self) -> str:
+        """The orbit in words, kept with the shared surroundings (which are those of
+        this orbit): a search of a short window pays for it once."""
+        if self.spec.orbit is None:
+            return "Earth centre"
+        text = self.shared.memo.get("orbit_description")
+        if text is None:
+            text = self.shared.memo["orbit_description"] = self.spec.orbit.describe()
+        return str(text)
+
     def result(self) -> PointingAnalysis:
         """The analysis: the accumulated intervals (each condition less what hides it),
         extrema and averages."""
@@ -787,7 +797,7 @@ class _Search:
             stop_s=grid.stop_s,
             precision_s=self.precision,
             on_orbit=spec.on_orbit,
-            orbit="Earth centre" if spec.orbit is None else spec.orbit.describe(),
+            orbit=self._orbit_description(),
             grid=grid,
             vectors=[],
             shadow=self.orbit.get("shadow", []),
