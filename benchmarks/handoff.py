@@ -78,7 +78,7 @@ def main() -> None:
     for label, wheels, options in (
         ("locked, exact solver", locked, {}),
         ("spinning, step 10 s", spinning, {"step": 10.0}),
-        ("spinning, 1e-6 rad", spinning, {"tolerance": 1e-6, "span": 3600.0}),
+        ("spinning, 1e-6 rad", spinning, {"accuracy": 1e-6, "span": 3600.0}),
     ):
         cost = _best(lambda wheels=wheels, options=options: one_at_a_time(wheels, **options), 2)
         print(f"hand_off + window, {label:22s} {cost / picked.size * 1e3:8.2f} ms an instant")

@@ -184,15 +184,15 @@ def test_a_zero_step_returns_the_state():
 @pytest.mark.parametrize(
     "arguments, message",
     [
-        (([1.0, 0.0, 3.0], [1.0, 1.0, 1.0], [1, 0, 0, 0], 1.0), r"moments must be positive"),
+        (([1.0, 0.0, 3.0], [1.0, 1.0, 1.0], [1, 0, 0, 0], 1.0), r"inertia must be positive"),
         (([1.0, 2.0, 3.0], [1.0, np.nan, 1.0], [1, 0, 0, 0], 1.0), r"angular_momentum must be"),
         (([1.0, 2.0, 3.0], [1.0, 1.0, 1.0], [0, 0, 0, 0], 1.0), r"non-zero quaternion"),
         (([1.0, 2.0, 3.0], [1.0, 1.0, 1.0], [1, 0, 0, 0], np.inf), r"dt must be finite"),
         (([1.0, 2.0, 3.0], [1.0, 1.0], [1, 0, 0, 0], 1.0), r"angular_momentum must have shape"),
         (([1.0, 2.0, 3.0], [1.0, 1.0, 1.0], [1, 0, 0], 1.0), r"quaternion_wxyz must have shape"),
         (([[1.0, 2.0, 3.0]] * 2, [[1.0, 1.0, 1.0]] * 3, [1, 0, 0, 0], 1.0), r"do not match"),
-        (([[1.0, 2.0, 3.0], [1.0, -2, 3.0]], [1.0, 1.0, 1.0], [1, 0, 0, 0], 1.0), r"moments\[1\]"),
-        ((["a", 2.0, 3.0], [1.0, 1.0, 1.0], [1, 0, 0, 0], 1.0), r"moments must be numeric"),
+        (([[1.0, 2.0, 3.0], [1.0, -2, 3.0]], [1.0, 1.0, 1.0], [1, 0, 0, 0], 1.0), r"inertia\[1\]"),
+        ((["a", 2.0, 3.0], [1.0, 1.0, 1.0], [1, 0, 0, 0], 1.0), r"inertia must be numeric"),
         (([1e-300, 2.0, 3.0], [1e10, 0.0, 0.0], [1, 0, 0, 0], 1.0), r"beyond the float range"),
     ],
 )
@@ -214,7 +214,7 @@ def test_bad_states_in_a_large_batch_are_named_by_index():
     momentum = np.tile([0.3, 2.0, -0.4], (40, 1))
     bad_moments = moments.copy()
     bad_moments[17, 1] = -2.0
-    with pytest.raises(InputError, match=r"moments\[17\] must be positive"):
+    with pytest.raises(InputError, match=r"inertia\[17\] must be positive"):
         advance(bad_moments, momentum, [1, 0, 0, 0], 1.0)
     bad_momentum = momentum.copy()
     bad_momentum[33, 2] = np.inf

@@ -13,7 +13,7 @@ the dense output (a partial step of the method) is what is checked.
 3. A full inertia tensor (body axes not principal) against the same reference.
 4. A body-fixed burn switching on and off mid-step, and an angular-velocity-dependent
    damper (a UserTorque, kicked by Runge–Kutta): order 4 convergence.
-5. A step chosen from a tolerance: the error DOP853 measures is within the tolerance
+5. A step chosen from an accuracy: the error DOP853 measures is within the accuracy
    and within the estimate the solver reports.
 """
 
@@ -184,8 +184,8 @@ def test_angular_velocity_dependent_damper_is_order_4():
     assert errors[1] <= 1e-9 and 12.0 <= errors[0] / errors[1] <= 22.0, errors
 
 
-@pytest.mark.parametrize("order, tolerance", [(4, 1e-6), (6, 1e-8)])
-def test_step_chosen_from_a_tolerance_meets_it(order, tolerance):
+@pytest.mark.parametrize("order, accuracy", [(4, 1e-6), (6, 1e-8)])
+def test_step_chosen_from_an_accuracy_meets_it(order, accuracy):
     """The solver picks the step; DOP853 confirms the error and the reported estimate."""
     span = 1200.0
     t = np.linspace(0.0, span, 41)[1:]
@@ -201,7 +201,7 @@ def test_step_chosen_from_a_tolerance_meets_it(order, tolerance):
         TUMBLER_M0,
         TUMBLER_ATTITUDE,
         torques=[GG],
-        tolerance=tolerance,
+        accuracy=accuracy,
         span=span,
         order=order,
     )
@@ -209,5 +209,5 @@ def test_step_chosen_from_a_tolerance_meets_it(order, tolerance):
     actual = np.max(ref.angle(solver.attitude_quaternion(t), q_ref))
     # Measured: order 4 → step 25 s, estimate 7.5e-7, actual 4.4e-8; order 6 → 8.0 s,
     # 2.3e-10, 6.0e-11.  The estimate is conservative for these near-integrable methods.
-    assert actual <= tolerance and actual <= choice.error_estimate
-    assert choice.error_estimate <= tolerance and solver.step == choice.step
+    assert actual <= accuracy and actual <= choice.error_estimate
+    assert choice.error_estimate <= accuracy and solver.step == choice.step

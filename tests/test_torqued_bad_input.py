@@ -132,23 +132,23 @@ def test_order_and_method_are_checked():
         TorquedSolver(INERTIA, M0, torques=[lambda t, a, ω: -ω], order=6)
 
 
-def test_tolerance_needs_a_span_and_excludes_a_step():
+def test_accuracy_needs_a_span_and_excludes_a_step():
     gg = GravityGradient(circular)
     with pytest.raises(InputError, match="span"):
-        TorquedSolver(INERTIA, M0, torques=[gg], tolerance=1e-6)
-    with pytest.raises(InputError, match="either step or tolerance"):
-        TorquedSolver(INERTIA, M0, torques=[gg], tolerance=1e-6, span=100.0, step=1.0)
-    for tolerance in (0.0, -1.0, math.nan):
-        with pytest.raises(InputError, match="tolerance"):
-            TorquedSolver(INERTIA, M0, torques=[gg], tolerance=tolerance, span=100.0)
+        TorquedSolver(INERTIA, M0, torques=[gg], accuracy=1e-6)
+    with pytest.raises(InputError, match="either step or accuracy"):
+        TorquedSolver(INERTIA, M0, torques=[gg], accuracy=1e-6, span=100.0, step=1.0)
+    for accuracy in (0.0, -1.0, math.nan):
+        with pytest.raises(InputError, match="accuracy"):
+            TorquedSolver(INERTIA, M0, torques=[gg], accuracy=accuracy, span=100.0)
     with pytest.raises(InputError, match="span"):
-        TorquedSolver(INERTIA, M0, torques=[gg], tolerance=1e-6, span=-5.0)
+        TorquedSolver(INERTIA, M0, torques=[gg], accuracy=1e-6, span=-5.0)
 
 
 def test_a_step_search_that_would_run_away_is_refused(monkeypatch):
     """A torque that spins the body up to 3e5 rad/s: the search shrinks the step try
     after try, and each try runs the span twice.  Past the search's cap of steps over
-    the span it refuses, naming the tolerance, the step and the last estimate, instead
+    the span it refuses, naming the accuracy, the step and the last estimate, instead
     of running for hours (the cap lowered here so that the test is quick; the scenario
     layer refuses such a burn before any search, test_check_refuses_what_run_refuses)."""
     import attitude.torques.solver as torqued_solver
@@ -156,12 +156,12 @@ def test_a_step_search_that_would_run_away_is_refused(monkeypatch):
     monkeypatch.setattr(torqued_solver, "MAX_STEPS", 2e3)
     spin_up = ConstantTorque([0.0, 0.0, 1e4], 0.0, math.inf)
     message = (
-        r"tolerance: 1e-06 rad over 100 s would need a step below [\d.e-]+ s, more than "
+        r"accuracy: 1e-06 rad over 100 s would need a step below [\d.e-]+ s, more than "
         r"2000 steps; the estimate was [\d.e+-]+ rad at [\d.e-]+ s: give a step"
     )
     with pytest.raises(InputError, match=message):
         TorquedSolver(
-            [1.0, 2.0, 3.0], [0.1, 0.2, 0.3], None, 0.0, [spin_up], tolerance=1e-6, span=100.0
+            [1.0, 2.0, 3.0], [0.1, 0.2, 0.3], None, 0.0, [spin_up], accuracy=1e-6, span=100.0
         )
 
 
@@ -208,7 +208,7 @@ def test_batch_input_is_checked():
     gg = GravityGradient(circular)
     with pytest.raises(InputError, match="shape"):
         propagate_batch(INERTIA, M0, None, 0.0, [1.0], [gg])
-    with pytest.raises(InputError, match="moments"):
+    with pytest.raises(InputError, match="inertia"):
         propagate_batch([[1.0, 2.0, 3.0]] * 2, [M0] * 3, None, 0.0, [1.0], [gg])
     with pytest.raises(InputError, match="increasing"):
         propagate_batch(INERTIA, [M0], None, 0.0, [5.0, 1.0], [gg])
@@ -221,13 +221,13 @@ def test_a_huge_span_is_refused_not_hung():
     assert np.all(np.isfinite(solver.attitude_quaternion(3.0)))  # still usable after
 
 
-@pytest.mark.parametrize("tolerance", [1e-300, 1e-13, 0.5, 1e300])
-def test_a_tolerance_no_search_can_meet_is_refused_at_once(tolerance):
+@pytest.mark.parametrize("accuracy", [1e-300, 1e-13, 0.5, 1e300])
+def test_an_accuracy_no_search_can_meet_is_refused_at_once(accuracy):
     """The range of the file's ``[torques] accuracy`` (1e-12 to 0.1 rad): below it the
     estimate is rounding and the search would shrink the step for minutes."""
-    with pytest.raises(InputError, match=r"tolerance must be between 1e-12 and 0\.1 rad"):
+    with pytest.raises(InputError, match=r"accuracy must be between 1e-12 and 0\.1 rad"):
         TorquedSolver(
-            INERTIA, M0, torques=[GravityGradient(circular)], tolerance=tolerance, span=100.0
+            INERTIA, M0, torques=[GravityGradient(circular)], accuracy=accuracy, span=100.0
         )
 
 

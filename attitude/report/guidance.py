@@ -26,7 +26,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from attitude.report.torques import cpu_text
 from attitude.scenario.modes import ControlLoss
+from attitude.torques.solver import StepChoice, StepPrediction
 from attitude.trajectory.guided import GuidedMotion
 from attitude.trajectory.modes import uses_laws
 from attitude.trajectory.torqued import TorquedMotion
@@ -104,6 +106,8 @@ def guidance_summary(plan: RunPlan) -> dict[str, Any] | None:
                 entry["method"] = solver.method
                 entry["step_s"] = solver.step
                 entry["estimated_error_rad"] = solver.error_estimate
+                if isinstance(solver.step_search, StepChoice):  # searched for an accuracy
+                    entry["step_search_cpu_s"] = solver.step_search.cpu_s
         segments.append(entry)
         event = segment.event
         if isinstance(event, ControlLoss) and segment.before is not None:
@@ -164,13 +168,46 @@ def guidance_lines(plan: RunPlan) -> list[str]:
             f"control loss at {loss['epoch']}: {loss['description']}; the body turns at "
             f"{rate:.4g} deg/s just after"
         )
-    for item in summary["segments"]:
+    for item, segment in zip(summary["segments"], plan.trajectory.segments, strict=True):
         if "step_s" in item:
+            lines += _gyrostat_lines(item, segment.solver)
+    return lines
+
+
+def _gyrostat_lines(item: dict[str, Any], solver: Any) -> list[str]:
+    """What check says of a gyrostat segment: its step, its error and what its step
+    search costs the run (predicted past check's budget: TorquedSolver.predict_step)."""
+    search = solver.step_search
+    head = f"  segment {item['segment']} gyrostat, {item['method']}"
+    if not isinstance(search, StepPrediction):
+        lines = [
+            f"{head} at a step of {item['step_s']:.6g} s, estimated error "
+            f"{item['estimated_error_rad']:.2g} rad from its start"
+        ]
+        if isinstance(search, StepChoice) and search.cpu_s > 0.0:
+            tries = len(search.tried)
             lines.append(
-                f"  segment {item['segment']} gyrostat, {item['method']} at a step of "
-                f"{item['step_s']:.6g} s, estimated error {item['estimated_error_rad']:.2g} rad "
-                "from its start"
+                f"    run cost    about {cpu_text(search.cpu_s)} of CPU for its step search "
+                f"({tries} {'try' if tries == 1 else 'tries'} over its {search.span:.6g} s, "
+                "as here)"
             )
+        return lines
+    tries = len(search.tried)
+    lines = [
+        f"{head}: the step search for {search.accuracy:g} rad stopped at check's budget after "
+        f"{tries} {'try' if tries == 1 else 'tries'}; the run finishes it over the segment",
+        f"    at a step of {search.cut_step:.4g} s the error is predicted at "
+        f"{search.predicted_error:.2g} rad (from its first {search.until:.6g} s, growing as "
+        f"t^{search.growth:.2g}): the step will be near {search.step:.4g} s, "
+        f"{search.span / search.step:.3g} steps",
+        f"    run cost    about {cpu_text(search.search_cpu_s)} of CPU for its step search "
+        f"(predicted from {search.cpu_per_step * 1e6:.3g} µs a step measured here)",
+    ]
+    if solver.approximate_step_s is not None:
+        lines.append(
+            f"    the motion below was propagated at {solver.approximate_step_s:.4g} s: its "
+            "sizes are close, not exact"
+        )
     return lines
 
 

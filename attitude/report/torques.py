@@ -21,7 +21,7 @@ from attitude.report.plan import RunPlan
 from attitude.trajectory.steps import CHECK_BUDGET_S
 from attitude.trajectory.torqued import TorquedMotion
 
-__all__ = ["horizon_text", "run_cost_s", "torques_lines", "torques_summary"]
+__all__ = ["cpu_text", "horizon_text", "run_cost_s", "torques_lines", "torques_summary"]
 
 
 def torques_summary(plan: RunPlan) -> dict[str, Any]:
@@ -101,7 +101,7 @@ def _horizon_note(settings: Any) -> str:
     return "no orbit: the gravity gradient that the burns-only motion neglects is not known"
 
 
-def _seconds_text(seconds: float) -> str:
+def cpu_text(seconds: float) -> str:
     """A duration of CPU for `attitude check`: 0.4 s, 25 s, 3.2 min, 1.5 h."""
     if seconds < 60.0:
         return f"{seconds:.2g} s" if seconds < 10.0 else f"{seconds:.0f} s"
@@ -195,7 +195,7 @@ def torques_lines(plan: RunPlan) -> list[str]:
     cost = run_cost_s(plan)
     if cost is not None:
         lines.append(
-            f"  run cost    about {_seconds_text(cost)} of CPU for the motion under torques "
+            f"  run cost    about {cpu_text(cost)} of CPU for the motion under torques "
             f"({steps.grid_steps} steps at {steps.step_s:.4g} s, and the error estimate)"
         )
     horizon = horizon_text(plan)

@@ -44,7 +44,7 @@ from numpy.typing import NDArray
 
 from attitude.base.errors import InputError
 from attitude.base.quantities import as_si_scalar, as_vector3
-from attitude.torques.solver import TOLERANCE_RANGE_RAD
+from attitude.torques.solver import ACCURACY_RANGE_RAD
 
 __all__ = [
     "DEFAULT_ACCURACY_RAD",
@@ -56,8 +56,6 @@ __all__ = [
 
 DEFAULT_ACCURACY_RAD = 1e-6
 DEFAULT_HORIZON_THRESHOLD_RAD = math.radians(1.0)
-# Accuracies the step search can meet: below 1e-12 rad the estimate is rounding.
-_ACCURACY_RANGE_RAD = TOLERANCE_RANGE_RAD
 
 
 @dataclass(frozen=True)
@@ -122,7 +120,7 @@ class ScenarioTorques:
             object.__setattr__(self, "step", step)
         if self.accuracy is not None:
             accuracy = as_si_scalar(self.accuracy, "angle", "torques.accuracy")
-            low, high = _ACCURACY_RANGE_RAD
+            low, high = ACCURACY_RANGE_RAD
             if not low <= accuracy <= high:
                 raise InputError(
                     f"must be between {low:g} and {high:g} rad, got {accuracy!r} rad",

@@ -1,6 +1,6 @@
 """The exact torque-free flow map: many states, each advanced by its own step.
 
-``advance(moments, angular_momentum, quaternion_wxyz, dt)`` gives the exact state of
+``advance(inertia, angular_momentum, quaternion_wxyz, dt)`` gives the exact state of
 each of N free rigid bodies after its own time step, vectorized over the states: the
 primitive that torque splitting (a kick, then the exact free flow: Celledoni, Fassò,
 Säfström and Zanna, SIAM J. Sci. Comput. 30(4), 2008, doi:10.1137/070704393) and
@@ -59,7 +59,7 @@ def _kernels() -> list[Any]:
 
 
 def advance(
-    moments: ArrayLike,
+    inertia: ArrayLike,
     angular_momentum: ArrayLike,
     quaternion_wxyz: ArrayLike,
     dt: ArrayLike,
@@ -68,9 +68,9 @@ def advance(
 
     Parameters
     ----------
-    moments
-        (3,) or (N, 3): principal moments, kg m², along the body axes (the body axes
-        are principal axes; the moments in any order, as for ``EulerSolver``).
+    inertia
+        (3,) or (N, 3): principal moments of inertia, kg m², along the body axes (the
+        body axes are principal axes; the moments in any order, as for ``EulerSolver``).
     angular_momentum
         (3,) or (N, 3): body-frame angular momentum, N m s.
     quaternion_wxyz
@@ -90,17 +90,17 @@ def advance(
     raise an InputError naming the argument, the state and the value, and so does a
     step whose angles would leave the float range.
     """
-    inertia = _as_floats(moments, "moment_of_inertia", "moments")
+    moments = _as_floats(inertia, "moment_of_inertia", "inertia")
     m = _as_floats(angular_momentum, "angular_momentum", "angular_momentum")
     q = _as_floats(quaternion_wxyz, None, "quaternion_wxyz")
     τ = _as_floats(dt, "time", "dt")
-    if inertia.shape == (3,) and m.shape == (3,) and q.shape == (4,) and τ.ndim == 0:
-        m_new, q_new = _one_compiled(*_one_state(inertia, m, q, τ))
+    if moments.shape == (3,) and m.shape == (3,) and q.shape == (4,) and τ.ndim == 0:
+        m_new, q_new = _one_compiled(*_one_state(moments, m, q, τ))
         return np.array(m_new), np.array(q_new)
-    inertia, m, q, τ = _broadcast(inertia, m, q, τ)
-    q = _checked_batch(inertia, m, q, τ)
+    moments, m, q, τ = _broadcast(moments, m, q, τ)
+    q = _checked_batch(moments, m, q, τ)
     return _many_compiled(
-        np.ascontiguousarray(inertia),
+        np.ascontiguousarray(moments),
         np.ascontiguousarray(m),
         q,
         np.ascontiguousarray(τ),
@@ -108,7 +108,7 @@ def advance(
 
 
 def advance_floats(
-    moments: tuple[float, float, float],
+    inertia: tuple[float, float, float],
     angular_momentum: tuple[float, float, float],
     quaternion_wxyz: tuple[float, float, float, float],
     dt: float,
@@ -122,17 +122,17 @@ def advance_floats(
     non-finite state or result raises an InputError.
     """
     try:
-        return _one_compiled(moments, angular_momentum, quaternion_wxyz, dt)
+        return _one_compiled(inertia, angular_momentum, quaternion_wxyz, dt)
     except (ValueError, OverflowError):  # a NaN or an infinity met by the exact integers
         raise InputError(
             f"the free flow needs a finite state, got angular_momentum {list(angular_momentum)}"
-            f" and quaternion_wxyz {list(quaternion_wxyz)} with moments {list(moments)} "
+            f" and quaternion_wxyz {list(quaternion_wxyz)} with inertia {list(inertia)} "
             f"and dt {dt!r}"
         ) from None
 
 
 def advance_unit_batch(
-    moments: NDArray[np.float64],
+    inertia: NDArray[np.float64],
     angular_momentum: NDArray[np.float64],
     quaternion_wxyz: NDArray[np.float64],
     dt: NDArray[np.float64],
@@ -145,15 +145,15 @@ def advance_unit_batch(
     a step costs the flow itself; the results are those of ``advance`` on the same
     arrays to rounding (``advance`` normalizes the quaternions first).
     """
-    return UnitBatch(moments).advance(angular_momentum, quaternion_wxyz, dt)
+    return UnitBatch(inertia).advance(angular_momentum, quaternion_wxyz, dt)
 
 
 class UnitBatch:
     """``advance_unit_batch`` for a batch whose moments stay from call to call (the
     spacecraft of attitude.torques.solver.propagate_batch, kicked between flows)."""
 
-    def __init__(self, moments: NDArray[np.float64]) -> None:
-        self.moments = np.ascontiguousarray(moments, dtype=np.float64)  # (N, 3), positive
+    def __init__(self, inertia: NDArray[np.float64]) -> None:
+        self.inertia = np.ascontiguousarray(inertia, dtype=np.float64)  # (N, 3), positive
 
     def advance(
         self,
@@ -170,7 +170,7 @@ class UnitBatch:
                 f"{angular_momentum[k].tolist()}"
             )
         return _many_compiled(
-            self.moments,
+            self.inertia,
             np.ascontiguousarray(angular_momentum, dtype=np.float64),
             np.ascontiguousarray(quaternion_wxyz, dtype=np.float64),
             np.ascontiguousarray(dt, dtype=np.float64),
@@ -224,11 +224,11 @@ def _one_state(inertia: NDArray, m: NDArray, q: NDArray, τ: Any, k: int | None 
     """One state as Python floats, checked (``k``: its index in a batch, for messages)."""
     at = "" if k is None else f"[{k}]"
     I_list, m_list, q_list, τ_float = inertia.tolist(), m.tolist(), q.tolist(), float(τ)
-    for name, values in (("moments", I_list), ("angular_momentum", m_list)):
+    for name, values in (("inertia", I_list), ("angular_momentum", m_list)):
         if not all(map(math.isfinite, values)):
             raise InputError(f"{name}{at} must be finite, got {values}")
     if not min(I_list) > 0.0:
-        raise InputError(f"moments{at} must be positive, got {I_list}")
+        raise InputError(f"inertia{at} must be positive, got {I_list}")
     w, x, y, z = q_list
     norm = math.sqrt(w * w + x * x + y * y + z * z)
     if not (math.isfinite(norm) and norm > 0.0):
@@ -239,7 +239,7 @@ def _one_state(inertia: NDArray, m: NDArray, q: NDArray, τ: Any, k: int | None 
         raise InputError(f"dt{at} must be finite, got {τ_float}")
     if not math.isfinite(math.hypot(*m_list) / min(I_list)):
         raise InputError(
-            f"angular_momentum{at} {m_list} with moments {I_list}: the angular velocity "
+            f"angular_momentum{at} {m_list} with inertia {I_list}: the angular velocity "
             "|m|/I1 is beyond the float range"
         )
     return tuple(I_list), tuple(m_list), (w / norm, x / norm, y / norm, z / norm), τ_float, at
@@ -247,7 +247,7 @@ def _one_state(inertia: NDArray, m: NDArray, q: NDArray, τ: Any, k: int | None 
 
 def _broadcast(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray):
     """Arrays (N, 3), (N, 3), (N, 4) and (N,), broadcast together (shapes checked)."""
-    for name, array, width in (("moments", inertia, 3), ("angular_momentum", m, 3)):
+    for name, array, width in (("inertia", inertia, 3), ("angular_momentum", m, 3)):
         if array.ndim not in (1, 2) or array.shape[-1] != width:
             raise InputError(
                 f"{name} must have shape ({width},) or (N, {width}), got {array.shape}"
@@ -260,7 +260,7 @@ def _broadcast(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray):
         N = np.broadcast_shapes(inertia.shape[:-1], m.shape[:-1], q.shape[:-1], τ.shape)
     except ValueError:
         raise InputError(
-            f"the numbers of states do not match: moments {inertia.shape}, angular_momentum "
+            f"the numbers of states do not match: inertia {inertia.shape}, angular_momentum "
             f"{m.shape}, quaternion_wxyz {q.shape}, dt {τ.shape}"
         ) from None
     n = N[0] if N else 1
@@ -272,14 +272,14 @@ def _broadcast(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray):
 
 def _checked_batch(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray) -> NDArray:
     """The checks of ``_one_state`` on a whole batch; returns the normalized quaternions."""
-    for name, array in (("moments", inertia), ("angular_momentum", m), ("dt", τ)):
+    for name, array in (("inertia", inertia), ("angular_momentum", m), ("dt", τ)):
         finite = np.isfinite(array)
         if not finite.all():
             k = int(np.flatnonzero(~finite.reshape(len(array), -1).all(axis=1))[0])
             raise InputError(f"{name}[{k}] must be finite, got {array[k].tolist()}")
     if not (inertia > 0.0).all():
         bad = np.flatnonzero(~np.all(inertia > 0.0, axis=1))
-        raise InputError(f"moments[{bad[0]}] must be positive, got {inertia[bad[0]].tolist()}")
+        raise InputError(f"inertia[{bad[0]}] must be positive, got {inertia[bad[0]].tolist()}")
     norms = np.linalg.norm(q, axis=1)
     if not (np.isfinite(norms) & (norms > 0.0)).all():
         bad = np.flatnonzero(~(np.isfinite(norms) & (norms > 0.0)))
@@ -298,7 +298,7 @@ def _checked_batch(inertia: NDArray, m: NDArray, q: NDArray, τ: NDArray) -> NDA
     if len(bad):
         k = bad[0]
         raise InputError(
-            f"angular_momentum[{k}] {m[k].tolist()} with moments {inertia[k].tolist()}: "
+            f"angular_momentum[{k}] {m[k].tolist()} with inertia {inertia[k].tolist()}: "
             f"the angular velocity |m|/I1 is beyond the float range"
         )
     return q / norms[:, None]

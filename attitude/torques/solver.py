@@ -31,6 +31,7 @@ References: see :mod:`attitude.torques.splitting` and :mod:`attitude.torques.mod
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from typing import Any
@@ -55,12 +56,14 @@ from attitude.torques.models import (
 from attitude.torques.splitting import Composition, composition
 
 __all__ = [
+    "ACCURACY_RANGE_RAD",
     "MAX_STEPS",
-    "TOLERANCE_RANGE_RAD",
     "StepChoice",
+    "StepPrediction",
     "TorquedSolver",
     "angles_between",
     "departure_time",
+    "error_growth",
     "first_crossing",
     "next_search_step",
     "propagate_batch",
@@ -82,11 +85,11 @@ _MAX_REQUEST_STEPS = 1e8
 # free flows a step and tens of µs a flow, 1e7 steps are about an hour of computing.
 # The scenario's run-level search (attitude.trajectory.steps) has the same cap.
 MAX_STEPS = 1e7
-# The tolerances a step search can meet (rad): below 1e-12 the Richardson estimate is
+# The accuracies a step search can meet (rad): below 1e-12 the Richardson estimate is
 # rounding (16-digit states), and the search would shrink the step until it gives up
 # at MAX_STEPS; beyond 0.1 rad an estimate from a linear error model means
 # nothing.  The scenario's ``[torques] accuracy`` has the same range.
-TOLERANCE_RANGE_RAD = (1e-12, 0.1)
+ACCURACY_RANGE_RAD = (1e-12, 0.1)
 # The body must turn by less than this fraction of a turn in the spacing of float
 # seconds at the time reached (as ``attitude.trajectory`` requires of a scenario):
 # beyond, the free flow's phase is rounding, and a torque of 1e300 N m would spin the
@@ -141,7 +144,7 @@ class _Engine:
             return advance_floats(self.moment_floats, m, q, dt)
         m_array = np.stack(np.broadcast_arrays(*m), axis=-1)
         n = m_array.shape[0]
-        if self.unit_batch is None or self.unit_batch.moments.shape[0] != n:
+        if self.unit_batch is None or self.unit_batch.inertia.shape[0] != n:
             # The moments stay from flow to flow: what depends on them alone, once.
             self.unit_batch = UnitBatch(np.broadcast_to(self.moments, (n, 3)))
         # Every argument at its full (N, ...) shape: the free flow need not broadcast.
@@ -296,7 +299,7 @@ def _grid_steps(t_from: float, t_to: float, step: float, breakpoints: NDArray, l
 
 
 # ----------------------------------------------------------------- the step search
-# One search for a step that meets an error target, shared by TorquedSolver(tolerance=)
+# One search for a step that meets an error target, shared by TorquedSolver(accuracy=)
 # and the scenario's run-level search (attitude.trajectory.steps), which estimate the
 # error differently (one solver from its start; the whole run) but move alike.
 
@@ -316,21 +319,21 @@ def search_start_step(rate: float, torques: Iterable[Torque], t: float) -> float
 def next_search_step(
     step: float,
     error: float,
-    tolerance: float,
+    accuracy: float,
     order: int,
     span: float,
     good: float | None,
     bad: float,
 ) -> float | None:
     """The step search's next try after ``step`` gave the estimate ``error``, or None
-    when the search is done.  ``good``: the largest step that met ``tolerance`` so far
+    when the search is done.  ``good``: the largest step that met ``accuracy`` so far
     (None: none yet); ``bad``: the smallest that missed it (inf: none yet).
 
-    The error model C h^p (p = ``order``) aims at half the tolerance, moving at most
+    The error model C h^p (p = ``order``) aims at half the accuracy, moving at most
     8× down (and at least to 0.8 of the step) or 4× up a try, never past half the
     ``span``; once a passing and a failing step bracket the answer, it bisects in
     log h until they are within a factor 1.25."""
-    factor = (0.5 * tolerance / max(error, 1e-300)) ** (1.0 / order)
+    factor = (0.5 * accuracy / max(error, 1e-300)) ** (1.0 / order)
     if good is not None and math.isfinite(bad):
         if bad / good < 1.25:
             return None
@@ -340,6 +343,28 @@ def next_search_step(
             return None
         return min(0.5 * span, step * min(4.0, factor))
     return step * min(0.8, max(0.125, factor))
+
+
+# The exponent k of a search's error e(t) ~ t^k, fitted where a try was cut short.
+GROWTH_RANGE = (1.0, 3.0)
+
+
+def error_growth(times: Iterable[float], worst: Iterable[float], until: float) -> float:
+    """k of e(t) ~ t^k over [until/4, until], from the largest estimate ``worst[i]`` up to
+    each time ``times[i]`` (s from the search's start), within :data:`GROWTH_RANGE`:
+    how a try cut short by `attitude check`'s budget is extrapolated over its span,
+    e(span) = e(until) (span/until)^k (attitude.trajectory.steps explains the choice)."""
+    t = np.asarray(list(times), dtype=np.float64)
+    e = list(worst)
+    if t.size == 0 or until <= 0.0:
+        return GROWTH_RANGE[0]
+    index = int(np.searchsorted(t, 0.25 * until, side="right")) - 1
+    early = e[index] if index >= 0 else 0.0
+    late = e[-1]
+    if not (early > 0.0 and math.isfinite(late) and late > early):
+        return GROWTH_RANGE[0]
+    k = math.log(late / early) / math.log(until / float(t[index]))
+    return float(np.clip(k, *GROWTH_RANGE))
 
 
 # ----------------------------------------------------------------- the solver
@@ -359,10 +384,47 @@ class StepChoice:
 
     step: float
     error_estimate: float
-    tolerance: float
+    accuracy: float
     span: float
     tried: tuple[tuple[float, float], ...] = field(default=())
     checks: int = 0
+    cpu_s: float = 0.0  # the search's CPU time (time.process_time)
+
+
+@dataclass(frozen=True)
+class StepPrediction:
+    """A step search cut by a budget of CPU time (:meth:`TorquedSolver.predict_step`,
+    for `attitude check`): its tries up to the cut are the search's own, and what lies
+    beyond is predicted.
+
+    ``step``: the step the search will end near, from the error model C h^p with a
+    margin of 2 (at most the cut try's); ``cut_step``: the try the budget cut;
+    ``predicted_error``: that try's estimate over the span, extrapolated from
+    ``until`` (s covered from t0) as t^``growth`` and bounded below by the earlier
+    tries scaled as h^p; ``tried``: (step, estimate) of every try, the last predicted;
+    ``cpu_s``: spent here, ``tries_cpu_s`` of it by the tries that finished;
+    ``cpu_per_step``: of one grid step, measured; ``search_cpu_s``: what the whole
+    search will take, predicted: the tries that finished here, the cut one finished
+    (1.5 runs of the span: the step and twice it) and two more tries at ``step``.
+    """
+
+    step: float
+    cut_step: float
+    predicted_error: float
+    until: float
+    growth: float
+    accuracy: float
+    span: float
+    tried: tuple[tuple[float, float], ...]
+    cpu_s: float
+    tries_cpu_s: float
+    cpu_per_step: float
+
+    @property
+    def search_cpu_s(self) -> float:
+        finish = 1.5 * self.span / self.cut_step * self.cpu_per_step
+        more = 2.0 * 1.5 * self.span / self.step * self.cpu_per_step
+        return self.tries_cpu_s + finish + more
 
 
 class _Propagation:
@@ -458,9 +520,9 @@ class TorquedSolver:
     small, e.g. a gravity-gradient-stabilized body; needs torques independent of ω);
     or ``method``, a name of :data:`attitude.torques.splitting.COMPOSITIONS`.
 
-    The step: ``step`` (s, default 5 s), or ``tolerance`` (rad) with ``span`` (s): the
+    The step: ``step`` (s, default 5 s), or ``accuracy`` (rad) with ``span`` (s): the
     step is then chosen so that the estimated attitude error over [t0, t0 + span] is
-    within the tolerance, and ``step_choice`` reports the estimate.
+    within the accuracy, and ``step_choice`` reports the estimate.
 
     ``wheel_momentum``: the momentum h (body axes, N m s) of wheels spinning at a
     constant speed relative to the body: the body is then a gyrostat
@@ -486,7 +548,7 @@ class TorquedSolver:
         order: int | None = None,
         *,
         method: str | None = None,
-        tolerance: float | None = None,
+        accuracy: float | None = None,
         span: float | None = None,
         wheel_momentum: ArrayLike | None = None,
     ) -> None:
@@ -545,11 +607,11 @@ class TorquedSolver:
             sorted({b for t in self._torques for b in t.breakpoints if b > self._t0})
         )
         self.step_choice: StepChoice | None = None
-        if tolerance is not None and not self._exact:
+        if accuracy is not None and not self._exact:
             if step is not None:
-                raise InputError("give either step or tolerance, not both")
-            self._propagation = self._choose_step(tolerance, span)
-        else:  # (a tolerance without torques: the exact solver needs no step)
+                raise InputError("give either step or accuracy, not both")
+            self._propagation = self._choose_step(accuracy, span)
+        else:  # (an accuracy without torques: the exact solver needs no step)
             step = 5.0 if step is None else as_si_scalar(step, "time", "step")
             if not step > 0.0:
                 raise InputError(f"step must be positive (s), got {step}")
@@ -560,29 +622,68 @@ class TorquedSolver:
     def _new_propagation(self, step: float) -> _Propagation:
         return _Propagation(self._engine, self._t0, self._m0, self._q0, step, self._breakpoints)
 
-    def _choose_step(self, tolerance: Any, span: Any) -> _Propagation:
-        """Step and half step over the span, until the Richardson estimate meets the tolerance."""
-        tolerance = as_si_scalar(tolerance, "angle", "tolerance")
-        low, high = TOLERANCE_RANGE_RAD
-        if not low <= tolerance <= high:
+    def _choose_step(self, accuracy: Any, span: Any) -> _Propagation:
+        """Step and half step over the span, until the Richardson estimate meets the accuracy."""
+        choice, propagation = self._search(accuracy, span, None)
+        assert isinstance(choice, StepChoice) and propagation is not None
+        self.step_choice = choice
+        return propagation
+
+    def predict_step(
+        self, accuracy: Any, span: Any, budget_s: float
+    ) -> StepChoice | StepPrediction:
+        """The search that ``accuracy=`` and ``span=`` make, within ``budget_s`` of CPU
+        time: its :class:`StepChoice` when it ends within the budget, else a
+        :class:`StepPrediction` from its tries so far (the same tries, cut where the
+        budget ran out).  Refuses what the search would refuse, and a predicted step
+        of more than :data:`MAX_STEPS` steps over the span.  The solver itself is
+        unchanged (its step stays the one it was made with)."""
+        return self._search(accuracy, span, budget_s)[0]
+
+    def _search(
+        self, accuracy: Any, span: Any, budget_s: float | None
+    ) -> tuple[StepChoice | StepPrediction, _Propagation | None]:
+        """The step search of ``accuracy`` over ``span``; with ``budget_s``, cut when the
+        CPU time spent passes it (:meth:`predict_step`)."""
+        accuracy = as_si_scalar(accuracy, "angle", "accuracy")
+        low, high = ACCURACY_RANGE_RAD
+        if not low <= accuracy <= high:
             raise InputError(
-                f"tolerance must be between {low:g} and {high:g} rad (below, the estimate "
-                f"is rounding; above, it means nothing), got {tolerance!r} rad"
+                f"accuracy must be between {low:g} and {high:g} rad (below, the estimate "
+                f"is rounding; above, it means nothing), got {accuracy!r} rad"
             )
         if span is None:
-            raise InputError("a tolerance needs span=, the duration (s) it is to hold over")
+            raise InputError("an accuracy needs span=, the duration (s) it is to hold over")
         span = as_si_scalar(span, "time", "span")
         if not span > 0.0:
             raise InputError(f"span must be positive (s), got {span}")
         p = self.method.order
+        scale = 2.0**p - 1.0
         checks = self._t0 + span * np.linspace(1.0 / 32.0, 1.0, 32)
+        started = time.process_time()
 
-        def estimate(step: float) -> tuple[float, _Propagation]:
-            """Richardson estimate of the error of the run at ``step`` (from 2 step)."""
+        def estimate(step: float) -> tuple[float, _Propagation, tuple | None]:
+            """Richardson estimate of the error of the run at ``step`` (from 2 step), and
+            (checks compared, their running largest estimate, the steps taken, the CPU
+            time of the try) when the budget cut it."""
             fine = self._new_propagation(step)
             coarse = self._new_propagation(2.0 * step)
-            difference = np.max(angles_between(coarse.states(checks)[1], fine.states(checks)[1]))
-            return float(difference) / (2.0**p - 1.0), fine
+            if budget_s is None:
+                difference = np.max(
+                    angles_between(coarse.states(checks)[1], fine.states(checks)[1])
+                )
+                return float(difference) / scale, fine, None
+            begun = time.process_time()
+            worst, envelope = 0.0, []
+            for i in range(checks.size):  # in time order: the grids grow as they are read
+                at = checks[i : i + 1]
+                angle = float(angles_between(coarse.states(at)[1], fine.states(at)[1])[0])
+                worst = max(worst, angle / scale)
+                envelope.append(worst)
+                if i + 1 < checks.size and time.process_time() - started > budget_s:
+                    cost = time.process_time() - begun
+                    return worst, fine, (i + 1, envelope, fine.count + coarse.count, cost)
+            return worst, fine, None
 
         # Search on the adopted step s, within a factor 1.25 of the largest that passes:
         # the error model C s^p to move, bisection (in log s) once bracketed.
@@ -592,41 +693,87 @@ class TorquedSolver:
         tried: list[tuple[float, float]] = []
         for _ in range(10):
             if span / step > MAX_STEPS:
-                last = (
-                    f"; the estimate was {tried[-1][1]:.3g} rad at {tried[-1][0]:.3g} s"
-                    if tried
-                    else ""
-                )
-                raise InputError(
-                    f"{tolerance:g} rad over {span:g} s would need a step below "
-                    f"{step:.3g} s, more than {MAX_STEPS:g} steps{last}: give a step, "
-                    "a looser tolerance or a shorter span",
-                    key="tolerance",
-                    value=tolerance,
-                )
-            error, propagation = estimate(step)
+                raise self._too_many_steps(accuracy, span, step, tried)
+            error, propagation, cut = estimate(step)
+            if cut is not None:
+                return self._prediction(accuracy, span, step, error, cut, tried, started), None
             tried.append((step, error))
-            if error <= tolerance:
+            if error <= accuracy:
                 if good is None or step > good[0]:
                     good = (step, error, propagation)
             else:
                 bad = min(bad, step)
             following = next_search_step(
-                step, error, tolerance, p, span, None if good is None else good[0], bad
+                step, error, accuracy, p, span, None if good is None else good[0], bad
             )
             if following is None:
                 break
             step = following
         if good is None:
             raise InputError(
-                f"{tolerance:g} rad over {span:g} s not reached: the estimate was "
+                f"{accuracy:g} rad over {span:g} s not reached: the estimate was "
                 f"{tried[-1][1]:.3g} rad at a step of {tried[-1][0]:.3g} s",
-                key="tolerance",
-                value=tolerance,
+                key="accuracy",
+                value=accuracy,
             )
         step, error, propagation = good
-        self.step_choice = StepChoice(step, error, tolerance, span, tuple(tried), len(checks))
-        return propagation
+        cpu = time.process_time() - started
+        choice = StepChoice(step, error, accuracy, span, tuple(tried), len(checks), cpu)
+        return choice, propagation
+
+    def _too_many_steps(
+        self, accuracy: float, span: float, step: float, tried: list[tuple[float, float]]
+    ) -> InputError:
+        last = f"; the estimate was {tried[-1][1]:.3g} rad at {tried[-1][0]:.3g} s" if tried else ""
+        return InputError(
+            f"{accuracy:g} rad over {span:g} s would need a step below "
+            f"{step:.3g} s, more than {MAX_STEPS:g} steps{last}: give a step, "
+            "a looser accuracy or a shorter span",
+            key="accuracy",
+            value=accuracy,
+        )
+
+    def _prediction(
+        self,
+        accuracy: float,
+        span: float,
+        step: float,
+        error: float,
+        cut: tuple,
+        tried: list[tuple[float, float]],
+        started: float,
+    ) -> StepPrediction:
+        """The search cut at the try of ``step`` after ``cut[0]`` checks: its estimate
+        extrapolated over the span, bounded below by the finished tries scaled as h^p,
+        and the step that meets the accuracy with a margin of 2 (as
+        attitude.trajectory.steps predicts the run-level search)."""
+        count, envelope, steps, cost = cut
+        p = self.method.order
+        times = [float(x) for x in (np.linspace(1.0 / 32.0, 1.0, 32)[:count] * span)]
+        until = times[-1]
+        growth = error_growth(times, envelope, until)
+        predicted = max(
+            [error * (span / until) ** growth] + [e * (step / h) ** p for h, e in tried if e > 0.0]
+        )
+        needed = step * min(1.0, (0.5 * accuracy / max(predicted, 1e-300)) ** (1.0 / p))
+        tried = [*tried, (step, predicted)]
+        if span / needed > MAX_STEPS:
+            raise self._too_many_steps(accuracy, span, needed, tried)
+        per_step = cost / steps if steps else 0.0
+        spent = time.process_time() - started
+        return StepPrediction(
+            needed,
+            step,
+            predicted,
+            until,
+            growth,
+            accuracy,
+            span,
+            tuple(tried),
+            spent,
+            spent - cost,
+            per_step,
+        )
 
     def _initial_step(self) -> float:
         """:func:`search_start_step` at the initial rate (the gyroscopic turn's too)."""
@@ -772,7 +919,7 @@ class TorquedSolver:
 
 
 def propagate_batch(
-    moments: ArrayLike,
+    inertia: ArrayLike,
     angular_momentum: ArrayLike,
     attitude: Rotation | None = None,
     t0: float = 0.0,
@@ -788,7 +935,7 @@ def propagate_batch(
 
     For dispersion studies: every kick and every free flow acts on all N states at
     once (vectorized), and the time-dependent part of the torques (the orbit position)
-    is computed once for all.  ``moments``: principal moments along the body axes,
+    is computed once for all.  ``inertia``: principal moments along the body axes,
     (3,) shared or (N, 3) dispersed, kg m² (body axes = principal axes here: a full
     tensor is diagonalized by the caller, as ``attitude.solver.inertia.principal_axes`` does);
     ``angular_momentum``: (N, 3), body axes, N m s; ``attitude``: a stack of N
@@ -804,14 +951,14 @@ def propagate_batch(
     quaternions body → inertial, scalar first, (T, N, 4), at each of the T times.
     The same grid and dense output as :class:`TorquedSolver` with the same step.
     """
-    moments = as_si_array(moments, "moment_of_inertia", "moments")
+    inertia = as_si_array(inertia, "moment_of_inertia", "inertia")
     m = as_si_array(angular_momentum, "angular_momentum", "angular_momentum")
     if m.ndim != 2 or m.shape[1] != 3:
         raise InputError(f"angular_momentum must have shape (N, 3), got {m.shape}")
     n = m.shape[0]
-    if moments.shape not in ((3,), (n, 3)) or not np.all(moments > 0.0):
+    if inertia.shape not in ((3,), (n, 3)) or not np.all(inertia > 0.0):
         raise InputError(
-            f"moments must be 3 positive values or shape ({n}, 3), got {moments.shape}"
+            f"inertia must be 3 positive moments or shape ({n}, 3), got {inertia.shape}"
         )
     if attitude is None:
         q = np.tile([1.0, 0.0, 0.0, 0.0], (n, 1))
@@ -826,7 +973,7 @@ def propagate_batch(
         raise InputError(f"step must be positive (s), got {step}")
     torques = as_torque_list(torques)
     chosen = composition(4 if order is None and method is None else order, method)
-    frame = PrincipalFrame(tuple(moments[..., i] for i in range(3)))
+    frame = PrincipalFrame(tuple(inertia[..., i] for i in range(3)))
     gyroscope = None
     if wheel_momentum is not None:
         h = as_si_array(wheel_momentum, "angular_momentum", "wheel_momentum")
@@ -839,7 +986,7 @@ def propagate_batch(
             )
         h = np.broadcast_to(h, (n, 3))
         gyroscope = Gyroscope(tuple(h[:, i] for i in range(3)), frame.moments)
-    engine = _Engine(chosen, merged_constant_torques(torques), frame, moments, gyroscope)
+    engine = _Engine(chosen, merged_constant_torques(torques), frame, inertia, gyroscope)
     breakpoints = np.array(sorted({b for t in torques for b in t.breakpoints if b > t0}))
 
     out_m = np.empty((times.size, n, 3))
@@ -860,7 +1007,7 @@ def propagate_batch(
             i += 1
             continue
         data = [d.tolist() for d in engine.time_data(starts, sizes)]
-        largest = largest_momentum(moments, float(starts[-1] + sizes[-1]))
+        largest = largest_momentum(inertia, float(starts[-1] + sizes[-1]))
         for k in range(starts.size):
             while i < times.size and times[i] < starts[k] + sizes[k]:
                 output(i, float(starts[k]))
@@ -868,7 +1015,7 @@ def propagate_batch(
             state = engine.step(*state, float(sizes[k]), engine.rows_for_step(data, k))
             m_k = state[0]
             if not np.all(np.abs(m_k[0]) + np.abs(m_k[1]) + np.abs(m_k[2]) <= largest):
-                _refuse_runaway(m_k, moments, float(starts[k] + sizes[k]))
+                _refuse_runaway(m_k, inertia, float(starts[k] + sizes[k]))
         t = float(starts[-1] + sizes[-1])
     return out_m, out_q
 

@@ -62,7 +62,7 @@ def hand_off(
     torques: Sequence[Any] = (),
     *,
     step: float | None = None,
-    tolerance: float | None = None,
+    accuracy: float | None = None,
     span: float | None = None,
     order: int | None = None,
 ) -> EulerSolver | TorquedSolver:
@@ -74,7 +74,7 @@ def hand_off(
 
     Returns the exact :class:`EulerSolver` for locked wheels without torques, else a
     :class:`TorquedSolver` (spinning wheels: a gyrostat; ``torques``: torque models of
-    :mod:`attitude.torques.models`), with ``step`` or ``tolerance`` and ``span``
+    :mod:`attitude.torques.models`), with ``step`` or ``accuracy`` and ``span``
     (default: ``TorquedSolver``'s step) and ``order``.  Both give ``attitude(t)``,
     ``angular_velocity(t)`` (body, rad/s) and ``angular_momentum(t)`` (the total M, body
     axes) for t ≥ t0.
@@ -89,8 +89,8 @@ def hand_off(
     if not spinning and not torques:
         return EulerSolver(tensor, M, attitude, t0=t0)
     options: dict[str, Any] = {"order": order}
-    if tolerance is not None:
-        options.update(tolerance=tolerance, span=span)
+    if accuracy is not None:
+        options.update(accuracy=accuracy, span=span)
     elif step is not None:
         options["step"] = step
     return TorquedSolver(

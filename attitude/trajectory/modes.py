@@ -35,6 +35,7 @@ orientation table's coverage), stated by ``check`` and in the summary.
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -49,7 +50,7 @@ from attitude.scenario.events import AttitudeReset, InertiaChange, State
 from attitude.scenario.modes import MODE_EVENTS, ControlLoss, ControlResume, ModeChange, Wheels
 from attitude.scenario.scenario import Scenario
 from attitude.solver.inertia import PrincipalAxes
-from attitude.torques.solver import TorquedSolver
+from attitude.torques.solver import StepChoice, StepPrediction, TorquedSolver
 from attitude.trajectory.guided import GuidedMotion
 from attitude.trajectory.torqued import TorquedMotion
 
@@ -72,6 +73,10 @@ GYROSTAT_ACCURACY_RAD = 1e-7
 # is refused before it starts, so that `check` answers in seconds and an absurd span
 # (years of tumbling) is one line, not hours; a given [torques] step has no search.
 GYROSTAT_SEARCH_MAX_STEPS = 2e5
+# `attitude check` cuts the gyrostat's step search at its CPU budget and predicts the
+# rest (TorquedSolver.predict_step); the segment is then propagated at a step long
+# enough to take about this much CPU, for the checks that read the motion.
+_CHECK_MOTION_S = 0.5
 
 
 def uses_laws(scenario: Scenario) -> bool:
@@ -96,8 +101,11 @@ class _Builder:
         free_solver: Callable[..., Any],
         make: Callable[..., Any],
         where: Callable[..., Any],
+        check_budget_s: float | None = None,
     ) -> None:
         self.scenario = scenario
+        # `attitude check`: the CPU time left for the gyrostats' step searches (None: run).
+        self.budget_left = check_budget_s
         self.step = step
         self.free_solver = free_solver
         self.make = make
@@ -260,16 +268,34 @@ class _Builder:
         torques = [m for m, _ in acting]
         try:
             step = self.step_for()
-            estimate = None
+            if step is None and settings.step is not None:
+                step = float(settings.step)
+            search: StepChoice | StepPrediction | None = None
             if step is None:
-                step, estimate = _gyrostat_step(state, start, end, torques, settings, h)
+                started = time.process_time()
+                search = _gyrostat_step(state, start, end, torques, settings, h, self.budget_left)
+                if self.budget_left is not None:
+                    self.budget_left -= time.process_time() - started
+                step = _motion_step(search, end - start)
             motion = TorquedMotion(state, start, end, torques, step, settings.order, h)
         except InputError as exc:
+            if exc.key == "accuracy":  # the step search's refusal: the scenario's key
+                raise InputError(
+                    f"{text}: {exc.reason}", key="torques.accuracy", value=exc.value
+                ) from None
             if exc.key is not None:
                 raise
             raise InputError(f"{text}: {exc.reason}", key=key) from None
-        if estimate is not None:
-            motion.error_estimate = estimate
+        if search is not None:
+            motion.step_search = search
+            if isinstance(search, StepPrediction):
+                # The error model C h^p, from the cut try to the step predicted.
+                shrink = (search.step / search.cut_step) ** settings.order
+                motion.error_estimate = search.predicted_error * shrink
+                if step != search.step:
+                    motion.approximate_step_s = step
+            else:
+                motion.error_estimate = search.error_estimate
         return motion
 
     # ---- the walk
@@ -412,17 +438,24 @@ def _rate_key(key: str, event: Any) -> str:
 
 
 def _gyrostat_step(
-    state: State, start: float, end: float, torques: list, settings: Any, wheels: Any
-) -> tuple[float, float | None]:
-    """(step, estimated error) of a gyrostat segment that the run gives no step: the
-    ``[torques]`` step, or the step the splitting chooses for the ``[torques]`` accuracy
-    (:data:`GYROSTAT_ACCURACY_RAD` when none is given) over the segment."""
-    if settings.step is not None:
-        return float(settings.step), None
+    state: State,
+    start: float,
+    end: float,
+    torques: list,
+    settings: Any,
+    wheels: Any,
+    budget_s: float | None = None,
+) -> StepChoice | StepPrediction:
+    """How the step of a gyrostat segment that neither the run nor ``[torques]`` gives
+    is chosen: by the splitting's search for the ``[torques]`` accuracy
+    (:data:`GYROSTAT_ACCURACY_RAD` when none is given) over the segment.  With
+    ``budget_s`` (`attitude check`), the search is cut when it has spent that much CPU
+    and the rest predicted (:meth:`TorquedSolver.predict_step`): what the prediction
+    refuses, the search refuses too."""
     span = end - start
-    if span <= SAME_INSTANT_S:
-        return max(span, 1.0), 0.0
     accuracy = settings.accuracy if settings.accuracy is not None else GYROSTAT_ACCURACY_RAD
+    if span <= SAME_INSTANT_S:
+        return StepChoice(max(span, 1.0), 0.0, accuracy, span)
     # The search's first step (TorquedSolver's): half a quarter turn at the faster of
     # the body's rate I⁻¹M and the gyroscopic turn |I⁻¹h|.
     tensor = state.inertia.tensor
@@ -437,20 +470,42 @@ def _gyrostat_step(
             f"start at {first:.3g} s, {span / first:.3g} steps a try (at most "
             f"{GYROSTAT_SEARCH_MAX_STEPS:g}): give [torques] step, or a shorter span"
         )
+    if budget_s is not None:
+        solver = TorquedSolver(
+            tensor,
+            state.angular_momentum,
+            state.attitude,
+            start,
+            torques,
+            step=first,
+            order=settings.order,
+            wheel_momentum=wheels,
+        )
+        return solver.predict_step(accuracy, span, max(budget_s, 0.0))
     chooser = TorquedSolver(
-        state.inertia.tensor,
+        tensor,
         state.angular_momentum,
         state.attitude,
         start,
         torques,
         order=settings.order,
-        tolerance=accuracy,
+        accuracy=accuracy,
         span=span,
         wheel_momentum=wheels,
     )
     choice = chooser.step_choice
-    assert choice is not None  # a tolerance and a gyroscopic term: the step is searched
-    return choice.step, choice.error_estimate
+    assert choice is not None  # an accuracy and a gyroscopic term: the step is searched
+    return choice
+
+
+def _motion_step(search: StepChoice | StepPrediction, span: float) -> float:
+    """The step the segment is propagated at: the search's, or for a search that check's
+    budget cut, the predicted step or a longer one that takes about _CHECK_MOTION_S of
+    CPU (the checks that read the motion need its sizes, not its last digits)."""
+    if isinstance(search, StepChoice):
+        return search.step
+    affordable = _CHECK_MOTION_S / search.cpu_per_step if search.cpu_per_step > 0.0 else 1e4
+    return max(search.step, span / max(affordable, 1.0))
 
 
 def law_initial_state(scenario: Scenario) -> State:
@@ -470,6 +525,7 @@ def mode_segments(
     free_solver: Callable[..., Any],
     make: Callable[..., Any],
     where: Callable[..., Any],
+    check_budget_s: float | None = None,
 ) -> list[Any]:
     """The segments of ``scenario`` (which uses laws: :func:`uses_laws`), in time order.
 
@@ -478,7 +534,9 @@ def mode_segments(
     acts); ``free_solver(state, t0, end, where, step)``: the free or torqued solver from
     a state; ``make(raw, where)``: the checked segment of ``raw`` = (start, end, solver,
     state, event, before); ``where(key, text)``: what errors about a segment's motion
-    name (the key that set its rate, the state in words).  The errors are
+    name (the key that set its rate, the state in words); ``check_budget_s``: for
+    `attitude check`, the CPU time the gyrostats' step searches may take together,
+    beyond which they are predicted (:func:`_gyrostat_step`).  The errors are
     :class:`InputError` whose ``key`` names what holds the bad value.
     """
-    return _Builder(scenario, step, free_solver, make, where).build(models)
+    return _Builder(scenario, step, free_solver, make, where, check_budget_s).build(models)

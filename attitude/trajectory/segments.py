@@ -289,6 +289,7 @@ def segments(
     models: list[tuple[float, float, Torque, str]],
     step: float | Sequence[float | None] | None,
     checked: bool = True,
+    check_budget_s: float | None = None,
 ) -> Iterator[Segment]:
     """The segments of ``scenario`` in time order, built one at a time: the next is
     made when it is asked for, from this one's state at its end.
@@ -298,11 +299,14 @@ def segments(
     made before, rerun at its own steps).  ``checked``: refuse a segment that turns faster than
     TT seconds follow (:func:`check_resolved`) before yielding it, which propagates a
     torqued one to its end; a caller that compares runs as they go checks later.
+    ``check_budget_s``: for `attitude check`, the CPU time that the step searches of
+    gyrostat segments (spinning wheels after a control loss, no torque acting) may take
+    together, beyond which they are predicted (:mod:`attitude.trajectory.modes`).
     Errors are :class:`InputError` whose ``key`` names the state whose motion the
     solver refuses, or the burn that spins it up (:meth:`Segment.refused`).
     """
     if uses_laws(scenario):  # laws, slews, control losses: attitude.trajectory.modes
-        yield from _law_segments(scenario, models, step, checked)
+        yield from _law_segments(scenario, models, step, checked, check_budget_s)
         return
     ends = [offset for offset, _ in scenario.events] + [scenario.stop_s]
     state = initial_state(scenario)
@@ -340,6 +344,7 @@ def _law_segments(
     models: list[tuple[float, float, Torque, str]],
     step: float | Sequence[float | None] | None,
     checked: bool,
+    check_budget_s: float | None = None,
 ) -> Iterator[Segment]:
     """The segments of a scenario with laws (:func:`attitude.trajectory.modes.mode_segments`),
     with this module's solvers for the free stretches and its checks; the walk is made
@@ -364,4 +369,4 @@ def _law_segments(
             check_resolved(segment)
         return segment
 
-    yield from mode_segments(scenario, models, step, free_solver, make, Where)
+    yield from mode_segments(scenario, models, step, free_solver, make, Where, check_budget_s)

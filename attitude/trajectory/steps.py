@@ -53,6 +53,7 @@ from attitude.torques.models import ConstantTorque, Torque
 from attitude.torques.solver import (
     MAX_STEPS,
     angles_between,
+    error_growth,
     next_search_step,
     search_start_step,
 )
@@ -75,7 +76,6 @@ STOP_FACTOR = 64.0
 CHECK_BUDGET_S = 3.0
 _CHUNK = 4  # checks compared at a time: a try stops within 1/64 of the span
 _MAX_TRIES = 12
-_GROWTH = (1.0, 3.0)
 
 
 @dataclass(frozen=True)
@@ -120,7 +120,7 @@ class RunSteps:
     """How the torqued segments' step was set, and the run's estimated error.
 
     ``step_s``: the step of every torqued segment; ``given``: from ``[torques] step``
-    (else chosen for ``tolerance_rad``); ``measurement``: the run's estimate at that
+    (else chosen for ``accuracy_rad``); ``measurement``: the run's estimate at that
     step (None when not measured yet); ``tried``: (step, estimate, how the try ended) of
     every try of the search; ``settled``: False when check's budget stopped the search
     (``step_s`` is then its last candidate); ``grid_steps``: the steps of one run over
@@ -131,7 +131,7 @@ class RunSteps:
     step_s: float
     order: int
     given: bool
-    tolerance_rad: float | None
+    accuracy_rad: float | None
     measurement: Measurement | None = None
     tried: tuple[tuple[float, float, str], ...] = field(default=())
     settled: bool = True
@@ -160,19 +160,6 @@ def _check_times(scenario: Scenario) -> NDArray[np.float64]:
 
 def _torqued_steps(items: Iterable[Segment]) -> int:
     return sum(s.solver.steps_computed for s in items if isinstance(s.solver, TorquedMotion))
-
-
-def _growth(times: list[float], worst: list[float], until: float) -> float:
-    """k of e(t) ~ t^k over [until/4, until] (module docstring), within _GROWTH."""
-    if not times or until <= 0.0:
-        return _GROWTH[0]
-    index = int(np.searchsorted(np.asarray(times), 0.25 * until, side="right")) - 1
-    early = worst[index] if index >= 0 else 0.0
-    late = worst[-1]
-    if not (early > 0.0 and math.isfinite(late) and late > early):
-        return _GROWTH[0]
-    k = math.log(late / early) / math.log(until / times[index])
-    return float(np.clip(k, *_GROWTH))
 
 
 def measure(
@@ -213,7 +200,7 @@ def measure(
     worst = 0.0
 
     def result(ended: str, until: float, steps: int) -> Measurement:
-        growth = _growth(times, envelope, until) if ended != "span" else 1.0
+        growth = error_growth(times, envelope, until) if ended != "span" else 1.0
         found = Measurement(
             max((h for h in step if h is not None), default=0.0)
             if isinstance(step, list)
@@ -381,7 +368,7 @@ def _needed_step(
     models: list[tuple[float, float, Torque, str]],
     found: Measurement,
     tried: list[tuple[float, float, str]],
-    tolerance: float,
+    accuracy: float,
     order: int,
 ) -> float:
     """The step that the error model C h^p says meets the accuracy with a margin of 2,
@@ -389,7 +376,7 @@ def _needed_step(
     longer than the try's step; an InputError when it takes more than MAX_STEPS steps
     (the search would only shrink the step until it did)."""
     predicted = found.predicted_rad if found.ended == "budget" else found.extrapolated()
-    step = found.step_s * min(1.0, (0.5 * tolerance / max(predicted, 1e-300)) ** (1.0 / order))
+    step = found.step_s * min(1.0, (0.5 * accuracy / max(predicted, 1e-300)) ** (1.0 / order))
     if scenario.stop_s / step > MAX_STEPS:
         where = (
             "over the whole span"
@@ -400,7 +387,7 @@ def _needed_step(
             scenario,
             models,
             step,
-            f"{tolerance:g} rad over {scenario.stop_s:g} s would need a step near {step:.3g} "
+            f"{accuracy:g} rad over {scenario.stop_s:g} s would need a step near {step:.3g} "
             f"s, more than {MAX_STEPS:g} steps: the run's estimate was "
             f"{found.estimate_rad:.3g} rad at a step of {found.step_s:.3g} s {where}",
         )
@@ -414,8 +401,8 @@ def choose_steps(
 ) -> tuple[RunSteps, list[Segment] | None]:
     """The step for ``[torques] accuracy`` (module docstring): (how it was chosen, the
     run at that step, or None when check's ``budget_s`` stopped the search)."""
-    tolerance = scenario.torques.accuracy_rad
-    assert tolerance is not None  # an accuracy, or the default one
+    accuracy = scenario.torques.accuracy_rad
+    assert accuracy is not None  # an accuracy, or the default one
     order = scenario.torques.order
     span = scenario.stop_s
     step = _initial_step(scenario, models)
@@ -429,33 +416,33 @@ def choose_steps(
             raise _too_many_steps(scenario, models, step, tried)
         left = None if budget_s is None else max(budget_s - (time.process_time() - started), 0.0)
         found, run = measure(
-            scenario, models, step, budget_s=left, stop_above=STOP_FACTOR * tolerance
+            scenario, models, step, budget_s=left, stop_above=STOP_FACTOR * accuracy
         )
         if found.ended == "budget":  # check: the search stops here, its estimate predicted
             predicted = _predicted(found, seen, order)
             found = Measurement(**{**found.__dict__, "predicted_rad": predicted})
             tried.append((step, predicted, found.ended))
-            needed = _needed_step(scenario, models, found, tried, tolerance, order)
+            needed = _needed_step(scenario, models, found, tried, accuracy, order)
             cpu = time.process_time() - started
             per_step = found.cpu_s / found.steps if found.steps else 0.0
             grid = predicted_steps(scenario, models, needed)
             choice = RunSteps(
-                needed, order, False, tolerance, found, tuple(tried), False, grid, per_step, cpu
+                needed, order, False, accuracy, found, tuple(tried), False, grid, per_step, cpu
             )
             return choice, None
         seen.append(found)
         error = found.estimate_rad
         tried.append((step, error, found.ended))
-        if error > tolerance:
-            _needed_step(scenario, models, found, tried, tolerance, order)  # refuses a hopeless one
-        if error <= tolerance:
+        if error > accuracy:
+            _needed_step(scenario, models, found, tried, accuracy, order)  # refuses a hopeless one
+        if error <= accuracy:
             assert run is not None
             if good is None or step > good[0]:
                 good = (step, found, run)
         else:
             bad = min(bad, step)
         following = next_search_step(
-            step, error, tolerance, order, span, None if good is None else good[0], bad
+            step, error, accuracy, order, span, None if good is None else good[0], bad
         )
         if following is None:
             break
@@ -463,14 +450,14 @@ def choose_steps(
     cpu = time.process_time() - started
     if good is None:
         raise InputError(
-            f"{tolerance:g} rad over {span:g} s not reached: the run's estimate was "
+            f"{accuracy:g} rad over {span:g} s not reached: the run's estimate was "
             f"{tried[-1][1]:.3g} rad at a step of {tried[-1][0]:.3g} s",
             key="torques.accuracy",
-            value=tolerance,
+            value=accuracy,
         )
     step, found, run = good
     grid = _torqued_steps(run)
     per_step = found.cpu_s / found.steps if found.steps else 0.0
     return RunSteps(
-        step, order, False, tolerance, found, tuple(tried), True, grid, per_step, cpu
+        step, order, False, accuracy, found, tuple(tried), True, grid, per_step, cpu
     ), run

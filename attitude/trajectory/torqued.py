@@ -44,7 +44,7 @@ from attitude.scenario.events import State
 from attitude.scenario.scenario import Scenario
 from attitude.scenario.torques import ScenarioTorques
 from attitude.torques.models import ConstantTorque, GravityGradient, Torque
-from attitude.torques.solver import TorquedSolver
+from attitude.torques.solver import StepChoice, StepPrediction, TorquedSolver
 
 __all__ = ["SURVEY_PER_TURN", "TorquedMotion", "flip_amplitude_exceeds", "scenario_torque_models"]
 
@@ -187,6 +187,11 @@ class TorquedMotion:
         )
         # The run's estimated error within this segment (attitude.trajectory.steps).
         self.error_estimate: float | None = None
+        # A gyrostat's own step search (attitude.trajectory.modes): chosen, or predicted
+        # by `attitude check` past its budget, when the motion is then propagated at
+        # the longer approximate_step_s.
+        self.step_search: StepChoice | StepPrediction | None = None
+        self.approximate_step_s: float | None = None
         self._last: tuple[NDArray, NDArray, NDArray] | None = None
         self._survey: tuple[NDArray, NDArray, NDArray] | None = None
 

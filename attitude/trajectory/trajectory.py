@@ -65,7 +65,9 @@ def propagate(
     ``check``: what ``attitude check`` needs, within seconds: the search (or, with a
     given step, the run's estimate) within check's CPU budget; when that does not
     cover the whole run, the estimate is predicted, and the motion is propagated at a
-    longer step for the checks that read it (:attr:`Trajectory.approximate`).
+    longer step for the checks that read it (:attr:`Trajectory.approximate`).  Without
+    torques, a gyrostat segment's own step search (:mod:`attitude.trajectory.modes`) is
+    cut at the same budget and predicted beyond it.
 
     Raises :class:`InputError` whose ``key`` names what holds the bad value: the
     state (``initial_state.angular_velocity``, ``events[i].impulse``) whose motion the
@@ -75,8 +77,9 @@ def propagate(
     meet it otherwise; the orbit the gravity gradient needs.
     """
     models = scenario_torque_models(scenario) if scenario.torques.any else []
-    if not models:
-        return Trajectory(scenario, list(segments(scenario, models, None)))
+    if not models:  # check: a gyrostat's own step search within check's budget
+        budget = CHECK_BUDGET_S if check else None
+        return Trajectory(scenario, list(segments(scenario, models, None, check_budget_s=budget)))
     settings = scenario.torques
     if steps is not None:
         given = [h for h in steps if h is not None]
