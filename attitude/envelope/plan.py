@@ -193,14 +193,14 @@ def make_job(plan: EnvelopePlan) -> tuple[EnvelopeJob, list[str], list[str]]:
         k = int(np.argmax(np.linalg.norm(momenta, axis=1)))
         worst = State(handed[k], momenta[k], axes)
         τ = float(seconds[k])
-        step, _ = _gyrostat_step(
+        step = _gyrostat_step(
             worst,
             τ,
             τ + settings.window,
             [m for a, b, m in torques if a < τ + settings.window and b > τ],
             scenario.torques,
             plan.wheels.momentum_vector if spinning else None,
-        )
+        ).step
     job = EnvelopeJob(
         span,
         spec,
