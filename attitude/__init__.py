@@ -19,7 +19,9 @@ checks it, and that the README's "Layout" table lists the same layers and module
 12. ``attitude.files``: scenario files read and written
 13. ``attitude.estimation``: spin state and inertia ratios fitted to telemetry
 14. ``attitude.montecarlo``: Monte Carlo dispersions on Dask
-15. ``attitude.cli``: the command line
+15. ``attitude.envelope``: the loss-of-control envelope (a control loss at every instant
+    of a nominal timeline), on Dask
+16. ``attitude.cli``: the command line
 
 The names below are importable from ``attitude`` directly; all but the errors are
 loaded on first use, so that ``import attitude`` stays light (numpy, scipy, astropy,
@@ -39,6 +41,8 @@ from attitude.base.errors import AttitudeError, InertiaWarning, InputError
 from attitude.base.version import __version__
 
 if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and IDEs
+    from attitude.envelope.job import loss_of_control_envelope
+    from attitude.envelope.settings import EnvelopeSettings
     from attitude.environment.keplerian import KeplerianOrbit
     from attitude.environment.oem import OemOrbit
     from attitude.environment.orbit import TleOrbit
@@ -79,6 +83,8 @@ if TYPE_CHECKING:  # what the lazy names below resolve to, for type checkers and
     from attitude.trajectory.trajectory import Trajectory, propagate
 
 _LAZY = {
+    "loss_of_control_envelope": "attitude.envelope.job",
+    "EnvelopeSettings": "attitude.envelope.settings",
     "EulerSolver": "attitude.solver.euler_solver",
     "EulerSolverBatch": "attitude.solver.batch",
     "advance": "attitude.solver.free_flow",
@@ -159,6 +165,7 @@ __all__ = [
     "ControlLoss",
     "ControlResume",
     "DegenerateLawError",
+    "EnvelopeSettings",
     "EulerSolver",
     "EulerSolverBatch",
     "FitRefused",
@@ -202,6 +209,7 @@ __all__ = [
     "hand_off_at",
     "hand_off_states",
     "load_scenario",
+    "loss_of_control_envelope",
     "pointing_analysis",
     "pointing_samples",
     "propagate",

@@ -1,13 +1,16 @@
-"""The command line: ``attitude run``, ``check`` and ``montecarlo`` (also ``python -m attitude``).
+"""The command line: ``attitude run``, ``check``, ``montecarlo`` and ``envelope`` (also
+``python -m attitude``).
 
     attitude run SCENARIO.toml --out DIR   propagate, write the outputs into DIR
     attitude check SCENARIO.toml           validate the file and describe the run
     attitude montecarlo SCENARIO.toml --out DIR   the [dispersions] samples, on Dask
+    attitude envelope SCENARIO.toml --out DIR     the [envelope] of control losses, on Dask
 
 ``run`` and ``check`` take ``--formats csv,parquet,aem,plots,report`` (the outputs to
 write; default ``csv,aem,plots,report``, or the file's ``[output] formats``) and
 ``--aem-tolerance "1e-6 rad"`` (the accuracy the AEM is sampled for; an angle with its
-unit).  ``montecarlo`` writes its own outputs (``docs/montecarlo.md``).
+unit).  ``montecarlo`` and ``envelope`` write their own outputs (``docs/montecarlo.md``,
+``docs/envelope.md``).
 ``check`` goes through the same checks as ``run`` up to the sampling
 (``attitude.report.plan``): what ``check`` accepts, ``run`` computes, and it states the
 size of each chosen output.  ``--out`` given to ``check`` also checks the folder and
@@ -100,6 +103,7 @@ def _parser() -> argparse.ArgumentParser:
             'of the exact attitude, with its unit: "1e-6 rad" (the default), "0.2 arcsec"',
         )
     _montecarlo_parser(commands)
+    _envelope_parser(commands)
     from attitude.cli.fit import add_parser as add_fit_parser
 
     add_fit_parser(commands)
@@ -130,6 +134,21 @@ def _montecarlo_parser(commands) -> None:
         help="write sample K as DIR/sample_K.toml, an ordinary scenario, instead of running",
     )
     mc.add_argument("--quiet", action="store_true", help="no progress bar or messages")
+
+
+def _envelope_parser(commands) -> None:
+    """``attitude envelope``: the loss-of-control envelope of a scenario on Dask."""
+    envelope = commands.add_parser(
+        "envelope",
+        help="a control loss at every failure time of [envelope], on Dask (docs/envelope.md)",
+    )
+    envelope.add_argument("scenario", type=Path, help="scenario file (TOML) with [envelope]")
+    envelope.add_argument("--out", type=Path, help="output folder (the rules of run --out)")
+    where = envelope.add_mutually_exclusive_group()
+    where.add_argument("--scheduler", help="address of a Dask scheduler (default: local)")
+    where.add_argument("--workers", type=int, help="local worker processes (default: all cores)")
+    envelope.add_argument("--batch-size", type=int, help="failures per task (default: from costs)")
+    envelope.add_argument("--quiet", action="store_true", help="no progress bar or messages")
 
 
 def _outputs(args, outputs):
@@ -283,7 +302,7 @@ def _checked_run(args, state: dict) -> int:
     try:
         # The command line's own options first: their errors name the option, not a file.
         try:
-            if args.command != "montecarlo":  # montecarlo writes no time series
+            if args.command not in ("montecarlo", "envelope"):  # they write no time series
                 _outputs(args, OutputChoice())
         except InputError as exc:
             _error(str(exc))
@@ -294,9 +313,17 @@ def _checked_run(args, state: dict) -> int:
             from attitude.cli.montecarlo import command
 
             return command(args, loaded, progress)
+        if args.command == "envelope":
+            from attitude.cli.envelope import command as envelope_command
+
+            return envelope_command(args, loaded, progress)
         outputs = _outputs(args, loaded.outputs)
         # A run computes the validity horizon beside its outputs (attitude.report.run).
         checking = args.command == "check"
+        if "envelope" in loaded.document:  # the table in a moment, before the long checks
+            from attitude.envelope.plan import check_envelope_table
+
+            check_envelope_table(loaded)
         plan = plan_run(
             loaded.scenario,
             loaded.pointing,
@@ -310,6 +337,11 @@ def _checked_run(args, state: dict) -> int:
             from attitude.montecarlo.plan import plan_montecarlo
 
             montecarlo = plan_montecarlo(loaded, plan)
+        envelope = None
+        if "envelope" in loaded.document:  # the same checks as `attitude envelope`
+            from attitude.envelope.plan import plan_envelope
+
+            envelope = plan_envelope(loaded, plan=plan)
         if args.command == "check":
             if args.out is not None:
                 check_fits(plan.budget, args.out)
@@ -319,6 +351,8 @@ def _checked_run(args, state: dict) -> int:
             print(_describe(loaded, plan, args.out), flush=True)
             if montecarlo is not None:
                 print("\n".join(montecarlo.describe()), flush=True)
+            if envelope is not None:
+                print("\n".join(envelope.describe()), flush=True)
             return 0
         claim(args.out, OUTPUT_NAMES, dry_run=True)  # a folder that is not ours: say so first
         for note in plan.notes:

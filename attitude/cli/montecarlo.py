@@ -66,8 +66,9 @@ class ProgressBar:
     """A one-line progress bar on a text stream (redrawn in place on a terminal, a line
     every 10 % otherwise)."""
 
-    def __init__(self, stream=None, width: int = 30) -> None:
+    def __init__(self, stream=None, width: int = 30, noun: str = "samples") -> None:
         self.stream = stream or sys.stderr
+        self.noun = noun
         self.width = width
         self.start: float | None = None  # the first call: the samples start
         self.tty = hasattr(self.stream, "isatty") and self.stream.isatty()
@@ -86,7 +87,7 @@ class ProgressBar:
         eta = elapsed / fraction - elapsed if fraction > 0 else math.nan
         filled = int(self.width * fraction)
         text = (
-            f"[{'#' * filled}{'.' * (self.width - filled)}] {done}/{total} samples"
+            f"[{'#' * filled}{'.' * (self.width - filled)}] {done}/{total} {self.noun}"
             + (f", {failed} failed" if failed else "")
             + f", {elapsed:.0f} s"
             + (f", {eta:.0f} s to go" if done < total and math.isfinite(eta) else "")

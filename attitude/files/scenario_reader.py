@@ -697,7 +697,8 @@ def scenario_from_document(path: Path, document: dict[str, Any]) -> ScenarioFile
     """Check a TOML document as :func:`load_scenario` checks a file (``path`` names it in
     the errors): a Monte Carlo sample is built from its document through this one path.
 
-    A ``[dispersions]`` table is let through unread: ``attitude.montecarlo.dispersions`` reads it.
+    A ``[dispersions]`` table is let through unread: ``attitude.montecarlo.dispersions`` reads it;
+    so is ``[envelope]``: ``attitude.envelope.settings`` reads it.
     The tables are read in the order their errors are reported: [scenario],
     [spacecraft], [pointing] (the orbit: an attitude may be given in its frame),
     [initial_state], [[events]], [torques], [output].
@@ -712,6 +713,7 @@ def scenario_from_document(path: Path, document: dict[str, Any]) -> ScenarioFile
         "pointing",
         "torques",
         "dispersions",
+        "envelope",
         "sites",
     )
     name, scale, epoch = _scenario_table(root)

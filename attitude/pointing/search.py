@@ -17,7 +17,9 @@ time, as a sample there gives it.
 **Eclipses and the Moon behind the Earth** depend on the orbit alone: searched once
 for the span on a 10 s grid with the geometry's rate bound, so that none is missed
 however short (:func:`attitude.pointing.intervals.isolate`), and kept with the shared
-surroundings for every later search of the same span.
+surroundings for every later search of the same span.  Many searches of short spans
+within one long one (the envelope's windows after each failure) share one search of
+the long span (:func:`orbit_intervals`), each cut to its span.
 
 **Torque-free segments** (:mod:`attitude.pointing.free_search`): the structure of the
 closed-form motion bounds how fast each body vector's cosines with the Sun, the Moon
@@ -51,6 +53,7 @@ samples need: the ephemeris and the orbit over the span, and the size of the sea
 from __future__ import annotations
 
 import math
+from collections.abc import Collection
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -82,10 +85,12 @@ __all__ = [
     "CHUNK_POINTS",
     "EXTREMA",
     "MAX_SEARCH_POINTS",
+    "OrbitIntervals",
     "PointingAnalysis",
     "SearchGrid",
     "VectorAnalysis",
     "check_pointing",
+    "orbit_intervals",
     "pointing_analysis",
     "search_grid",
 ]
@@ -168,12 +173,7 @@ class SearchGrid:
     @property
     def _geometry_rate(self) -> float:
         """How fast the Sun, the Moon and the Earth can move across the sky, rad/s."""
-        return (
-            self.orbit_rate_rad_s
-            + _SUN_SKY_RATE
-            + _MOON_SKY_RATE
-            + 2.0 * self.orbit_speed_m_s / 3.56e8
-        )
+        return _geometry_rate(self.orbit_rate_rad_s, self.orbit_speed_m_s)
 
     def vector_angle_rate_bound(self, name: str) -> float:
         """A bound on how fast an angle between body vector ``name`` and the Sun, the
@@ -184,6 +184,12 @@ class SearchGrid:
     def fraction_rate_bound(self) -> float:
         """A bound on how fast the lit fraction of the Sun's disc changes, 1/s."""
         return 2.0 * self.orbit_rate_rad_s / (math.pi * _SUN_LEAST_RADIUS_RAD)
+
+
+def _geometry_rate(orbit_rate: float, orbit_speed: float) -> float:
+    """How fast the Sun, the Moon and the Earth can move across the sky, rad/s, from the
+    orbit's fastest nadir turn (with the limb's) and its greatest speed."""
+    return orbit_rate + _SUN_SKY_RATE + _MOON_SKY_RATE + 2.0 * orbit_speed / 3.56e8
 
 
 def _segment_rate(solver) -> float:
@@ -279,38 +285,60 @@ def _orbit_samples(
     return τ, r, v
 
 
+def _orbit_rates(
+    trajectory: Trajectory, spec: PointingSpec, start_s: float, stop_s: float
+) -> tuple[float, float]:
+    """Bounds on the orbit's angular rate as the search grid states it (the nadir's turn
+    plus the rate of the Earth's angular radius, rad/s) and on its speed (m/s) over
+    [start_s, stop_s]; zeros at the Earth's centre."""
+    if spec.orbit is None:
+        return 0.0, 0.0
+    _, r, v = _orbit_samples(trajectory, spec.orbit, start_s, stop_s)
+    distance = np.linalg.norm(r, axis=-1)
+    nadir_rate = np.linalg.norm(np.cross(r, v), axis=-1) / distance**2
+    rho = angular_radius(r, spec.earth_limb_atmosphere_height_m)
+    radial = np.abs(np.sum(r * v, axis=-1)) / distance
+    rho_rate = np.tan(np.minimum(rho, 1.5)) * radial / distance
+    # Between samples 60 s apart the rates change little: 25 % covers the peaks
+    # of a perigee pass that the samples straddle.
+    orbit_rate = 1.25 * float(np.max(nadir_rate + rho_rate))
+    return orbit_rate, float(np.max(np.linalg.norm(v, axis=-1)))
+
+
 def search_grid(
     trajectory: Trajectory,
     spec: PointingSpec,
     start_s: float | None = None,
     stop_s: float | None = None,
+    surroundings: SharedSurroundings | None = None,
+    orbit: OrbitIntervals | None = None,
 ) -> SearchGrid:
     """The search grid of :func:`pointing_analysis` over [start_s, stop_s] (the output
     span by default), from the rates of the motion and the orbit (see the module notes).
+    ``surroundings``: the shared surroundings to plan on, if they cover the span (by
+    default the process's cached ones); ``orbit``: the orbit's intervals over a span
+    holding this one, whose rate bounds serve here too (else the orbit is sampled over
+    this span).
     """
     scenario = trajectory.scenario
     spec = for_scenario(spec, scenario)  # the scenario's orbit, when the spec has none
     start_s = scenario.start_s if start_s is None else float(start_s)
     stop_s = scenario.stop_s if stop_s is None else float(stop_s)
     body = _body_rate(trajectory, start_s, stop_s)
-    orbit_rate = speed = 0.0
-    if spec.orbit is not None:
-        _, r, v = _orbit_samples(trajectory, spec.orbit, start_s, stop_s)
-        distance = np.linalg.norm(r, axis=-1)
-        nadir_rate = np.linalg.norm(np.cross(r, v), axis=-1) / distance**2
-        rho = angular_radius(r, spec.earth_limb_atmosphere_height_m)
-        radial = np.abs(np.sum(r * v, axis=-1)) / distance
-        rho_rate = np.tan(np.minimum(rho, 1.5)) * radial / distance
-        # Between samples 60 s apart the rates change little: 25 % covers the peaks
-        # of a perigee pass that the samples straddle.
-        orbit_rate = 1.25 * float(np.max(nadir_rate + rho_rate))
-        speed = float(np.max(np.linalg.norm(v, axis=-1)))
+    if orbit is not None and spec.orbit is not None and orbit.covers(start_s, stop_s):
+        orbit_rate, speed = orbit.orbit_rate_rad_s, orbit.orbit_speed_m_s
+    else:
+        orbit_rate, speed = _orbit_rates(trajectory, spec, start_s, stop_s)
     longest = _LONGEST_STEP_ON_ORBIT_S if spec.orbit is not None else _LONGEST_STEP_S
     rate = body + orbit_rate + _SUN_SKY_RATE + _MOON_SKY_RATE
     grid_step = min(longest, 2.0 * math.pi / (_SAMPLES_PER_TURN * rate))
     segments = _in_span(trajectory, start_s, stop_s)
     plans: list[FreePlan | None] = [None] * len(trajectory.segments)
-    shared = shared_surroundings(trajectory, spec, start_s, stop_s) if spec.body_vectors else None
+    shared = None
+    if spec.body_vectors:
+        shared = surroundings
+        if shared is None or not shared.covers(start_s, stop_s):
+            shared = shared_surroundings(trajectory, spec, start_s, stop_s)
     count, steps = 0, []
     for k, segment in segments:
         a, b = max(segment.start_s, start_s), min(segment.end_s, stop_s)
@@ -528,6 +556,7 @@ class _Search:
         spec: PointingSpec,
         grid: SearchGrid,
         shared: SharedSurroundings,
+        extrema: Collection[tuple[str, str]] | None = None,
     ) -> None:
         self.trajectory, self.spec, self.grid, self.shared = trajectory, spec, grid, shared
         self.precision = interval_precision(spec, trajectory.scenario.stop_s)[0]
@@ -540,7 +569,8 @@ class _Search:
             (v.name, quantity)
             for v in spec.body_vectors
             for quantity, needs_orbit in EXTREMA.items()
-            if spec.on_orbit or not needs_orbit
+            if (spec.on_orbit or not needs_orbit)
+            and (extrema is None or (v.name, quantity) in extrema)
         ]
         self.lows: dict[tuple[str, str], Extremum | None] = dict.fromkeys(self.wanted)
         self.highs: dict[tuple[str, str], Extremum | None] = dict.fromkeys(self.wanted)
@@ -559,13 +589,19 @@ class _Search:
 
     # ------------------------------------------------------------ the orbit alone
 
-    def orbit_only(self) -> None:
+    def orbit_only(self, given: OrbitIntervals | None = None) -> None:
         """The eclipses and the Moon behind the Earth over the span, and the lit
-        fraction's integral: computed once per span and precision, and kept with the
-        shared surroundings (``memo``)."""
+        fraction's integral: cut from ``given`` (found once over a longer span), else
+        computed once per span and precision, and kept with the shared surroundings
+        (``memo``)."""
         if self.spec.orbit is None:
             return
         grid = self.grid
+        if given is not None:
+            self.orbit, self.sunlit_integral = given.within(
+                self.shared, grid.start_s, grid.stop_s, self.precision
+            )
+            return
         key = ("orbit_only", grid.start_s, grid.stop_s, self.precision, grid._geometry_rate)
         found = self.shared.memo.get(key)
         if found is None:
@@ -739,6 +775,16 @@ class _Search:
             value = angles[name][quantity][k]
             which[(name, quantity)] = Extremum(extremum.time_s, float(value))
 
+    def _orbit_description(self) -> str:
+        """The orbit in words, kept with the shared surroundings (which are those of
+        this orbit): a search of a short window pays for it once."""
+        if self.spec.orbit is None:
+            return "Earth centre"
+        text = self.shared.memo.get("orbit_description")
+        if text is None:
+            text = self.shared.memo["orbit_description"] = self.spec.orbit.describe()
+        return str(text)
+
     def result(self) -> PointingAnalysis:
         """The analysis: the accumulated intervals (each condition less what hides it),
         extrema and averages."""
@@ -751,7 +797,7 @@ class _Search:
             stop_s=grid.stop_s,
             precision_s=self.precision,
             on_orbit=spec.on_orbit,
-            orbit="Earth centre" if spec.orbit is None else spec.orbit.describe(),
+            orbit=self._orbit_description(),
             grid=grid,
             vectors=[],
             shadow=self.orbit.get("shadow", []),
@@ -779,8 +825,9 @@ class _Search:
                 sun_in_view=difference(found.get(f"{name}.sun_in_view", []), umbra),
             )
             item.blinded = union(*(getattr(item, kind) for kind in v.exclusions))
-            low, high = extrema["cos_incidence"]
-            item.extrema["cos_incidence"] = (_first_dark(item, grid) or low, high)  # type: ignore[assignment]
+            if "cos_incidence" in extrema:
+                low, high = extrema["cos_incidence"]
+                item.extrema["cos_incidence"] = (_first_dark(item, grid) or low, high)  # type: ignore[assignment]
             analysis.vectors.append(item)
         return analysis
 
@@ -793,23 +840,128 @@ def _orbit_only(
     Sun's and Moon's rates for the angles' sums), and the integral of the lit fraction
     (the span less, in the shadow, the umbra's length and the penumbra's unlit part by
     Gauss–Legendre on each stretch)."""
-    τ = _grid_points(grid.start_s, grid.stop_s, _ORBIT_STEP_S)
+    return _orbit_search(shared, grid.start_s, grid.stop_s, grid._geometry_rate, precision)
+
+
+def _orbit_search(
+    shared: SharedSurroundings, start_s: float, stop_s: float, geometry: float, precision: float
+) -> tuple[dict[str, list[Interval]], float]:
+    """:func:`_orbit_only` over [start_s, stop_s] with the geometry's rate bound
+    ``geometry`` (rad/s)."""
+    τ = _grid_points(start_s, stop_s, _ORBIT_STEP_S)
 
     def evaluate(t: NDArray[np.float64]) -> dict[str, NDArray[np.float64]]:
         return _orbit_conditions(shared.at(t))
 
-    rate = 2.0 * grid._geometry_rate
+    rate = 2.0 * geometry
     found = find_all_intervals(
         evaluate, τ, precision, evaluate(τ), dict.fromkeys(("shadow", "umbra", "moon_hidden"), rate)
     )
-    x, w = np.polynomial.legendre.leggauss(_PENUMBRA_POINTS)
-    unlit = 0.0
-    for piece in difference(found["shadow"], found["umbra"]):
-        half = 0.5 * (piece.end_s - piece.start_s)
-        t = piece.start_s + half * (1.0 + x)
-        unlit += half * float(np.sum(w * (1.0 - shared.at(t).sunlit_fraction)))
+    penumbra = difference(found["shadow"], found["umbra"])
+    unlit = sum(_unlit(shared, p.start_s, p.end_s) for p in penumbra)
     unlit += sum(i.end_s - i.start_s for i in found["umbra"])
-    return found, (grid.stop_s - grid.start_s) - unlit
+    return found, (stop_s - start_s) - unlit
+
+
+@dataclass(frozen=True)
+class OrbitIntervals:
+    """The eclipses (``shadow``: any part of the Sun hidden; ``umbra``: all of it) and
+    the Moon behind the Earth (``moon_hidden``) over [start_s, stop_s], found once
+    (:func:`orbit_intervals`) and cut to any span within it (:meth:`within`) by
+    :func:`pointing_analysis`: they depend on the orbit alone, so that many searches of
+    short spans (the envelope's windows after each failure) share one search.
+    ``penumbra_unlit``: for each stretch of shadow outside the umbra, ∫(1 − λ) dt over
+    it (λ the lit fraction), for the lit fraction's mean.  ``orbit_rate_rad_s``,
+    ``orbit_speed_m_s``: the orbit's rate bounds over the whole span (as
+    :class:`SearchGrid` states them), which bound them over any part of it."""
+
+    start_s: float
+    stop_s: float
+    precision_s: float
+    intervals: dict[str, list[Interval]]
+    penumbra_unlit: tuple[tuple[Interval, float], ...]
+    orbit_rate_rad_s: float
+    orbit_speed_m_s: float
+
+    def covers(self, start_s: float, stop_s: float) -> bool:
+        return self.start_s <= start_s and stop_s <= self.stop_s
+
+    def within(
+        self, shared: SharedSurroundings, start_s: float, stop_s: float, precision_s: float
+    ) -> tuple[dict[str, list[Interval]], float]:
+        """The intervals over [start_s, stop_s] (cut at its ends, flagged as starting
+        before or ending after it, as a search of that span states them) and the
+        integral of the lit fraction over it (the penumbra cut by an end integrated
+        again, by Gauss–Legendre, over its part within the span)."""
+        if not self.covers(start_s, stop_s) or precision_s != self.precision_s:
+            raise ValueError(
+                f"the orbit's intervals over [{self.start_s:g}, {self.stop_s:g}] s at "
+                f"{self.precision_s:g} s do not serve [{start_s:g}, {stop_s:g}] s at "
+                f"{precision_s:g} s"
+            )
+        cut = {name: _cut(found, start_s, stop_s) for name, found in self.intervals.items()}
+        unlit = sum(i.end_s - i.start_s for i in cut["umbra"])
+        for piece, whole in self.penumbra_unlit:
+            a, b = max(piece.start_s, start_s), min(piece.end_s, stop_s)
+            if b <= a:
+                continue
+            unlit += whole if (a, b) == (piece.start_s, piece.end_s) else _unlit(shared, a, b)
+        return cut, (stop_s - start_s) - unlit
+
+
+def _cut(intervals: list[Interval], start_s: float, stop_s: float) -> list[Interval]:
+    """``intervals`` (sorted, disjoint) within [start_s, stop_s]: one that holds at an
+    end starts before (ends after) the span, as :func:`find_all_intervals` states it."""
+    ends = np.array([i.end_s for i in intervals], dtype=np.float64)
+    out = []
+    for interval in intervals[int(np.searchsorted(ends, start_s)) :]:
+        if interval.start_s > stop_s or (interval.start_s == stop_s and start_s < stop_s):
+            break
+        if interval.end_s == start_s and start_s < stop_s:
+            continue  # touches the span's start only
+        before = interval.start_s < start_s or (
+            interval.start_s == start_s and interval.starts_before
+        )
+        after = interval.end_s > stop_s or (interval.end_s == stop_s and interval.ends_after)
+        start, end = max(interval.start_s, start_s), min(interval.end_s, stop_s)
+        out.append(Interval(start, end, before, after))
+    return out
+
+
+def _unlit(shared: SharedSurroundings, a: float, b: float) -> float:
+    """∫(1 − λ) dt over [a, b] (a stretch of penumbra) by Gauss–Legendre."""
+    x, w = np.polynomial.legendre.leggauss(_PENUMBRA_POINTS)
+    half = 0.5 * (b - a)
+    t = a + half * (1.0 + x)
+    return half * float(np.sum(w * (1.0 - shared.at(t).sunlit_fraction)))
+
+
+def orbit_intervals(
+    trajectory: Trajectory,
+    spec: PointingSpec,
+    start_s: float,
+    stop_s: float,
+    surroundings: SharedSurroundings | None = None,
+) -> OrbitIntervals | None:
+    """The :class:`OrbitIntervals` of ``spec``'s orbit (or the scenario's) over
+    [start_s, stop_s] (None at the Earth's centre), searched as
+    :func:`pointing_analysis` searches them (the geometry's rate bound over this span,
+    which bounds it over any part), to the interval precision of ``trajectory``'s
+    scenario: pass it to :func:`pointing_analysis` (``orbit``) for spans within it."""
+    spec = for_scenario(spec, trajectory.scenario)
+    if spec.orbit is None:
+        return None
+    shared = surroundings
+    if shared is None or not shared.covers(start_s, stop_s):
+        shared = shared_surroundings(trajectory, spec, start_s, stop_s)
+    precision = interval_precision(spec, trajectory.scenario.stop_s)[0]
+    orbit_rate, speed = _orbit_rates(trajectory, spec, start_s, stop_s)
+    found, _ = _orbit_search(shared, start_s, stop_s, _geometry_rate(orbit_rate, speed), precision)
+    penumbra = tuple(
+        (piece, _unlit(shared, piece.start_s, piece.end_s))
+        for piece in difference(found["shadow"], found["umbra"])
+    )
+    return OrbitIntervals(start_s, stop_s, precision, found, penumbra, orbit_rate, speed)
 
 
 def pointing_analysis(
@@ -819,6 +971,8 @@ def pointing_analysis(
     stop_s: float | None = None,
     grid: SearchGrid | None = None,
     surroundings: SharedSurroundings | None = None,
+    orbit: OrbitIntervals | None = None,
+    extrema: Collection[tuple[str, str]] | None = None,
 ) -> PointingAnalysis:
     """Every interval and extremum of ``spec``'s pointing over [start_s, stop_s] (TT s
     since the epoch; the output span by default), on the exact motion.
@@ -831,16 +985,19 @@ def pointing_analysis(
     :class:`~attitude.pointing.shared_surroundings.SharedSurroundings` to use (one
     covering the span, for the same epoch, orbit and limb height); by default the
     process's cached one (:func:`~attitude.pointing.shared_surroundings
-    .shared_surroundings`).
+    .shared_surroundings`).  ``orbit``: the eclipses and the Moon behind the Earth
+    found once over a span holding this one (:func:`orbit_intervals`), cut to it.
+    ``extrema``: the (vector name, quantity) pairs of :data:`EXTREMA` to find (all by
+    default); the others are left out of each vector's ``extrema``.
     """
     spec = for_scenario(spec, trajectory.scenario)  # the scenario's orbit, if the spec has none
     if grid is None:
-        grid = search_grid(trajectory, spec, start_s, stop_s)
+        grid = search_grid(trajectory, spec, start_s, stop_s, surroundings, orbit)
     shared = surroundings
     if shared is None or not shared.covers(grid.start_s, grid.stop_s):
         shared = shared_surroundings(trajectory, spec, grid.start_s, grid.stop_s)
-    search = _Search(trajectory, spec, grid, shared)
-    search.orbit_only()
+    search = _Search(trajectory, spec, grid, shared, extrema)
+    search.orbit_only(orbit)
     if spec.body_vectors:
         # Consecutive torque-free segments are searched together, and so are
         # consecutive other ones, on the grid.

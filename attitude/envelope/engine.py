@@ -1,0 +1,131 @@
+"""The envelope's failures on Dask, by the Monte Carlo's engine: the same local cluster
+or scheduler (:mod:`attitude.montecarlo.cluster`), batch sizes from the measured costs
+(:func:`attitude.montecarlo.simulation.choose_batch_size`), results gathered as tasks
+finish, a progress callback.
+
+Each failure is computed from the job alone (its hand-off state, the shared
+surroundings, one step for the splitting chosen before the job), so the table is the
+same whatever the number of workers and the batch size; the rows are sorted by τ.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from attitude.base.errors import InputError
+from attitude.envelope.failure import BatchResult, EnvelopeJob, evaluate_batch
+from attitude.envelope.plan import EnvelopePlan, make_job
+from attitude.montecarlo.cluster import check_where, check_workers, connect, task_overhead_s
+from attitude.montecarlo.simulation import choose_batch_size
+
+if TYPE_CHECKING:
+    import pandas
+
+__all__ = ["EnvelopeResult", "simulate"]
+
+# Failures timed on the client to size the batches.
+_TIMED = 2
+
+
+@dataclass
+class EnvelopeResult:
+    """The table (one row a failure, in τ order) and how the job ran."""
+
+    plan: EnvelopePlan
+    table: pandas.DataFrame
+    execution: dict[str, Any]
+
+
+def simulate(
+    plan: EnvelopePlan,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    batch_size: int | None = None,
+    progress: Callable[[int, int, int], None] | None = None,
+    stage: Callable[[str], None] | None = None,
+    probed: bool = False,
+) -> EnvelopeResult:
+    """Compute every failure of ``plan`` on Dask (module notes); ``progress(done,
+    total, failed)`` as batches finish, ``stage(text)`` what is happening."""
+    import pandas
+
+    stage = stage or (lambda text: None)
+    if batch_size is not None and not 1 <= batch_size <= plan.count:
+        raise InputError(
+            f"expected 1 to {plan.count}, got {batch_size}", key="--batch-size", value=batch_size
+        )
+    count = check_where(scheduler, workers, probe=not probed)
+    started = time.perf_counter()
+    stage("the nominal timeline and the hand-off states")
+    job, epochs, modes = make_job(plan)
+    timed = evaluate_batch(job, 0, min(_TIMED, job.count))  # warms this process too
+    failure_s = timed.compute_s / max(min(_TIMED, job.count), 1)
+    stage(f"{failure_s * 1e3:.3g} ms a failure")
+    if scheduler is None:
+        stage(f"starting a local Dask cluster of {count} worker processes")
+    with connect(scheduler, workers, probed=True) as client:
+        threads = check_workers(client)
+        overhead = task_overhead_s(client)
+        size = batch_size or choose_batch_size(job.count, threads, failure_s, overhead)
+        batches = [(a, min(a + size, job.count)) for a in range(0, job.count, size)]
+        stage(f"{job.count} failures on {threads} workers: {len(batches)} tasks of {size}")
+        rows, compute_s = _run_batches(client, job, batches, progress)
+    rows.sort(key=lambda row: row["failure"])
+    for row in rows:
+        row["epoch_utc"] = epochs[row["failure"]]
+        row["mode"] = modes[row["failure"]]
+    table = pandas.DataFrame(rows, columns=plan.columns)
+    execution = {
+        "scheduler": scheduler or f"local cluster ({threads} processes, one thread each)",
+        "workers": threads,
+        "batch_size": size,
+        "tasks": len(batches),
+        "failure_s": failure_s,
+        "compute_s": compute_s,
+        "wall_s": time.perf_counter() - started,
+        "step_s": job.step,
+    }
+    return EnvelopeResult(plan, table, execution)
+
+
+def _run_batches(
+    client, job: EnvelopeJob, batches: list[tuple[int, int]], progress
+) -> tuple[list[dict[str, Any]], float]:
+    """Send the job once to every worker, one task per batch; gather as they finish."""
+    from distributed import as_completed
+
+    shared = client.scatter(job, broadcast=True, hash=False)
+    futures = client.map(
+        evaluate_batch,
+        [shared] * len(batches),
+        [a for a, _ in batches],
+        [b for _, b in batches],
+        pure=False,
+    )
+    span = {future.key: batch for future, batch in zip(futures, batches, strict=True)}
+    rows: list[dict[str, Any]] = []
+    done = failed = 0
+    compute_s = 0.0
+    if progress:
+        progress(0, job.count, 0)
+    for future, result in as_completed(futures, client.loop, with_results=True, raise_errors=False):
+        first, stop = span[future.key]
+        if isinstance(result, BatchResult):
+            rows += result.rows
+            compute_s += result.compute_s
+            failed += sum(row["status"] != "ok" for row in result.rows)
+        else:  # a task that died (a worker killed): its failures are rows with the error
+            error = f"the task of failures {first}-{stop - 1} failed: {result!r}"
+            rows += [
+                {"failure": k, "tau_s": float(job.seconds[k]), "status": "failed", "error": error}
+                for k in range(first, stop)
+            ]
+            failed += stop - first
+        done += stop - first
+        if progress:
+            progress(done, job.count, failed)
+        future.release()
+    return rows, compute_s

@@ -1,0 +1,291 @@
+"""One control loss: the motion after it and its metrics, on the exact motion.
+
+For a failure at τ the body starts from the nominal state (the law's or the slew's
+attitude and rate, read on the nominal timeline) with the wheels' momentum h, through
+the exact hand-off (:func:`attitude.trajectory.handoff.hand_off_states` for every τ at
+once; :func:`~attitude.trajectory.handoff.hand_off` for one): the closed-form rigid
+body (locked wheels, no torque), or the splitting with the exact gyroscopic flow
+(spinning wheels) and the scenario's torques.  That motion, one segment over
+[τ, τ + window], is searched by the exact pointing search
+(:func:`attitude.pointing.search.pointing_analysis`: torque-free segments on the
+motion's structure, others with rigorous rate bounds) against the surroundings of the
+whole job, built once per process and shared by every τ
+(:func:`attitude.pointing.shared_surroundings.shared_surroundings`).
+
+The metrics (columns of the table; times in s after τ; ``inf``: not within the window):
+
+- ``{vector}_{exclusion}_s``: the first violation of each exclusion of each body vector
+  (``sun_exclusion``, ``moon_exclusion``, ``earth_limb_exclusion``; 0 when violated at τ),
+  and ``{vector}_blinded_s``, the first of them;
+- ``{panel}_least_sun_angle_deg``: the least angle between each panel's normal and the
+  Sun over the window;
+- ``power_at_loss``, ``power_mean``: the panels' power fraction at τ and its mean over
+  the window (:mod:`attitude.envelope.power`: the energy the panels collect, as a
+  fraction of full power over the window), ``power_lost_s``: the first time it is at or
+  below the threshold (eclipses included: the Earth's shadow takes the power to 0);
+- ``rate_at_loss_deg_s``, ``rate_max_deg_s``, ``rate_max_at_s``: the body rate |ω| just
+  after the loss (with locked wheels, I⁻¹(I ω_law + h): their momentum passes to the
+  body), and its largest over the window, on the motion
+  (:func:`attitude.trajectory.rates.largest_rate`);
+- ``flips``, ``first_flip_s``: the body's flips (Джанибеков) within the window;
+- ``first_violation_s``: the least of the exclusion times (the first instant any body
+  vector is blinded).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import weakref
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
+
+from attitude.envelope.power import first_below, integral, power_fraction
+from attitude.pointing.search import OrbitIntervals, pointing_analysis
+from attitude.pointing.shared_surroundings import SharedSurroundings, shared_surroundings
+from attitude.pointing.spec import PointingSpec
+from attitude.scenario.events import State
+from attitude.scenario.modes import Wheels
+from attitude.scenario.scenario import Scenario
+from attitude.solver.euler_solver import EulerSolver
+from attitude.trajectory.handoff import hand_off
+from attitude.trajectory.rates import largest_rate
+from attitude.trajectory.segments import Segment
+from attitude.trajectory.torqued import TorquedMotion
+from attitude.trajectory.trajectory import Trajectory
+
+__all__ = ["BatchResult", "EnvelopeJob", "evaluate_batch", "failure_metrics", "metric_names"]
+
+EXCLUSIONS = ("sun_exclusion", "moon_exclusion", "earth_limb_exclusion")
+
+
+def metric_names(spec: PointingSpec) -> list[str]:
+    """The table's metric columns for ``spec``'s body vectors (module notes)."""
+    names = []
+    for vector in spec.body_vectors:
+        exclusions = vector.exclusions
+        names += [f"{vector.name}_{e}_s" for e in exclusions]
+        if exclusions:
+            names.append(f"{vector.name}_blinded_s")
+    panels = [v.name for v in spec.body_vectors if v.kind == "panel"]
+    names += [f"{p}_least_sun_angle_deg" for p in panels]
+    if panels:
+        names += ["power_at_loss", "power_mean", "power_lost_s"]
+    names += ["rate_at_loss_deg_s", "rate_max_deg_s", "rate_max_at_s", "flips", "first_flip_s"]
+    names.append("first_violation_s")
+    return names
+
+
+@dataclass(frozen=True, eq=False)
+class EnvelopeJob:
+    """What every task needs (scattered once to each worker).
+
+    ``scenario``: the job's span (the epoch, the orbit, the spacecraft; its stop covers
+    the last window) without events; ``spec``: the pointing, with the orbit;
+    ``seconds``: the failure instants τ; ``quaternions`` (scalar last, scipy's order,
+    body → ICRF) and ``momenta`` (N m s, body axes): the hand-off states there, and the nominal
+    rates ``angular_velocities`` (rad/s, body axes);
+    ``wheels``; ``torques``: (start, stop, model) of the torques acting on the free
+    body; ``step``: the splitting's step (None: the exact solver); ``order``;
+    ``orbit``: the eclipses and the Moon behind the Earth over the whole span, found
+    once and cut to each window (None at the Earth's centre).
+    """
+
+    scenario: Scenario
+    spec: PointingSpec
+    seconds: NDArray[np.float64]
+    quaternions: NDArray[np.float64]
+    momenta: NDArray[np.float64]
+    angular_velocities: NDArray[np.float64]
+    wheels: Wheels
+    window: float
+    threshold: float
+    torques: tuple[tuple[float, float, Any], ...]
+    step: float | None
+    order: int
+    columns: tuple[str, ...]
+    orbit: OrbitIntervals | None = None
+
+    @property
+    def count(self) -> int:
+        return int(self.seconds.size)
+
+
+@dataclass
+class BatchResult:
+    """The rows of failures ``first`` to ``stop − 1``, and the CPU they took (s)."""
+
+    rows: list[dict[str, Any]]
+    compute_s: float
+
+
+def motion_after(job: EnvelopeJob, k: int) -> Trajectory:
+    """The motion after failure ``k``: one segment over [τ, τ + window]."""
+    τ = float(job.seconds[k])
+    end = τ + job.window
+    attitude = Rotation.from_quat(job.quaternions[k])
+    axes = job.scenario.spacecraft.principal_axes
+    state = State(attitude, job.momenta[k], axes)
+    acting = [model for a, b, model in job.torques if a < end and b > τ]
+    spinning = job.wheels.case == "spinning"
+    if not spinning and not acting:
+        # Locked wheels: the momentum already holds h; the exact rigid body.
+        solver: Any = hand_off(attitude, job.angular_velocities[k], axes, τ, job.wheels)
+    else:
+        assert job.step is not None
+        h = job.wheels.momentum_vector if spinning else None
+        solver = TorquedMotion(state, τ, end, acting, job.step, job.order, h)
+    return Trajectory(job.scenario, [Segment(τ, end, solver, state)])
+
+
+def _first(intervals, τ: float) -> float:
+    if not intervals:
+        return math.inf
+    first = intervals[0]
+    return 0.0 if first.starts_before else max(first.start_s - τ, 0.0)
+
+
+def _surroundings(job: EnvelopeJob, trajectory: Trajectory) -> SharedSurroundings:
+    """The job's shared surroundings in this process: looked up once per job (the
+    lookup hashes the orbit), then kept with it."""
+    found = _SURROUNDINGS.get(job)
+    if found is None:
+        found = shared_surroundings(trajectory, job.spec, 0.0, job.scenario.stop_s)
+        _SURROUNDINGS[job] = found
+    return found
+
+
+# Each job's shared surroundings in this process, for as long as the job lives.
+_SURROUNDINGS: weakref.WeakKeyDictionary[EnvelopeJob, SharedSurroundings] = (
+    weakref.WeakKeyDictionary()
+)
+
+
+def failure_metrics(job: EnvelopeJob, k: int) -> dict[str, Any]:
+    """The metrics of failure ``k`` (module notes), as one row of the table."""
+    τ = float(job.seconds[k])
+    end = τ + job.window
+    trajectory = motion_after(job, k)
+    shared = _surroundings(job, trajectory)
+    analysis = pointing_analysis(
+        trajectory,
+        job.spec,
+        τ,
+        end,
+        surroundings=shared,
+        orbit=job.orbit,
+        extrema=[(v.name, "sun_angle") for v in job.spec.body_vectors if v.kind == "panel"],
+    )
+    row: dict[str, Any] = {}
+    firsts = []
+    for item in analysis.vectors:
+        name = item.vector.name
+        exclusions = item.vector.exclusions
+        for e in exclusions:
+            row[f"{name}_{e}_s"] = _first(getattr(item, e), τ)
+            firsts.append(row[f"{name}_{e}_s"])
+        if exclusions:
+            row[f"{name}_blinded_s"] = _first(item.blinded, τ)
+    panels = [item for item in analysis.vectors if item.vector.kind == "panel"]
+    for item in panels:
+        row[f"{item.vector.name}_least_sun_angle_deg"] = math.degrees(
+            item.extrema["sun_angle"][0].value
+        )
+    if panels:
+        normals = np.array([item.vector.vector for item in panels])
+
+        def power_in(shadow: bool):
+            """P(t); outside the Earth's shadow the lit fraction is 1 (only the Sun's
+            direction is needed there, from the interpolated targets)."""
+
+            def sun(t):
+                if shadow:
+                    around = shared.at(t)
+                    return around.sun_direction, around.sunlit_fraction
+                return shared.targets(t).sun, 1.0
+
+            def power(t):
+                t = np.asarray(t, dtype=float)
+                return power_fraction(segment.solver.attitude, sun, normals, t)
+
+            return power
+
+        segment = trajectory.segments[0]
+        grid = analysis.grid
+        turning = float(np.mean([grid.vector_angle_rate_bound(i.vector.name) for i in panels]))
+        row["power_at_loss"] = float(power_in(True)(np.array([τ, τ]))[0])
+        pieces = _pieces(analysis, τ, end, turning, grid.fraction_rate_bound)
+        if isinstance(segment.solver, EulerSolver):
+            # The free search integrates the incidence exactly on each cell's quintic.
+            row["power_mean"] = float(np.mean([i.mean_cos_incidence for i in panels]))
+        else:  # the grid search's trapezoid is coarse: Gauss–Legendre between the edges
+            energy = sum(
+                integral(power_in(shadow), a, b, lipschitz) for a, b, lipschitz, shadow in pieces
+            )
+            row["power_mean"] = energy / job.window
+        row["power_lost_s"] = _power_lost(power_in, pieces, τ, job.threshold, analysis.precision_s)
+    segment = trajectory.segments[0]
+    # The body's rate just after the loss: the law's with spinning wheels, I⁻¹(Iω + h)
+    # with locked ones (their momentum passes to the body).
+    rate0 = float(np.linalg.norm(trajectory.angular_velocity(np.array([τ, τ]))[0]))
+    rate, at = largest_rate(segment, τ, end)
+    row["rate_at_loss_deg_s"] = math.degrees(rate0)
+    row["rate_max_deg_s"] = math.degrees(max(rate, rate0))
+    row["rate_max_at_s"] = at - τ if rate > rate0 else 0.0
+    flips = segment.solver.flip_times(τ, end)
+    row["flips"] = len(flips)
+    row["first_flip_s"] = float(flips[0] - τ) if len(flips) else math.inf
+    row["first_violation_s"] = min(firsts, default=math.inf)
+    return row
+
+
+def _pieces(analysis, τ: float, end: float, turning: float, fraction_rate: float):
+    """[τ, end] cut at the shadow's edges, each piece with its bound on |P'|: outside
+    the Earth's shadow the lit fraction is 1, and only the panels' turning bounds it;
+    within a shadow the lit fraction's rate adds to it."""
+    pieces: list[tuple[float, float, float, bool]] = []
+    cursor = τ
+    for shadow in analysis.shadow:
+        a, b = max(shadow.start_s, τ), min(shadow.end_s, end)
+        if b < a:
+            continue
+        if a > cursor:
+            pieces.append((cursor, a, turning, False))
+        pieces.append((a, b, turning + fraction_rate, True))
+        cursor = b
+    if cursor < end:
+        pieces.append((cursor, end, turning, False))
+    return pieces
+
+
+def _power_lost(power_in, pieces, τ: float, threshold: float, precision: float) -> float:
+    """The first time the panels' power fraction reaches ``threshold`` (s after τ)."""
+    for a, b, lipschitz, shadow in pieces:
+        found = first_below(power_in(shadow), a, b, lipschitz, threshold, precision)
+        if found is not None:
+            return found - τ
+    return math.inf
+
+
+def evaluate_batch(job: EnvelopeJob, first: int, stop: int) -> BatchResult:
+    """Failures ``first`` to ``stop − 1`` of ``job``, each a row (runs on a worker).  A
+    failure whose motion is refused is a row with its error; the job goes on."""
+    started = time.process_time()
+    rows = []
+    for k in range(first, stop):
+        row: dict[str, Any] = {"failure": k, "tau_s": float(job.seconds[k])}
+        try:
+            row.update(failure_metrics(job, k), status="ok", error="")
+        except Exception as exc:  # a refused motion is this failure's row, not the job's end
+            row.update({name: math.nan for name in job.columns}, status="failed", error=_text(exc))
+        rows.append(row)
+    return BatchResult(rows, time.process_time() - started)
+
+
+def _text(exc: BaseException) -> str:
+    text = " ".join(str(exc).split())
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__

@@ -1,0 +1,130 @@
+"""The panels' sunlit power after a loss, and the first time it falls below a threshold.
+
+The power fraction of the panels p (body vectors of kind ``panel``) is
+
+    P(t) = λ(t) · (1/n) Σ_p max(cos θ_p(t), 0),
+
+θ_p the angle between the panel's normal and the Sun, λ the lit fraction of the Sun's
+disc (0 in umbra, between 0 and 1 in penumbra: :mod:`attitude.pointing.eclipse`):
+1 when every panel faces the Sun squarely in full light.
+
+:func:`first_below` finds the first time P ≤ c on [a, b] without a grid that could miss
+a dip: P is Lipschitz, |P'| ≤ L with L = λ_max + (1/n) Σ_p max|θ_p'| (each angle's rate
+bound from the search, :meth:`attitude.pointing.search.SearchGrid.vector_angle_rate_bound`,
+and the lit fraction's, :attr:`~attitude.pointing.search.SearchGrid.fraction_rate_bound`,
+which counts only inside the Earth's shadow), so on a cell [t₀, t₁] of width h,
+P ≥ (P(t₀) + P(t₁) − L h)/2.  A cell whose bound exceeds c is settled; the others, in
+time order up to the first node where P ≤ c, are cut into 16 parts until the first is narrower
+than the precision: its left end is the first instant P can reach c (an early answer
+by at most the precision, never a late one).
+
+:func:`integral` gives ∫P dt over a piece where P is smooth but for the kinks of
+max(cos θ, 0): Gauss–Legendre (8 points) on cells no longer than the Lipschitz
+step and :data:`_LONGEST_CELL_S`; the caller cuts the window at the shadow's edges.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+import numpy as np
+from numpy.typing import NDArray
+
+__all__ = ["first_below", "integral", "power_fraction"]
+
+# The first nodes are spaced so that the Lipschitz bound sags at most this much
+# between two of them (a power fraction), and a run of nodes holds at most this many.
+_SAG = 0.05
+_CHUNK_NODES = 8192
+# The integral's cells: at most this long (s), and Gauss–Legendre points in each.
+_LONGEST_CELL_S = 30.0
+_GAUSS_POINTS = 8
+# An open cell is cut into this many parts a round (one call of the function for all
+# of them: a cell of 30 s reaches 1 ms in 4 rounds, where halving takes 15), and at
+# most this many rounds (a cell of a week cut 20 times is 5e-19 s wide).
+_SPLIT = 16
+_MAX_HALVINGS = 20
+
+
+def power_fraction(
+    attitude: Callable, sun: Callable, panels: NDArray[np.float64], t: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """P(t) (module notes): ``attitude(t)`` the body → ICRF Rotation, ``sun(t)`` the
+    Sun's unit direction (n, 3) and the lit fraction (n,) or 1, ``panels`` (k, 3) unit
+    normals in body axes."""
+    rotation = attitude(t)
+    direction, lit = sun(t)
+    cosines = np.stack([np.einsum("ij,ij->i", rotation.apply(p), direction) for p in panels])
+    return lit * np.mean(np.maximum(cosines, 0.0), axis=0)
+
+
+def first_below(
+    f: Callable[[NDArray[np.float64]], NDArray[np.float64]],
+    a: float,
+    b: float,
+    lipschitz: float,
+    threshold: float,
+    precision: float,
+) -> float | None:
+    """The first t in [a, b] where ``f`` (vectorized, |f'| ≤ ``lipschitz``) may reach
+    ``threshold``, within ``precision`` (s), or None if f stays above it (module notes)."""
+    if f(np.array([a]))[0] <= threshold:
+        return a
+    if b <= a:
+        return None
+    step = 2.0 * _SAG / lipschitz if lipschitz > 0.0 else b - a
+    cells = max(1, math.ceil((b - a) / step))
+    chunk = max(1, math.ceil(cells / math.ceil(cells / _CHUNK_NODES)))
+    edges = np.linspace(a, b, cells + 1)
+    for start in range(0, cells, chunk):
+        t = edges[start : start + chunk + 1]
+        found = _first_in(lambda x: f(x) - threshold, t, lipschitz, precision)
+        if found is not None:
+            return found
+    return None
+
+
+def _first_in(g, t, lipschitz: float, precision: float) -> float | None:
+    """The first cell of nodes ``t`` where g = f − c may reach 0, cut down to
+    ``precision``: its left end, or None."""
+    v = g(t)
+    left, right, v_left, v_right = t[:-1], t[1:], v[:-1], v[1:]
+    for _ in range(_MAX_HALVINGS):
+        below = np.flatnonzero(v_right <= 0.0)
+        last = below[0] + 1 if below.size else left.size
+        left, right, v_left, v_right = left[:last], right[:last], v_left[:last], v_right[:last]
+        open_ = 0.5 * (v_left + v_right - lipschitz * (right - left)) <= 0.0
+        left, right, v_left, v_right = left[open_], right[open_], v_left[open_], v_right[open_]
+        if left.size == 0:
+            return None
+        if right[0] - left[0] <= precision:
+            return float(left[0])
+        # Each open cell cut into _SPLIT equal parts, all evaluated in one call.
+        fractions = np.arange(1, _SPLIT) / _SPLIT
+        inner = left[:, None] + (right - left)[:, None] * fractions[None, :]
+        v_inner = g(inner.ravel()).reshape(inner.shape)
+        nodes = np.column_stack([left, inner, right])
+        values = np.column_stack([v_left, v_inner, v_right])
+        left, right = np.ravel(nodes[:, :-1]), np.ravel(nodes[:, 1:])
+        v_left, v_right = np.ravel(values[:, :-1]), np.ravel(values[:, 1:])
+    return float(left[0])  # cut to the limit: the earliest instant it may reach
+
+
+def integral(
+    f: Callable[[NDArray[np.float64]], NDArray[np.float64]],
+    a: float,
+    b: float,
+    lipschitz: float,
+) -> float:
+    """∫_a^b f dt (module notes)."""
+    if b <= a:
+        return 0.0
+    step = min(2.0 * _SAG / lipschitz if lipschitz > 0.0 else b - a, _LONGEST_CELL_S)
+    cells = max(1, math.ceil((b - a) / step))
+    x, w = np.polynomial.legendre.leggauss(_GAUSS_POINTS)
+    edges = np.linspace(a, b, cells + 1)
+    half = 0.5 * np.diff(edges)
+    t = (edges[:-1] + half)[:, None] + half[:, None] * x[None, :]
+    values = f(t.ravel()).reshape(t.shape)
+    return float(np.sum(half * (values @ w)))

@@ -1,0 +1,233 @@
+"""The envelope's outputs: the table per failure (``envelope.parquet``,
+``envelope.csv``), the metrics plotted against the failure time (``envelope.png``),
+``summary.json`` (the worst τ and its margins) and ``report.html``.
+
+Times after the loss are seconds; ``inf`` in the table (``null`` in summary.json) means
+"not within the window".  The folder is claimed as ``attitude run``'s is
+(:func:`attitude.outputs.folder.claim`): a file this tool did not write is never
+replaced, and a run stopped midway leaves the folder as it was.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+from html import escape
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from attitude.base.version import __version__
+from attitude.envelope.engine import EnvelopeResult
+from attitude.envelope.plan import EnvelopePlan
+from attitude.outputs.budget import DISK_SHARE, ResourceError
+from attitude.outputs.folder import claim
+from attitude.report.page import _STYLE, _figures_and_files, _table
+from attitude.report.summaries import to_json, write_json
+
+__all__ = ["OUTPUT_NAMES", "check_folder", "summary", "worst", "write_report"]
+
+OUTPUT_NAMES = ("envelope.parquet", "envelope.csv", "summary.json", "envelope.png", "report.html")
+_CSV_BYTES_PER_CELL = 24
+_FIXED_BYTES = 5_000_000  # the plot, the page, summary.json
+
+
+def check_folder(plan: EnvelopePlan, out_dir: str | Path) -> None:
+    """Refuse, before anything runs, a folder that is not ours or a disk too small."""
+    claim(out_dir, OUTPUT_NAMES, dry_run=True)
+    need = plan.count * len(plan.columns) * (_CSV_BYTES_PER_CELL + 8) + _FIXED_BYTES
+    where = Path(out_dir).expanduser().absolute()
+    while not where.exists():
+        where = where.parent
+    free = shutil.disk_usage(where).free
+    if need > DISK_SHARE * free:
+        raise ResourceError(
+            f"{out_dir}: the table of {plan.count:,} failures would take about "
+            f"{need / 1e9:.3g} GB, and its disk has {free / 1e9:.3g} GB free",
+            key="--out",
+            value=str(out_dir),
+        )
+
+
+def worst(table) -> int | None:
+    """The row of the worst failure: the soonest blinded (``first_violation_s``), then
+    the soonest without power, then the fastest turning; None if every failure failed."""
+    ok = table[table["status"] == "ok"]
+    if ok.empty:
+        return None
+    keys = ["first_violation_s"]
+    if "power_lost_s" in ok:
+        keys.append("power_lost_s")
+    ordered = ok.assign(_rate=-ok["rate_max_deg_s"]).sort_values([*keys, "_rate", "tau_s"])
+    return int(ordered.index[0])
+
+
+# Per metric, whether its worst value is its least (times, margins) or its greatest.
+def _least_is_worst(name: str) -> bool:
+    return not (name.startswith("rate_") or name == "flips" or name.endswith("_at_s"))
+
+
+def summary(result: EnvelopeResult) -> dict[str, Any]:
+    """What summary.json says: the job, the worst τ and its margins, each metric's worst."""
+    plan, table = result.plan, result.table
+    ok = table[table["status"] == "ok"]
+    row = worst(table)
+    per_metric = {}
+    for name in plan.metrics:
+        if name in ("rate_max_at_s",) or ok.empty:
+            continue
+        values = ok[name].to_numpy(dtype=float)
+        k = int(np.argmin(values) if _least_is_worst(name) else np.argmax(values))
+        per_metric[name] = {"tau_s": float(ok["tau_s"].iloc[k]), "value": float(values[k])}
+    settings = plan.settings
+    return to_json(
+        {
+            "scenario": {"name": plan.name, "file": plan.file},
+            "attitude_version": __version__,
+            "failures": plan.count,
+            "failed": int((table["status"] != "ok").sum()),
+            "every_s": settings.every,
+            "window_s": settings.window,
+            "wheels": {"case": plan.wheels.case, "momentum_Nms": plan.wheels.momentum_vector},
+            "power_threshold": settings.power_threshold,
+            "units": "times in s after the loss (null: not within the window), angles deg, "
+            "rates deg/s, power as a fraction of full (every panel square to the Sun, lit)",
+            "worst": None
+            if row is None
+            else {
+                "tau_s": float(table.loc[row, "tau_s"]),
+                "epoch_utc": str(table.loc[row, "epoch_utc"]),
+                "mode": str(table.loc[row, "mode"]),
+                "margins": {name: _plain(table.loc[row, name]) for name in plan.metrics},
+            },
+            "worst_per_metric": per_metric,
+            "execution": result.execution,
+        }
+    )
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, np.generic):
+        value = value.item()
+    return value
+
+
+def write_report(result: EnvelopeResult, out_dir: str | Path) -> list[str]:
+    """Write the outputs of ``result`` into ``out_dir`` (module notes)."""
+    folder = claim(out_dir, OUTPUT_NAMES)
+    return folder.write(lambda tmp: _build(result, tmp), result.plan.file or "python", __version__)
+
+
+def _build(result: EnvelopeResult, tmp: Path) -> list[str]:
+    table = result.table
+    table.to_parquet(tmp / "envelope.parquet", index=False)
+    table.to_csv(tmp / "envelope.csv", index=False)
+    stats = summary(result)
+    write_json(tmp / "summary.json", stats)
+    files = ["envelope.parquet", "envelope.csv", "summary.json"]
+    images = {}
+    if (table["status"] == "ok").any():
+        images["The metrics against the failure time"] = _plot(result, tmp / "envelope.png")
+    (tmp / "report.html").write_text(_page(result, stats, images, files), encoding="utf-8")
+    return [*files, *images.values(), "report.html"]
+
+
+def _groups(plan: EnvelopePlan) -> list[tuple[str, list[str]]]:
+    """The panels of the figure: metrics of one unit together."""
+    metrics = plan.metrics
+    times = [m for m in metrics if m.endswith("_s") and not m.startswith("rate_")]
+    pairs: list[tuple[str, list[str]]] = [
+        ("time to first violation, power loss, flip (s after the loss)", times),
+        ("least Sun angle of each panel (deg)", [m for m in metrics if m.endswith("_deg")]),
+        (
+            "panels' power fraction",
+            [m for m in ("power_at_loss", "power_mean") if m in metrics],
+        ),
+        ("body rate (deg/s)", ["rate_at_loss_deg_s", "rate_max_deg_s"]),
+        ("flips within the window", ["flips"]),
+    ]
+    return [(name, chosen) for name, chosen in pairs if chosen]
+
+
+def _plot(result: EnvelopeResult, path: Path) -> str:
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    plan, table = result.plan, result.table
+    ok = table[table["status"] == "ok"]
+    hours = ok["tau_s"].to_numpy(dtype=float) / 3600.0
+    groups = _groups(plan)
+    figure = Figure(figsize=(10, 2.6 * len(groups)), layout="constrained")
+    FigureCanvasAgg(figure)
+    axes = figure.subplots(len(groups), 1, sharex=True, squeeze=False)[:, 0]
+    window = plan.settings.window
+    for ax, (title, names) in zip(axes, groups, strict=True):
+        for name in names:
+            values = ok[name].to_numpy(dtype=float)
+            if name.endswith("_s"):  # none within the window: drawn at the window's end
+                values = np.where(np.isfinite(values), values, window)
+            ax.plot(hours, values, ".-", markersize=2, linewidth=0.8, label=name)
+        ax.set_title(title, fontsize=9)
+        ax.legend(fontsize=7, loc="best")
+        ax.grid(alpha=0.3)
+    axes[-1].set_xlabel(f"failure time τ (h after {plan.scenario.format_epoch(0.0)})")
+    figure.savefig(path, dpi=90)
+    return path.name
+
+
+def _cell(value: Any) -> str:
+    if isinstance(value, float):
+        return "—" if not math.isfinite(value) else f"{value:.6g}"
+    return str(value) if value is not None else "— (none within the window)"
+
+
+def _page(result: EnvelopeResult, stats: dict[str, Any], images, files) -> str:
+    plan = result.plan
+    title = f"Loss-of-control envelope: {plan.name}"
+    parts = [
+        "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>",
+        f"<title>{escape(title)}</title><style>{_STYLE}</style></head><body>",
+        f"<h1>{escape(title)}</h1>",
+        f"<p class='note'>{escape(plan.file or 'a scenario built in Python')}, computed by "
+        f"attitude {escape(__version__)}: the exact motion after each loss, searched exactly "
+        "(docs/envelope.md).</p>",
+        "<p>" + "<br>".join(escape(line) for line in plan.describe()) + "</p>",
+    ]
+    worst_row = stats["worst"]
+    if worst_row is not None:
+        parts.append(
+            f"<h2>The worst failure time: {escape(worst_row['epoch_utc'])} "
+            f"(τ = {worst_row['tau_s']:g} s, {escape(worst_row['mode'])})</h2>"
+        )
+        parts.append(
+            _table(
+                ["metric", "value"],
+                [[name, _cell(value)] for name, value in worst_row["margins"].items()],
+            )
+        )
+    parts.append("<h2>Each metric's worst failure time</h2>")
+    parts.append(
+        _table(
+            ["metric", "τ (s)", "value"],
+            [
+                [name, f"{entry['tau_s']:g}", _cell(entry["value"])]
+                for name, entry in stats["worst_per_metric"].items()
+            ],
+        )
+    )
+    if stats["failed"]:
+        first = result.table[result.table["status"] != "ok"].iloc[0]
+        parts.append(
+            f"<p class='note'>{stats['failed']} failures could not be computed; the first "
+            f"(τ = {first['tau_s']:g} s): {escape(str(first['error']))}</p>"
+        )
+    parts += _figures_and_files(images, files)
+    execution = result.execution
+    parts.append(
+        f"<p class='note'>{escape(str(execution['scheduler']))}: "
+        f"{execution['compute_s']:.3g} s of CPU on the workers, {execution['wall_s']:.3g} s "
+        "of wall time.</p>"
+    )
+    parts.append("</body></html>\n")
+    return "\n".join(parts)
