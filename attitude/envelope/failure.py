@@ -44,7 +44,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-from attitude.envelope.power import first_below, integral, power_fraction
+from attitude.envelope.power import first_below_many, integral, power_fraction
 from attitude.pointing.search import OrbitIntervals, pointing_analysis
 from attitude.pointing.shared_surroundings import SharedSurroundings, shared_surroundings
 from attitude.pointing.spec import PointingSpec
@@ -165,8 +165,30 @@ _SURROUNDINGS: weakref.WeakKeyDictionary[EnvelopeJob, SharedSurroundings] = (
 )
 
 
+@dataclass
+class _Power:
+    """What the power search of one failure needs: its motion's attitude, the panels'
+    normals, the window cut at the shadow's edges (:func:`_pieces`), its precision;
+    ``row`` receives ``power_at_loss`` and ``power_lost_s``."""
+
+    row: dict[str, Any]
+    τ: float
+    attitude: Any
+    normals: NDArray[np.float64]
+    pieces: list[tuple[float, float, float, bool]]
+    precision: float
+
+
 def failure_metrics(job: EnvelopeJob, k: int) -> dict[str, Any]:
     """The metrics of failure ``k`` (module notes), as one row of the table."""
+    row, power = _structure(job, k)
+    if power is not None:
+        _power_search(_SURROUNDINGS[job], [power], job.threshold)
+    return row
+
+
+def _structure(job: EnvelopeJob, k: int) -> tuple[dict[str, Any], _Power | None]:
+    """Failure ``k``'s row but for the power search's two columns, and that search."""
     τ = float(job.seconds[k])
     end = τ + job.window
     trajectory = motion_after(job, k)
@@ -195,40 +217,25 @@ def failure_metrics(job: EnvelopeJob, k: int) -> dict[str, Any]:
         row[f"{item.vector.name}_least_sun_angle_deg"] = math.degrees(
             item.extrema["sun_angle"][0].value
         )
+    segment = trajectory.segments[0]
+    power = None
     if panels:
         normals = np.array([item.vector.vector for item in panels])
-
-        def power_in(shadow: bool):
-            """P(t); outside the Earth's shadow the lit fraction is 1 (only the Sun's
-            direction is needed there, from the interpolated targets)."""
-
-            def sun(t):
-                if shadow:
-                    around = shared.at(t)
-                    return around.sun_direction, around.sunlit_fraction
-                return shared.targets(t).sun, 1.0
-
-            def power(t):
-                t = np.asarray(t, dtype=float)
-                return power_fraction(segment.solver.attitude, sun, normals, t)
-
-            return power
-
-        segment = trajectory.segments[0]
         grid = analysis.grid
         turning = float(np.mean([grid.vector_angle_rate_bound(i.vector.name) for i in panels]))
-        row["power_at_loss"] = float(power_in(True)(np.array([τ, τ]))[0])
+        row["power_at_loss"] = math.nan  # filled by the power search (_power_search)
         pieces = _pieces(analysis, τ, end, turning, grid.fraction_rate_bound)
         if isinstance(segment.solver, EulerSolver):
             # The free search integrates the incidence exactly on each cell's quintic.
             row["power_mean"] = float(np.mean([i.mean_cos_incidence for i in panels]))
         else:  # the grid search's trapezoid is coarse: Gauss–Legendre between the edges
             energy = sum(
-                integral(power_in(shadow), a, b, lipschitz) for a, b, lipschitz, shadow in pieces
+                integral(_power_in(shared, segment.solver.attitude, normals, shadow), a, b, lip)
+                for a, b, lip, shadow in pieces
             )
             row["power_mean"] = energy / job.window
-        row["power_lost_s"] = _power_lost(power_in, pieces, τ, job.threshold, analysis.precision_s)
-    segment = trajectory.segments[0]
+        row["power_lost_s"] = math.nan
+        power = _Power(row, τ, segment.solver.attitude, normals, pieces, analysis.precision_s)
     # The body's rate just after the loss: the law's with spinning wheels, I⁻¹(Iω + h)
     # with locked ones (their momentum passes to the body).
     rate0 = float(np.linalg.norm(trajectory.angular_velocity(np.array([τ, τ]))[0]))
@@ -240,7 +247,97 @@ def failure_metrics(job: EnvelopeJob, k: int) -> dict[str, Any]:
     row["flips"] = len(flips)
     row["first_flip_s"] = float(flips[0] - τ) if len(flips) else math.inf
     row["first_violation_s"] = min(firsts, default=math.inf)
-    return row
+    return row, power
+
+
+def _sun(shared: SharedSurroundings, t: NDArray[np.float64], shadow: bool):
+    """The Sun's direction and the lit fraction at ``t``: outside the Earth's shadow
+    the lit fraction is 1 (only the Sun's direction is needed there, from the
+    interpolated targets)."""
+    if shadow:
+        around = shared.at(t)
+        return around.sun_direction, around.sunlit_fraction
+    return shared.targets(t).sun, 1.0
+
+
+def _power_in(shared: SharedSurroundings, attitude, normals, shadow: bool):
+    """P(t) of one motion, for the integral of a torqued motion."""
+
+    def power(t):
+        t = np.asarray(t, dtype=float)
+        return power_fraction(attitude, lambda x: _sun(shared, x, shadow), normals, t)
+
+    return power
+
+
+def _power_search(shared: SharedSurroundings, items: list[_Power], threshold: float) -> None:
+    """``power_at_loss`` and ``power_lost_s`` of many failures at once
+    (:func:`attitude.envelope.power.first_below_many`): the first piece of every
+    failure's window together (with the instant of the loss), then the next piece of
+    those not yet below the threshold, and so on; each round evaluates the Sun and the
+    lit fraction for every failure's points in one call, and each failure's attitude
+    once.  Each failure's points and their order are those it has alone, so its row
+    is the same bit for bit whatever the batch."""
+    for item in items:
+        item.row["power_lost_s"] = math.inf
+    waiting = list(range(len(items)))
+    level = 0
+    while waiting:
+        # (failure, a, b, bound on |P'|, in the shadow): the instant of the loss (its
+        # power, the lit fraction counted) first, then piece ``level`` of each window.
+        problems = [(i, items[i].τ, items[i].τ, 0.0, True) for i in waiting] if level == 0 else []
+        problems += [(i, *items[i].pieces[level]) for i in waiting if level < len(items[i].pieces)]
+        if not problems:
+            break
+        owners = np.array([p[0] for p in problems], dtype=np.intp)
+        darks = np.array([p[4] for p in problems], dtype=bool)
+        found, at_start = first_below_many(
+            _batch_power(shared, items, owners, darks),
+            np.array([p[1] for p in problems]),
+            np.array([p[2] for p in problems]),
+            np.array([p[3] for p in problems]),
+            threshold,
+            np.array([items[p[0]].precision for p in problems]),
+        )
+        searched = len(problems)
+        if level == 0:
+            searched -= len(waiting)
+            for j, i in enumerate(waiting):
+                items[i].row["power_at_loss"] = float(at_start[j])
+        still = []
+        for j in range(len(problems) - searched, len(problems)):
+            i = int(owners[j])
+            if math.isnan(found[j]):
+                still.append(i)
+            else:
+                items[i].row["power_lost_s"] = float(found[j]) - items[i].τ
+        waiting = still
+        level += 1
+
+
+def _batch_power(shared: SharedSurroundings, items: list[_Power], owners, darks):
+    """P at times of many pieces (``owners``: each piece's failure, ``darks``: whether
+    it lies in the Earth's shadow): the Sun for all points in one call, each failure's
+    attitude at its points in one call."""
+
+    def f(which: NDArray[np.intp], t: NDArray[np.float64]) -> NDArray[np.float64]:
+        whose, dark = owners[which], darks[which]
+        direction = np.empty((t.size, 3))
+        lit = np.ones(t.size)
+        if np.any(dark):
+            direction[dark], lit[dark] = _sun(shared, t[dark], True)
+        if not np.all(dark):
+            direction[~dark] = _sun(shared, t[~dark], False)[0]
+        out = np.empty(t.size)
+        for i in np.unique(whose):
+            mine = whose == i
+            item = items[int(i)]
+            out[mine] = power_fraction(
+                item.attitude, lambda _, m=mine: (direction[m], lit[m]), item.normals, t[mine]
+            )
+        return out
+
+    return f
 
 
 def _pieces(analysis, τ: float, end: float, turning: float, fraction_rate: float):
@@ -262,28 +359,40 @@ def _pieces(analysis, τ: float, end: float, turning: float, fraction_rate: floa
     return pieces
 
 
-def _power_lost(power_in, pieces, τ: float, threshold: float, precision: float) -> float:
-    """The first time the panels' power fraction reaches ``threshold`` (s after τ)."""
-    for a, b, lipschitz, shadow in pieces:
-        found = first_below(power_in(shadow), a, b, lipschitz, threshold, precision)
-        if found is not None:
-            return found - τ
-    return math.inf
-
-
 def evaluate_batch(job: EnvelopeJob, first: int, stop: int) -> BatchResult:
     """Failures ``first`` to ``stop − 1`` of ``job``, each a row (runs on a worker).  A
-    failure whose motion is refused is a row with its error; the job goes on."""
+    failure whose motion is refused is a row with its error; the job goes on.
+
+    The power searches of the batch run together (:func:`_power_search`); each row is
+    the same bit for bit as :func:`failure_metrics` gives it alone."""
     started = time.process_time()
     rows = []
+    searches: list[_Power] = []
     for k in range(first, stop):
         row: dict[str, Any] = {"failure": k, "tau_s": float(job.seconds[k])}
         try:
-            row.update(failure_metrics(job, k), status="ok", error="")
+            metrics, power = _structure(job, k)
+            row.update(metrics, status="ok", error="")
+            if power is not None:
+                power.row = row
+                searches.append(power)
         except Exception as exc:  # a refused motion is this failure's row, not the job's end
-            row.update({name: math.nan for name in job.columns}, status="failed", error=_text(exc))
+            _failed(row, job, exc)
         rows.append(row)
+    if searches:
+        try:
+            _power_search(_SURROUNDINGS[job], searches, job.threshold)
+        except Exception:  # find which failure's search is refused: each alone
+            for power in searches:
+                try:
+                    _power_search(_SURROUNDINGS[job], [power], job.threshold)
+                except Exception as exc:
+                    _failed(power.row, job, exc)
     return BatchResult(rows, time.process_time() - started)
+
+
+def _failed(row: dict[str, Any], job: EnvelopeJob, exc: BaseException) -> None:
+    row.update({name: math.nan for name in job.columns}, status="failed", error=_text(exc))
 
 
 def _text(exc: BaseException) -> str:

@@ -16,7 +16,10 @@ which counts only inside the Earth's shadow), so on a cell [t₀, t₁] of width
 P ≥ (P(t₀) + P(t₁) − L h)/2.  A cell whose bound exceeds c is settled; the others, in
 time order up to the first node where P ≤ c, are cut into 16 parts until the first is narrower
 than the precision: its left end is the first instant P can reach c (an early answer
-by at most the precision, never a late one).
+by at most the precision, never a late one).  :func:`first_below_many` runs that
+search for many pieces (of many failures) at once, each round of cuts one call of the
+function for every piece: the same cells, nodes and answer as :func:`first_below` on
+each piece alone (the same arithmetic, element by element).
 
 :func:`integral` gives ∫P dt over a piece where P is smooth but for the kinks of
 max(cos θ, 0): Gauss–Legendre (8 points) on cells no longer than the Lipschitz
@@ -31,7 +34,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["first_below", "integral", "power_fraction"]
+__all__ = ["first_below", "first_below_many", "integral", "power_fraction"]
 
 # The first nodes are spaced so that the Lipschitz bound sags at most this much
 # between two of them (a power fraction), and a run of nodes holds at most this many.
@@ -83,6 +86,110 @@ def first_below(
         if found is not None:
             return found
     return None
+
+
+def first_below_many(
+    f: Callable[[NDArray[np.intp], NDArray[np.float64]], NDArray[np.float64]],
+    a: NDArray[np.float64],
+    b: NDArray[np.float64],
+    lipschitz: NDArray[np.float64],
+    threshold: float,
+    precision: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """:func:`first_below` on each piece [a_i, b_i] (bound ``lipschitz[i]``, precision
+    ``precision[i]``) at once: ``f(which, t)`` gives the function of piece ``which[j]``
+    at ``t[j]``.  Returns the first times (NaN where f stays above ``threshold``) and
+    f(a_i).  A piece of more than :data:`_CHUNK_NODES` cells is searched alone, by
+    :func:`first_below`."""
+    count = a.size
+    found = np.full(count, np.nan)
+    at_start = np.empty(count)
+    # Round 0: every piece's first nodes (its start alone if it is empty or searched
+    # alone), in one call.
+    edges: list[NDArray[np.float64]] = []
+    for i in range(count):
+        lo, hi, slope = float(a[i]), float(b[i]), float(lipschitz[i])
+        if hi <= lo:
+            edges.append(np.array([lo]))
+            continue
+        step = 2.0 * _SAG / slope if slope > 0.0 else hi - lo
+        cells = max(1, math.ceil((hi - lo) / step))
+        edges.append(np.linspace(lo, hi, cells + 1) if cells <= _CHUNK_NODES else np.array([lo]))
+    sizes = np.array([e.size for e in edges], dtype=np.intp)
+    which = np.repeat(np.arange(count, dtype=np.intp), sizes)
+    values = f(which, np.concatenate(edges)) if count else np.empty(0)
+    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.intp)
+    at_start[:] = values[starts]
+    pid_parts, left_parts, right_parts, vl_parts, vr_parts = [], [], [], [], []
+    for i in range(count):
+        if at_start[i] <= threshold:
+            found[i] = a[i]
+        elif sizes[i] > 1:
+            t = edges[i]
+            g = values[starts[i] : starts[i] + sizes[i]] - threshold
+            pid_parts.append(np.full(t.size - 1, i, dtype=np.intp))
+            left_parts.append(t[:-1])
+            right_parts.append(t[1:])
+            vl_parts.append(g[:-1])
+            vr_parts.append(g[1:])
+        elif b[i] > a[i]:  # more cells than a run holds: alone, in runs
+            alone = first_below(
+                _one(f, i),
+                float(a[i]),
+                float(b[i]),
+                float(lipschitz[i]),
+                threshold,
+                float(precision[i]),
+            )
+            found[i] = np.nan if alone is None else alone
+    if not pid_parts:
+        return found, at_start
+    pid = np.concatenate(pid_parts)
+    left, right = np.concatenate(left_parts), np.concatenate(right_parts)
+    v_left, v_right = np.concatenate(vl_parts), np.concatenate(vr_parts)
+    fractions = np.arange(1, _SPLIT) / _SPLIT
+    for _ in range(_MAX_HALVINGS):
+        # Each piece's cells up to its first node where f ≤ c (as _first_in).
+        index = np.arange(pid.size)
+        first_low = np.full(count, pid.size)
+        low = v_right <= 0.0
+        np.minimum.at(first_low, pid[low], index[low])
+        keep = index <= first_low[pid]
+        keep &= 0.5 * (v_left + v_right - lipschitz[pid] * (right - left)) <= 0.0
+        pid, left, right = pid[keep], left[keep], right[keep]
+        v_left, v_right = v_left[keep], v_right[keep]
+        if pid.size == 0:
+            return found, at_start
+        heads = np.flatnonzero(np.concatenate([[True], pid[1:] != pid[:-1]]))
+        narrow = heads[right[heads] - left[heads] <= precision[pid[heads]]]
+        if narrow.size:
+            found[pid[narrow]] = left[narrow]
+            done = np.zeros(count, dtype=bool)
+            done[pid[narrow]] = True
+            keep = ~done[pid]
+            pid, left, right = pid[keep], left[keep], right[keep]
+            v_left, v_right = v_left[keep], v_right[keep]
+            if pid.size == 0:
+                return found, at_start
+        inner = left[:, None] + (right - left)[:, None] * fractions[None, :]
+        v_inner = (f(np.repeat(pid, _SPLIT - 1), inner.ravel()) - threshold).reshape(inner.shape)
+        nodes = np.column_stack([left, inner, right])
+        values = np.column_stack([v_left, v_inner, v_right])
+        left, right = np.ravel(nodes[:, :-1]), np.ravel(nodes[:, 1:])
+        v_left, v_right = np.ravel(values[:, :-1]), np.ravel(values[:, 1:])
+        pid = np.repeat(pid, _SPLIT)
+    heads = np.flatnonzero(np.concatenate([[True], pid[1:] != pid[:-1]]))
+    found[pid[heads]] = left[heads]  # cut to the limit: the earliest instant it may reach
+    return found, at_start
+
+
+def _one(f, i: int) -> Callable[[NDArray[np.float64]], NDArray[np.float64]]:
+    """Piece ``i``'s function of :func:`first_below_many` alone."""
+
+    def g(t: NDArray[np.float64]) -> NDArray[np.float64]:
+        return f(np.full(t.size, i, dtype=np.intp), t)
+
+    return g
 
 
 def _first_in(g, t, lipschitz: float, precision: float) -> float | None:
