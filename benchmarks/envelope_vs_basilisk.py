@@ -59,7 +59,7 @@ EPOCH = "2025-05-01T10:00:00"
 INERTIA = [820.0, 1040.0, 610.0]
 STEP_S = 0.1
 SAMPLE = 16  # failures timed on each side
-BATCH = 32  # failures a task (the engine sizes tasks to tens of failures at this cost)
+BATCH = 32  # failures a task (the engine makes a task last 100 times its scheduling cost)
 
 
 def case(every: float = 10.0) -> tuple[Scenario, PointingSpec, EnvelopeSettings]:
