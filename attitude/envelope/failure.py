@@ -44,7 +44,14 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-from attitude.envelope.power import first_below_many, integral, power_fraction
+from attitude.envelope.power import (
+    first_below,
+    first_below_many,
+    first_nodes,
+    integral,
+    mean_incidence,
+    power_fraction,
+)
 from attitude.pointing.search import OrbitIntervals, pointing_analysis
 from attitude.pointing.shared_surroundings import SharedSurroundings, shared_surroundings
 from attitude.pointing.spec import PointingSpec
@@ -167,13 +174,14 @@ _SURROUNDINGS: weakref.WeakKeyDictionary[EnvelopeJob, SharedSurroundings] = (
 
 @dataclass
 class _Power:
-    """What the power search of one failure needs: its motion's attitude, the panels'
-    normals, the window cut at the shadow's edges (:func:`_pieces`), its precision;
-    ``row`` receives ``power_at_loss`` and ``power_lost_s``."""
+    """What the power search of one failure needs: its motion's attitude quaternions
+    (scalar first, body → ICRF), the panels' normals, the window cut at the shadow's
+    edges (:func:`_pieces`), its precision; ``row`` receives ``power_at_loss`` and
+    ``power_lost_s``."""
 
     row: dict[str, Any]
     τ: float
-    attitude: Any
+    quaternions: Any
     normals: NDArray[np.float64]
     pieces: list[tuple[float, float, float, bool]]
     precision: float
@@ -230,12 +238,13 @@ def _structure(job: EnvelopeJob, k: int) -> tuple[dict[str, Any], _Power | None]
             row["power_mean"] = float(np.mean([i.mean_cos_incidence for i in panels]))
         else:  # the grid search's trapezoid is coarse: Gauss–Legendre between the edges
             energy = sum(
-                integral(_power_in(shared, segment.solver.attitude, normals, shadow), a, b, lip)
+                integral(_power_in(shared, segment.solver, normals, shadow), a, b, lip)
                 for a, b, lip, shadow in pieces
             )
             row["power_mean"] = energy / job.window
         row["power_lost_s"] = math.nan
-        power = _Power(row, τ, segment.solver.attitude, normals, pieces, analysis.precision_s)
+        quaternions = segment.solver.attitude_quaternion
+        power = _Power(row, τ, quaternions, normals, pieces, analysis.precision_s)
     # The body's rate just after the loss: the law's with spinning wheels, I⁻¹(Iω + h)
     # with locked ones (their momentum passes to the body).
     rate0 = float(np.linalg.norm(trajectory.angular_velocity(np.array([τ, τ]))[0]))
@@ -260,65 +269,118 @@ def _sun(shared: SharedSurroundings, t: NDArray[np.float64], shadow: bool):
     return shared.targets(t).sun, 1.0
 
 
-def _power_in(shared: SharedSurroundings, attitude, normals, shadow: bool):
+def _power_in(shared: SharedSurroundings, solver, normals, shadow: bool):
     """P(t) of one motion, for the integral of a torqued motion."""
 
     def power(t):
         t = np.asarray(t, dtype=float)
-        return power_fraction(attitude, lambda x: _sun(shared, x, shadow), normals, t)
+        return power_fraction(
+            solver.attitude_quaternion, lambda x: _sun(shared, x, shadow), normals, t
+        )
 
     return power
 
 
+# The power search takes a piece's nodes in runs of at most this many cells, the next
+# run only if the power stays above the threshold over the previous one: in the
+# Earth's shadow the lit fraction's rate makes the nodes about a second apart, and the
+# power falls to 0 in the umbra, within the first run or two of a shadow piece.
+_RUN_CELLS = 256
+
+
 def _power_search(shared: SharedSurroundings, items: list[_Power], threshold: float) -> None:
     """``power_at_loss`` and ``power_lost_s`` of many failures at once
-    (:func:`attitude.envelope.power.first_below_many`): the first piece of every
-    failure's window together (with the instant of the loss), then the next piece of
-    those not yet below the threshold, and so on; each round evaluates the Sun and the
-    lit fraction for every failure's points in one call, and each failure's attitude
-    once.  Each failure's points and their order are those it has alone, so its row
-    is the same bit for bit whatever the batch."""
+    (:func:`attitude.envelope.power.first_below_many`): the first run of nodes of
+    every failure's window together (with the instant of the loss), then the next run
+    of those not yet below the threshold, and so on through the pieces of the window;
+    each round evaluates the Sun and the lit fraction for every failure's points in
+    one call, and each failure's attitude once.  Each failure's points and their order
+    are those it has alone, so its row is the same bit for bit whatever the batch.
+    A piece of more cells than :func:`~attitude.envelope.power.first_below` takes in
+    one run is searched by it, for its failure alone."""
+    stages = [_stages(item) for item in items]
     for item in items:
         item.row["power_lost_s"] = math.inf
     waiting = list(range(len(items)))
     level = 0
     while waiting:
-        # (failure, a, b, bound on |P'|, in the shadow): the instant of the loss (its
-        # power, the lit fraction counted) first, then piece ``level`` of each window.
-        problems = [(i, items[i].τ, items[i].τ, 0.0, True) for i in waiting] if level == 0 else []
-        problems += [(i, *items[i].pieces[level]) for i in waiting if level < len(items[i].pieces)]
-        if not problems:
+        # (failure, nodes, bound on |P'|, in the shadow): the instant of the loss (its
+        # power, the lit fraction counted) first, then stage ``level`` of each window.
+        runs = [(i, np.array([items[i].τ]), 0.0, True) for i in waiting] if level == 0 else []
+        alone: list[tuple[int, float, float, float, bool]] = []
+        for i in waiting:
+            if level < len(stages[i]):
+                stage = stages[i][level]
+                (runs if isinstance(stage[0], np.ndarray) else alone).append((i, *stage))
+        if not runs and not alone:
             break
-        owners = np.array([p[0] for p in problems], dtype=np.intp)
-        darks = np.array([p[4] for p in problems], dtype=bool)
-        found, at_start = first_below_many(
-            _batch_power(shared, items, owners, darks),
-            np.array([p[1] for p in problems]),
-            np.array([p[2] for p in problems]),
-            np.array([p[3] for p in problems]),
-            threshold,
-            np.array([items[p[0]].precision for p in problems]),
-        )
-        searched = len(problems)
-        if level == 0:
-            searched -= len(waiting)
-            for j, i in enumerate(waiting):
-                items[i].row["power_at_loss"] = float(at_start[j])
+        found_at: dict[int, float] = {}
+        for i, a, b, lipschitz, dark in alone:
+            first = first_below(
+                _one(_batch_power(shared, items, np.array([i]), np.array([dark]))),
+                a,
+                b,
+                lipschitz,
+                threshold,
+                items[i].precision,
+            )
+            found_at[i] = math.nan if first is None else first
+        if runs:
+            owners = np.array([r[0] for r in runs], dtype=np.intp)
+            found, at_start = first_below_many(
+                _batch_power(shared, items, owners, np.array([r[3] for r in runs], dtype=bool)),
+                [r[1] for r in runs],
+                np.array([r[2] for r in runs]),
+                threshold,
+                np.array([items[r[0]].precision for r in runs]),
+            )
+            first_stage = 0
+            if level == 0:
+                first_stage = len(waiting)
+                for j, i in enumerate(waiting):
+                    items[i].row["power_at_loss"] = float(at_start[j])
+            for j in range(first_stage, len(runs)):
+                found_at[int(owners[j])] = float(found[j])
         still = []
-        for j in range(len(problems) - searched, len(problems)):
-            i = int(owners[j])
-            if math.isnan(found[j]):
+        for i in waiting:
+            if i in found_at and not math.isnan(found_at[i]):
+                items[i].row["power_lost_s"] = found_at[i] - items[i].τ
+            elif level + 1 < len(stages[i]):
                 still.append(i)
-            else:
-                items[i].row["power_lost_s"] = float(found[j]) - items[i].τ
         waiting = still
         level += 1
+
+
+def _one(f):
+    """``f`` of :func:`_batch_power` for its one piece."""
+
+    def power(t: NDArray[np.float64]) -> NDArray[np.float64]:
+        return f(np.zeros(t.size, dtype=np.intp), t)
+
+    return power
+
+
+def _stages(item: _Power) -> list[tuple]:
+    """The window's pieces as the power search takes them, in time order: runs of at
+    most _RUN_CELLS cells of a piece's nodes (nodes, bound, in the shadow), or a piece
+    searched alone (a, b, bound, in the shadow)."""
+    stages: list[tuple] = []
+    for a, b, lipschitz, dark in item.pieces:
+        nodes = first_nodes(a, b, lipschitz)
+        if nodes is None:
+            stages.append((a, b, lipschitz, dark))
+            continue
+        cells = max(nodes.size - 1, 1)
+        for start in range(0, cells, _RUN_CELLS):
+            stages.append((nodes[start : start + _RUN_CELLS + 1], lipschitz, dark))
+    return stages
 
 
 def _batch_power(shared: SharedSurroundings, items: list[_Power], owners, darks):
     """P at times of many pieces (``owners``: each piece's failure, ``darks``: whether
     it lies in the Earth's shadow): the Sun for all points in one call, each failure's
-    attitude at its points in one call."""
+    attitude at its points in one call, the incidences of all in one pass (element by
+    element: a point's value does not depend on the others)."""
 
     def f(which: NDArray[np.intp], t: NDArray[np.float64]) -> NDArray[np.float64]:
         whose, dark = owners[which], darks[which]
@@ -328,14 +390,12 @@ def _batch_power(shared: SharedSurroundings, items: list[_Power], owners, darks)
             direction[dark], lit[dark] = _sun(shared, t[dark], True)
         if not np.all(dark):
             direction[~dark] = _sun(shared, t[~dark], False)[0]
-        out = np.empty(t.size)
+        q = np.empty((t.size, 4))
         for i in np.unique(whose):
             mine = whose == i
-            item = items[int(i)]
-            out[mine] = power_fraction(
-                item.attitude, lambda _, m=mine: (direction[m], lit[m]), item.normals, t[mine]
-            )
-        return out
+            q[mine] = items[int(i)].quaternions(t[mine])
+        # Every failure of a task has the job's panels.
+        return lit * mean_incidence(q, items[0].normals, direction)
 
     return f
 

@@ -17,9 +17,9 @@ P ≥ (P(t₀) + P(t₁) − L h)/2.  A cell whose bound exceeds c is settled; t
 time order up to the first node where P ≤ c, are cut into 16 parts until the first is narrower
 than the precision: its left end is the first instant P can reach c (an early answer
 by at most the precision, never a late one).  :func:`first_below_many` runs that
-search for many pieces (of many failures) at once, each round of cuts one call of the
-function for every piece: the same cells, nodes and answer as :func:`first_below` on
-each piece alone (the same arithmetic, element by element).
+search on many runs of nodes (of many failures) at once, each round of cuts one call
+of the function for all: each run's cells, nodes and answer are those it has alone
+(the same arithmetic, element by element).
 
 :func:`integral` gives ∫P dt over a piece where P is smooth but for the kinks of
 max(cos θ, 0): Gauss–Legendre (8 points) on cells no longer than the Lipschitz
@@ -34,7 +34,14 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["first_below", "first_below_many", "integral", "power_fraction"]
+__all__ = [
+    "first_below",
+    "first_below_many",
+    "first_nodes",
+    "integral",
+    "mean_incidence",
+    "power_fraction",
+]
 
 # The first nodes are spaced so that the Lipschitz bound sags at most this much
 # between two of them (a power fraction), and a run of nodes holds at most this many.
@@ -51,15 +58,38 @@ _MAX_HALVINGS = 20
 
 
 def power_fraction(
-    attitude: Callable, sun: Callable, panels: NDArray[np.float64], t: NDArray[np.float64]
+    quaternions: Callable, sun: Callable, panels: NDArray[np.float64], t: NDArray[np.float64]
 ) -> NDArray[np.float64]:
-    """P(t) (module notes): ``attitude(t)`` the body → ICRF Rotation, ``sun(t)`` the
-    Sun's unit direction (n, 3) and the lit fraction (n,) or 1, ``panels`` (k, 3) unit
-    normals in body axes."""
-    rotation = attitude(t)
+    """P(t) (module notes): ``quaternions(t)`` the unit attitude quaternions (n, 4),
+    scalar first, body → ICRF, ``sun(t)`` the Sun's unit direction (n, 3) and the lit
+    fraction (n,) or 1, ``panels`` (k, 3) unit normals in body axes."""
     direction, lit = sun(t)
-    cosines = np.stack([np.einsum("ij,ij->i", rotation.apply(p), direction) for p in panels])
-    return lit * np.mean(np.maximum(cosines, 0.0), axis=0)
+    return lit * mean_incidence(quaternions(t), panels, direction)
+
+
+def mean_incidence(
+    q: NDArray[np.float64], panels: NDArray[np.float64], sun: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """(1/k) Σ_p max(cos θ_p, 0) at each of n instants: each panel's unit normal b_p
+    (``panels``, (k, 3), body axes) turned to ICRF by the unit quaternions ``q`` ((n, 4),
+    w, x, y, z) as R(q) b_p, the rotation matrix written row by row, against the Sun's
+    unit directions ``sun`` (n, 3).  Element by element: an instant's value does not
+    depend on the others computed with it."""
+    w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    xx, yy, zz = x * x, y * y, z * z
+    xy, xz, yz, wx, wy, wz = x * y, x * z, y * z, w * x, w * y, w * z
+    rows = (
+        (1.0 - 2.0 * (yy + zz), 2.0 * (xy - wz), 2.0 * (xz + wy)),
+        (2.0 * (xy + wz), 1.0 - 2.0 * (xx + zz), 2.0 * (yz - wx)),
+        (2.0 * (xz - wy), 2.0 * (yz + wx), 1.0 - 2.0 * (xx + yy)),
+    )
+    total = np.zeros(q.shape[0])
+    for b in panels:
+        cosine = (rows[0][0] * b[0] + rows[0][1] * b[1] + rows[0][2] * b[2]) * sun[:, 0]
+        cosine += (rows[1][0] * b[0] + rows[1][1] * b[1] + rows[1][2] * b[2]) * sun[:, 1]
+        cosine += (rows[2][0] * b[0] + rows[2][1] * b[1] + rows[2][2] * b[2]) * sun[:, 2]
+        total += np.maximum(cosine, 0.0)
+    return total / len(panels)
 
 
 def first_below(
@@ -88,60 +118,49 @@ def first_below(
     return None
 
 
+def first_nodes(a: float, b: float, lipschitz: float) -> NDArray[np.float64] | None:
+    """The nodes :func:`first_below` starts from on [a, b] (``a`` alone for an empty
+    piece), or None for a piece of more cells than a run holds (:func:`first_below`
+    searches it in runs)."""
+    if b <= a:
+        return np.array([a])
+    step = 2.0 * _SAG / lipschitz if lipschitz > 0.0 else b - a
+    cells = max(1, math.ceil((b - a) / step))
+    return np.linspace(a, b, cells + 1) if cells <= _CHUNK_NODES else None
+
+
 def first_below_many(
     f: Callable[[NDArray[np.intp], NDArray[np.float64]], NDArray[np.float64]],
-    a: NDArray[np.float64],
-    b: NDArray[np.float64],
+    nodes: list[NDArray[np.float64]],
     lipschitz: NDArray[np.float64],
     threshold: float,
     precision: NDArray[np.float64],
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """:func:`first_below` on each piece [a_i, b_i] (bound ``lipschitz[i]``, precision
-    ``precision[i]``) at once: ``f(which, t)`` gives the function of piece ``which[j]``
-    at ``t[j]``.  Returns the first times (NaN where f stays above ``threshold``) and
-    f(a_i).  A piece of more than :data:`_CHUNK_NODES` cells is searched alone, by
-    :func:`first_below`."""
-    count = a.size
+    """:func:`first_below` on many runs of nodes at once: run i starts from
+    ``nodes[i]`` (consecutive nodes of :func:`first_nodes`, one node for a piece
+    reduced to its start), with the bound ``lipschitz[i]`` and ``precision[i]``;
+    ``f(which, t)`` gives the function of run ``which[j]`` at ``t[j]``.  Returns each
+    run's first time (NaN where f stays above ``threshold``) and f at its first node.
+    The first node counts: f there at or below the threshold answers it."""
+    count = len(nodes)
     found = np.full(count, np.nan)
-    at_start = np.empty(count)
-    # Round 0: every piece's first nodes (its start alone if it is empty or searched
-    # alone), in one call.
-    edges: list[NDArray[np.float64]] = []
-    for i in range(count):
-        lo, hi, slope = float(a[i]), float(b[i]), float(lipschitz[i])
-        if hi <= lo:
-            edges.append(np.array([lo]))
-            continue
-        step = 2.0 * _SAG / slope if slope > 0.0 else hi - lo
-        cells = max(1, math.ceil((hi - lo) / step))
-        edges.append(np.linspace(lo, hi, cells + 1) if cells <= _CHUNK_NODES else np.array([lo]))
-    sizes = np.array([e.size for e in edges], dtype=np.intp)
+    sizes = np.array([t.size for t in nodes], dtype=np.intp)
     which = np.repeat(np.arange(count, dtype=np.intp), sizes)
-    values = f(which, np.concatenate(edges)) if count else np.empty(0)
+    values = f(which, np.concatenate(nodes)) if count else np.empty(0)
     starts = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.intp)
-    at_start[:] = values[starts]
+    at_start = values[starts]
     pid_parts, left_parts, right_parts, vl_parts, vr_parts = [], [], [], [], []
     for i in range(count):
         if at_start[i] <= threshold:
-            found[i] = a[i]
+            found[i] = nodes[i][0]
         elif sizes[i] > 1:
-            t = edges[i]
+            t = nodes[i]
             g = values[starts[i] : starts[i] + sizes[i]] - threshold
             pid_parts.append(np.full(t.size - 1, i, dtype=np.intp))
             left_parts.append(t[:-1])
             right_parts.append(t[1:])
             vl_parts.append(g[:-1])
             vr_parts.append(g[1:])
-        elif b[i] > a[i]:  # more cells than a run holds: alone, in runs
-            alone = first_below(
-                _one(f, i),
-                float(a[i]),
-                float(b[i]),
-                float(lipschitz[i]),
-                threshold,
-                float(precision[i]),
-            )
-            found[i] = np.nan if alone is None else alone
     if not pid_parts:
         return found, at_start
     pid = np.concatenate(pid_parts)
@@ -173,23 +192,14 @@ def first_below_many(
                 return found, at_start
         inner = left[:, None] + (right - left)[:, None] * fractions[None, :]
         v_inner = (f(np.repeat(pid, _SPLIT - 1), inner.ravel()) - threshold).reshape(inner.shape)
-        nodes = np.column_stack([left, inner, right])
+        cut = np.column_stack([left, inner, right])
         values = np.column_stack([v_left, v_inner, v_right])
-        left, right = np.ravel(nodes[:, :-1]), np.ravel(nodes[:, 1:])
+        left, right = np.ravel(cut[:, :-1]), np.ravel(cut[:, 1:])
         v_left, v_right = np.ravel(values[:, :-1]), np.ravel(values[:, 1:])
         pid = np.repeat(pid, _SPLIT)
     heads = np.flatnonzero(np.concatenate([[True], pid[1:] != pid[:-1]]))
     found[pid[heads]] = left[heads]  # cut to the limit: the earliest instant it may reach
     return found, at_start
-
-
-def _one(f, i: int) -> Callable[[NDArray[np.float64]], NDArray[np.float64]]:
-    """Piece ``i``'s function of :func:`first_below_many` alone."""
-
-    def g(t: NDArray[np.float64]) -> NDArray[np.float64]:
-        return f(np.full(t.size, i, dtype=np.intp), t)
-
-    return g
 
 
 def _first_in(g, t, lipschitz: float, precision: float) -> float | None:
