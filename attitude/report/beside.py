@@ -2,7 +2,7 @@
 
 A report's validity horizon (:func:`attitude.trajectory.horizon.validity_horizon`: the scenario
 propagated again under gravity gradient over the span, splitting steps of exact free
-flows) takes a fifth of a one-day run's CPU and needs none of the rest; it is a few
+flows) is a part of a run's CPU that needs none of the rest; it is a few
 numbers to the summary at the end.  :class:`Beside` computes such a function in a child
 process made by ``fork`` (nothing to import again, nothing to send but the result)
 while the parent streams the outputs, and hands the result, or the exception the

@@ -42,11 +42,13 @@ __all__ = [
     "time_unit",
 ]
 
-_DPI = 110
+# 9 in at 100 dpi: 900 pixels across, the text (in points) as large relative to the
+# figure as at any dpi; fewer pixels to rasterise and to encode than at 110 dpi (-17 %).
+_DPI = 100
 # zlib's fastest level for the PNGs: the encoding is a fifth of a figure's time at the
 # default level (6), a tenth at this one, for files about 15 % larger.
 PNG_OPTIONS: dict[str, Any] = {"pil_kwargs": {"compress_level": 1}}
-# At least the width of the axes in pixels (9 in at 110 dpi, less the margins).
+# At least the width of the axes in pixels (9 in at 100 dpi, less the margins).
 PIXEL_COLUMNS = 900
 
 
@@ -176,10 +178,17 @@ def _panels(rows: int, height_in: float) -> tuple[Figure, list]:
 
 
 def _save(figure: Figure, path: Path) -> str:
+    """The figure as an opaque RGB PNG: its background is white, so the alpha channel
+    that matplotlib's own PNG carries says nothing, and without it there is a quarter
+    less to compress (a fifth of the encoding's time)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from PIL import Image  # matplotlib's own dependency, its PNG writer
 
-    FigureCanvasAgg(figure)
-    figure.savefig(path, dpi=_DPI, **PNG_OPTIONS)
+    figure.set_dpi(_DPI)
+    canvas = FigureCanvasAgg(figure)
+    canvas.draw()
+    rgb = np.asarray(canvas.buffer_rgba())[:, :, :3]
+    Image.fromarray(rgb).save(path, format="png", dpi=(_DPI, _DPI), **PNG_OPTIONS["pil_kwargs"])
     return path.name
 
 

@@ -79,6 +79,15 @@ _DENSE_CHUNK = 8192
 _SLIVER = 1e-6
 # More steps than this in one request (hours of computing) is refused as a mistake.
 _MAX_REQUEST_STEPS = 1e8
+# The compiled loop's start-up (numba's import and its cached machine code loaded: about
+# 0.3 s of CPU) is the cost of some 8 000 steps of the Python loop (35 µs each), which
+# computes the same states bit for bit.  A process takes its first PYTHON_LOOP_STEPS
+# steps in Python and the rest compiled (paying the start when it is sure to need
+# more): an hour's validity horizon never starts numba, a day's pays its start once and
+# at most 0.15 s for the steps taken in Python first (a rent-or-buy rule: never more
+# than twice the cheaper choice in hindsight).
+PYTHON_LOOP_STEPS = 4096
+_python_steps = 0  # steps this process took by the Python loop in place of the compiled one
 # A step search that would try a step with more than this many steps over its span is
 # refused (each try runs the span twice): torques that turn the body faster and faster
 # (a runaway spin-up) would otherwise halve the step for hours before failing.  At 8
@@ -209,7 +218,11 @@ class _Engine:
         (:mod:`attitude.torques.compiled_steps`) into the ``out_*`` rows, stopping before
         a state beyond ``largest`` (|m1| + |m2| + |m3|, N m s); the number done (0 when
         this engine has no compiled loop)."""
+        global _python_steps
         if not self.compiled:
+            return 0
+        if _python_steps < PYTHON_LOOP_STEPS:  # numba's start not yet worth paying
+            _python_steps += len(sizes)
             return 0
         from attitude.torques.compiled_steps import gravity_gradient_steps
 
