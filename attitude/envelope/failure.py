@@ -44,7 +44,14 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
-from attitude.envelope.power import first_below, integral, power_fraction
+from attitude.envelope.power import (
+    first_below,
+    first_below_many,
+    first_nodes,
+    integral,
+    mean_incidence,
+    power_fraction,
+)
 from attitude.pointing.search import OrbitIntervals, pointing_analysis
 from attitude.pointing.shared_surroundings import SharedSurroundings, shared_surroundings
 from attitude.pointing.spec import PointingSpec
@@ -165,8 +172,31 @@ _SURROUNDINGS: weakref.WeakKeyDictionary[EnvelopeJob, SharedSurroundings] = (
 )
 
 
+@dataclass
+class _Power:
+    """What the power search of one failure needs: its motion's attitude quaternions
+    (scalar first, body → ICRF), the panels' normals, the window cut at the shadow's
+    edges (:func:`_pieces`), its precision; ``row`` receives ``power_at_loss`` and
+    ``power_lost_s``."""
+
+    row: dict[str, Any]
+    τ: float
+    quaternions: Any
+    normals: NDArray[np.float64]
+    pieces: list[tuple[float, float, float, bool]]
+    precision: float
+
+
 def failure_metrics(job: EnvelopeJob, k: int) -> dict[str, Any]:
     """The metrics of failure ``k`` (module notes), as one row of the table."""
+    row, power = _structure(job, k)
+    if power is not None:
+        _power_search(_SURROUNDINGS[job], [power], job.threshold)
+    return row
+
+
+def _structure(job: EnvelopeJob, k: int) -> tuple[dict[str, Any], _Power | None]:
+    """Failure ``k``'s row but for the power search's two columns, and that search."""
     τ = float(job.seconds[k])
     end = τ + job.window
     trajectory = motion_after(job, k)
@@ -195,40 +225,26 @@ def failure_metrics(job: EnvelopeJob, k: int) -> dict[str, Any]:
         row[f"{item.vector.name}_least_sun_angle_deg"] = math.degrees(
             item.extrema["sun_angle"][0].value
         )
+    segment = trajectory.segments[0]
+    power = None
     if panels:
         normals = np.array([item.vector.vector for item in panels])
-
-        def power_in(shadow: bool):
-            """P(t); outside the Earth's shadow the lit fraction is 1 (only the Sun's
-            direction is needed there, from the interpolated targets)."""
-
-            def sun(t):
-                if shadow:
-                    around = shared.at(t)
-                    return around.sun_direction, around.sunlit_fraction
-                return shared.targets(t).sun, 1.0
-
-            def power(t):
-                t = np.asarray(t, dtype=float)
-                return power_fraction(segment.solver.attitude, sun, normals, t)
-
-            return power
-
-        segment = trajectory.segments[0]
         grid = analysis.grid
         turning = float(np.mean([grid.vector_angle_rate_bound(i.vector.name) for i in panels]))
-        row["power_at_loss"] = float(power_in(True)(np.array([τ, τ]))[0])
+        row["power_at_loss"] = math.nan  # filled by the power search (_power_search)
         pieces = _pieces(analysis, τ, end, turning, grid.fraction_rate_bound)
         if isinstance(segment.solver, EulerSolver):
             # The free search integrates the incidence exactly on each cell's quintic.
             row["power_mean"] = float(np.mean([i.mean_cos_incidence for i in panels]))
         else:  # the grid search's trapezoid is coarse: Gauss–Legendre between the edges
             energy = sum(
-                integral(power_in(shadow), a, b, lipschitz) for a, b, lipschitz, shadow in pieces
+                integral(_power_in(shared, segment.solver, normals, shadow), a, b, lip)
+                for a, b, lip, shadow in pieces
             )
             row["power_mean"] = energy / job.window
-        row["power_lost_s"] = _power_lost(power_in, pieces, τ, job.threshold, analysis.precision_s)
-    segment = trajectory.segments[0]
+        row["power_lost_s"] = math.nan
+        quaternions = segment.solver.attitude_quaternion
+        power = _Power(row, τ, quaternions, normals, pieces, analysis.precision_s)
     # The body's rate just after the loss: the law's with spinning wheels, I⁻¹(Iω + h)
     # with locked ones (their momentum passes to the body).
     rate0 = float(np.linalg.norm(trajectory.angular_velocity(np.array([τ, τ]))[0]))
@@ -240,7 +256,148 @@ def failure_metrics(job: EnvelopeJob, k: int) -> dict[str, Any]:
     row["flips"] = len(flips)
     row["first_flip_s"] = float(flips[0] - τ) if len(flips) else math.inf
     row["first_violation_s"] = min(firsts, default=math.inf)
-    return row
+    return row, power
+
+
+def _sun(shared: SharedSurroundings, t: NDArray[np.float64], shadow: bool):
+    """The Sun's direction and the lit fraction at ``t``: outside the Earth's shadow
+    the lit fraction is 1 (only the Sun's direction is needed there, from the
+    interpolated targets)."""
+    if shadow:
+        around = shared.at(t)
+        return around.sun_direction, around.sunlit_fraction
+    return shared.targets(t).sun, 1.0
+
+
+def _power_in(shared: SharedSurroundings, solver, normals, shadow: bool):
+    """P(t) of one motion, for the integral of a torqued motion."""
+
+    def power(t):
+        t = np.asarray(t, dtype=float)
+        return power_fraction(
+            solver.attitude_quaternion, lambda x: _sun(shared, x, shadow), normals, t
+        )
+
+    return power
+
+
+# The power search takes a piece's nodes in runs of at most this many cells, the next
+# run only if the power stays above the threshold over the previous one: in the
+# Earth's shadow the lit fraction's rate makes the nodes about a second apart, and the
+# power falls to 0 in the umbra, within the first run or two of a shadow piece.
+_RUN_CELLS = 256
+
+
+def _power_search(shared: SharedSurroundings, items: list[_Power], threshold: float) -> None:
+    """``power_at_loss`` and ``power_lost_s`` of many failures at once
+    (:func:`attitude.envelope.power.first_below_many`): the first run of nodes of
+    every failure's window together (with the instant of the loss), then the next run
+    of those not yet below the threshold, and so on through the pieces of the window;
+    each round evaluates the Sun and the lit fraction for every failure's points in
+    one call, and each failure's attitude once.  Each failure's points and their order
+    are those it has alone, so its row is the same bit for bit whatever the batch.
+    A piece of more cells than :func:`~attitude.envelope.power.first_below` takes in
+    one run is searched by it, for its failure alone."""
+    stages = [_stages(item) for item in items]
+    for item in items:
+        item.row["power_lost_s"] = math.inf
+    waiting = list(range(len(items)))
+    level = 0
+    while waiting:
+        # (failure, nodes, bound on |P'|, in the shadow): the instant of the loss (its
+        # power, the lit fraction counted) first, then stage ``level`` of each window.
+        runs = [(i, np.array([items[i].τ]), 0.0, True) for i in waiting] if level == 0 else []
+        alone: list[tuple[int, float, float, float, bool]] = []
+        for i in waiting:
+            if level < len(stages[i]):
+                stage = stages[i][level]
+                (runs if isinstance(stage[0], np.ndarray) else alone).append((i, *stage))
+        if not runs and not alone:
+            break
+        found_at: dict[int, float] = {}
+        for i, a, b, lipschitz, dark in alone:
+            first = first_below(
+                _one(_batch_power(shared, items, np.array([i]), np.array([dark]))),
+                a,
+                b,
+                lipschitz,
+                threshold,
+                items[i].precision,
+            )
+            found_at[i] = math.nan if first is None else first
+        if runs:
+            owners = np.array([r[0] for r in runs], dtype=np.intp)
+            found, at_start = first_below_many(
+                _batch_power(shared, items, owners, np.array([r[3] for r in runs], dtype=bool)),
+                [r[1] for r in runs],
+                np.array([r[2] for r in runs]),
+                threshold,
+                np.array([items[r[0]].precision for r in runs]),
+            )
+            first_stage = 0
+            if level == 0:
+                first_stage = len(waiting)
+                for j, i in enumerate(waiting):
+                    items[i].row["power_at_loss"] = float(at_start[j])
+            for j in range(first_stage, len(runs)):
+                found_at[int(owners[j])] = float(found[j])
+        still = []
+        for i in waiting:
+            if i in found_at and not math.isnan(found_at[i]):
+                items[i].row["power_lost_s"] = found_at[i] - items[i].τ
+            elif level + 1 < len(stages[i]):
+                still.append(i)
+        waiting = still
+        level += 1
+
+
+def _one(f):
+    """``f`` of :func:`_batch_power` for its one piece."""
+
+    def power(t: NDArray[np.float64]) -> NDArray[np.float64]:
+        return f(np.zeros(t.size, dtype=np.intp), t)
+
+    return power
+
+
+def _stages(item: _Power) -> list[tuple]:
+    """The window's pieces as the power search takes them, in time order: runs of at
+    most _RUN_CELLS cells of a piece's nodes (nodes, bound, in the shadow), or a piece
+    searched alone (a, b, bound, in the shadow)."""
+    stages: list[tuple] = []
+    for a, b, lipschitz, dark in item.pieces:
+        nodes = first_nodes(a, b, lipschitz)
+        if nodes is None:
+            stages.append((a, b, lipschitz, dark))
+            continue
+        cells = max(nodes.size - 1, 1)
+        for start in range(0, cells, _RUN_CELLS):
+            stages.append((nodes[start : start + _RUN_CELLS + 1], lipschitz, dark))
+    return stages
+
+
+def _batch_power(shared: SharedSurroundings, items: list[_Power], owners, darks):
+    """P at times of many pieces (``owners``: each piece's failure, ``darks``: whether
+    it lies in the Earth's shadow): the Sun for all points in one call, each failure's
+    attitude at its points in one call, the incidences of all in one pass (element by
+    element: a point's value does not depend on the others)."""
+
+    def f(which: NDArray[np.intp], t: NDArray[np.float64]) -> NDArray[np.float64]:
+        whose, dark = owners[which], darks[which]
+        direction = np.empty((t.size, 3))
+        lit = np.ones(t.size)
+        if np.any(dark):
+            direction[dark], lit[dark] = _sun(shared, t[dark], True)
+        if not np.all(dark):
+            direction[~dark] = _sun(shared, t[~dark], False)[0]
+        q = np.empty((t.size, 4))
+        for i in np.unique(whose):
+            mine = whose == i
+            q[mine] = items[int(i)].quaternions(t[mine])
+        # Every failure of a task has the job's panels.
+        return lit * mean_incidence(q, items[0].normals, direction)
+
+    return f
 
 
 def _pieces(analysis, τ: float, end: float, turning: float, fraction_rate: float):
@@ -262,28 +419,40 @@ def _pieces(analysis, τ: float, end: float, turning: float, fraction_rate: floa
     return pieces
 
 
-def _power_lost(power_in, pieces, τ: float, threshold: float, precision: float) -> float:
-    """The first time the panels' power fraction reaches ``threshold`` (s after τ)."""
-    for a, b, lipschitz, shadow in pieces:
-        found = first_below(power_in(shadow), a, b, lipschitz, threshold, precision)
-        if found is not None:
-            return found - τ
-    return math.inf
-
-
 def evaluate_batch(job: EnvelopeJob, first: int, stop: int) -> BatchResult:
     """Failures ``first`` to ``stop − 1`` of ``job``, each a row (runs on a worker).  A
-    failure whose motion is refused is a row with its error; the job goes on."""
+    failure whose motion is refused is a row with its error; the job goes on.
+
+    The power searches of the batch run together (:func:`_power_search`); each row is
+    the same bit for bit as :func:`failure_metrics` gives it alone."""
     started = time.process_time()
     rows = []
+    searches: list[_Power] = []
     for k in range(first, stop):
         row: dict[str, Any] = {"failure": k, "tau_s": float(job.seconds[k])}
         try:
-            row.update(failure_metrics(job, k), status="ok", error="")
+            metrics, power = _structure(job, k)
+            row.update(metrics, status="ok", error="")
+            if power is not None:
+                power.row = row
+                searches.append(power)
         except Exception as exc:  # a refused motion is this failure's row, not the job's end
-            row.update({name: math.nan for name in job.columns}, status="failed", error=_text(exc))
+            _failed(row, job, exc)
         rows.append(row)
+    if searches:
+        try:
+            _power_search(_SURROUNDINGS[job], searches, job.threshold)
+        except Exception:  # find which failure's search is refused: each alone
+            for power in searches:
+                try:
+                    _power_search(_SURROUNDINGS[job], [power], job.threshold)
+                except Exception as exc:
+                    _failed(power.row, job, exc)
     return BatchResult(rows, time.process_time() - started)
+
+
+def _failed(row: dict[str, Any], job: EnvelopeJob, exc: BaseException) -> None:
+    row.update({name: math.nan for name in job.columns}, status="failed", error=_text(exc))
 
 
 def _text(exc: BaseException) -> str:

@@ -16,7 +16,10 @@ which counts only inside the Earth's shadow), so on a cell [t₀, t₁] of width
 P ≥ (P(t₀) + P(t₁) − L h)/2.  A cell whose bound exceeds c is settled; the others, in
 time order up to the first node where P ≤ c, are cut into 16 parts until the first is narrower
 than the precision: its left end is the first instant P can reach c (an early answer
-by at most the precision, never a late one).
+by at most the precision, never a late one).  :func:`first_below_many` runs that
+search on many runs of nodes (of many failures) at once, each round of cuts one call
+of the function for all: each run's cells, nodes and answer are those it has alone
+(the same arithmetic, element by element).
 
 :func:`integral` gives ∫P dt over a piece where P is smooth but for the kinks of
 max(cos θ, 0): Gauss–Legendre (8 points) on cells no longer than the Lipschitz
@@ -31,7 +34,14 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["first_below", "integral", "power_fraction"]
+__all__ = [
+    "first_below",
+    "first_below_many",
+    "first_nodes",
+    "integral",
+    "mean_incidence",
+    "power_fraction",
+]
 
 # The first nodes are spaced so that the Lipschitz bound sags at most this much
 # between two of them (a power fraction), and a run of nodes holds at most this many.
@@ -48,15 +58,38 @@ _MAX_HALVINGS = 20
 
 
 def power_fraction(
-    attitude: Callable, sun: Callable, panels: NDArray[np.float64], t: NDArray[np.float64]
+    quaternions: Callable, sun: Callable, panels: NDArray[np.float64], t: NDArray[np.float64]
 ) -> NDArray[np.float64]:
-    """P(t) (module notes): ``attitude(t)`` the body → ICRF Rotation, ``sun(t)`` the
-    Sun's unit direction (n, 3) and the lit fraction (n,) or 1, ``panels`` (k, 3) unit
-    normals in body axes."""
-    rotation = attitude(t)
+    """P(t) (module notes): ``quaternions(t)`` the unit attitude quaternions (n, 4),
+    scalar first, body → ICRF, ``sun(t)`` the Sun's unit direction (n, 3) and the lit
+    fraction (n,) or 1, ``panels`` (k, 3) unit normals in body axes."""
     direction, lit = sun(t)
-    cosines = np.stack([np.einsum("ij,ij->i", rotation.apply(p), direction) for p in panels])
-    return lit * np.mean(np.maximum(cosines, 0.0), axis=0)
+    return lit * mean_incidence(quaternions(t), panels, direction)
+
+
+def mean_incidence(
+    q: NDArray[np.float64], panels: NDArray[np.float64], sun: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """(1/k) Σ_p max(cos θ_p, 0) at each of n instants: each panel's unit normal b_p
+    (``panels``, (k, 3), body axes) turned to ICRF by the unit quaternions ``q`` ((n, 4),
+    w, x, y, z) as R(q) b_p, the rotation matrix written row by row, against the Sun's
+    unit directions ``sun`` (n, 3).  Element by element: an instant's value does not
+    depend on the others computed with it."""
+    w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    xx, yy, zz = x * x, y * y, z * z
+    xy, xz, yz, wx, wy, wz = x * y, x * z, y * z, w * x, w * y, w * z
+    rows = (
+        (1.0 - 2.0 * (yy + zz), 2.0 * (xy - wz), 2.0 * (xz + wy)),
+        (2.0 * (xy + wz), 1.0 - 2.0 * (xx + zz), 2.0 * (yz - wx)),
+        (2.0 * (xz - wy), 2.0 * (yz + wx), 1.0 - 2.0 * (xx + yy)),
+    )
+    total = np.zeros(q.shape[0])
+    for b in panels:
+        cosine = (rows[0][0] * b[0] + rows[0][1] * b[1] + rows[0][2] * b[2]) * sun[:, 0]
+        cosine += (rows[1][0] * b[0] + rows[1][1] * b[1] + rows[1][2] * b[2]) * sun[:, 1]
+        cosine += (rows[2][0] * b[0] + rows[2][1] * b[1] + rows[2][2] * b[2]) * sun[:, 2]
+        total += np.maximum(cosine, 0.0)
+    return total / len(panels)
 
 
 def first_below(
@@ -83,6 +116,90 @@ def first_below(
         if found is not None:
             return found
     return None
+
+
+def first_nodes(a: float, b: float, lipschitz: float) -> NDArray[np.float64] | None:
+    """The nodes :func:`first_below` starts from on [a, b] (``a`` alone for an empty
+    piece), or None for a piece of more cells than a run holds (:func:`first_below`
+    searches it in runs)."""
+    if b <= a:
+        return np.array([a])
+    step = 2.0 * _SAG / lipschitz if lipschitz > 0.0 else b - a
+    cells = max(1, math.ceil((b - a) / step))
+    return np.linspace(a, b, cells + 1) if cells <= _CHUNK_NODES else None
+
+
+def first_below_many(
+    f: Callable[[NDArray[np.intp], NDArray[np.float64]], NDArray[np.float64]],
+    nodes: list[NDArray[np.float64]],
+    lipschitz: NDArray[np.float64],
+    threshold: float,
+    precision: NDArray[np.float64],
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """:func:`first_below` on many runs of nodes at once: run i starts from
+    ``nodes[i]`` (consecutive nodes of :func:`first_nodes`, one node for a piece
+    reduced to its start), with the bound ``lipschitz[i]`` and ``precision[i]``;
+    ``f(which, t)`` gives the function of run ``which[j]`` at ``t[j]``.  Returns each
+    run's first time (NaN where f stays above ``threshold``) and f at its first node.
+    The first node counts: f there at or below the threshold answers it."""
+    count = len(nodes)
+    found = np.full(count, np.nan)
+    sizes = np.array([t.size for t in nodes], dtype=np.intp)
+    which = np.repeat(np.arange(count, dtype=np.intp), sizes)
+    values = f(which, np.concatenate(nodes)) if count else np.empty(0)
+    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.intp)
+    at_start = values[starts]
+    pid_parts, left_parts, right_parts, vl_parts, vr_parts = [], [], [], [], []
+    for i in range(count):
+        if at_start[i] <= threshold:
+            found[i] = nodes[i][0]
+        elif sizes[i] > 1:
+            t = nodes[i]
+            g = values[starts[i] : starts[i] + sizes[i]] - threshold
+            pid_parts.append(np.full(t.size - 1, i, dtype=np.intp))
+            left_parts.append(t[:-1])
+            right_parts.append(t[1:])
+            vl_parts.append(g[:-1])
+            vr_parts.append(g[1:])
+    if not pid_parts:
+        return found, at_start
+    pid = np.concatenate(pid_parts)
+    left, right = np.concatenate(left_parts), np.concatenate(right_parts)
+    v_left, v_right = np.concatenate(vl_parts), np.concatenate(vr_parts)
+    fractions = np.arange(1, _SPLIT) / _SPLIT
+    for _ in range(_MAX_HALVINGS):
+        # Each piece's cells up to its first node where f ≤ c (as _first_in).
+        index = np.arange(pid.size)
+        first_low = np.full(count, pid.size)
+        low = v_right <= 0.0
+        np.minimum.at(first_low, pid[low], index[low])
+        keep = index <= first_low[pid]
+        keep &= 0.5 * (v_left + v_right - lipschitz[pid] * (right - left)) <= 0.0
+        pid, left, right = pid[keep], left[keep], right[keep]
+        v_left, v_right = v_left[keep], v_right[keep]
+        if pid.size == 0:
+            return found, at_start
+        heads = np.flatnonzero(np.concatenate([[True], pid[1:] != pid[:-1]]))
+        narrow = heads[right[heads] - left[heads] <= precision[pid[heads]]]
+        if narrow.size:
+            found[pid[narrow]] = left[narrow]
+            done = np.zeros(count, dtype=bool)
+            done[pid[narrow]] = True
+            keep = ~done[pid]
+            pid, left, right = pid[keep], left[keep], right[keep]
+            v_left, v_right = v_left[keep], v_right[keep]
+            if pid.size == 0:
+                return found, at_start
+        inner = left[:, None] + (right - left)[:, None] * fractions[None, :]
+        v_inner = (f(np.repeat(pid, _SPLIT - 1), inner.ravel()) - threshold).reshape(inner.shape)
+        cut = np.column_stack([left, inner, right])
+        values = np.column_stack([v_left, v_inner, v_right])
+        left, right = np.ravel(cut[:, :-1]), np.ravel(cut[:, 1:])
+        v_left, v_right = np.ravel(values[:, :-1]), np.ravel(values[:, 1:])
+        pid = np.repeat(pid, _SPLIT)
+    heads = np.flatnonzero(np.concatenate([[True], pid[1:] != pid[:-1]]))
+    found[pid[heads]] = left[heads]  # cut to the limit: the earliest instant it may reach
+    return found, at_start
 
 
 def _first_in(g, t, lipschitz: float, precision: float) -> float | None:

@@ -1,0 +1,67 @@
+"""The envelope's batch of failures (their power searches run together,
+``attitude.envelope.failure._power_search``) against the same failures computed one at
+a time (``failure_metrics``, and a batch of one): the same rows, bit for bit.
+
+Each failure's points in the batched search, and their order, are those it has alone,
+and every step of the search is element by element, so the rows must be identical,
+not merely within the search's precision.  The failures span imaging, a slew, the
+station pass and charging, in and out of the Earth's shadow, with the power threshold
+reached at the loss, later in the window, and never; both wheel cases.
+"""
+
+import functools
+import math
+
+import numpy as np
+import pytest
+
+from attitude import EnvelopeSettings, Wheels, load_scenario
+from attitude.envelope.failure import evaluate_batch, failure_metrics
+from attitude.envelope.plan import make_job, plan_envelope
+
+SCENARIO = "scenarios/eo_envelope.toml"
+CASES = {
+    "locked, threshold 0.3": ("locked", 0.3, tuple(np.arange(0.0, 5400.0, 450.0))),
+    "locked, threshold 0.05": ("locked", 0.05, (300.0, 2100.0, 3000.0, 3900.0)),
+    "spinning": ("spinning", 0.3, (600.0, 3300.0)),
+}
+
+
+@functools.cache
+def _rows(name: str):
+    case, threshold, taus = CASES[name]
+    settings = EnvelopeSettings(
+        window=1200.0, times=taus, wheels=Wheels(case, [0.0, 2.0, 0.0]), power_threshold=threshold
+    )
+    job, _, _ = make_job(plan_envelope(load_scenario(SCENARIO), settings=settings))
+    return job, evaluate_batch(job, 0, job.count).rows
+
+
+def _same(a, b) -> bool:
+    if isinstance(a, float) and isinstance(b, float) and math.isnan(a) and math.isnan(b):
+        return True
+    return type(a) is type(b) and a == b
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_batch_rows_against_failures_one_at_a_time(name):
+    job, batch = _rows(name)
+    assert [row["status"] for row in batch] == ["ok"] * job.count
+    for k, together in enumerate(batch):
+        alone = evaluate_batch(job, k, k + 1).rows[0]
+        assert list(together) == list(alone)
+        differing = {
+            c: (together[c], alone[c]) for c in together if not _same(together[c], alone[c])
+        }
+        assert not differing, (k, differing)
+        metrics = failure_metrics(job, k)
+        assert all(_same(together[c], metrics[c]) for c in metrics)
+
+
+def test_the_batches_cover_every_outcome_of_the_power_search():
+    """Power at or below the threshold at the loss, reaching it later, and never:
+    else the comparison above would be idle."""
+    lost = [row["power_lost_s"] for name in CASES for row in _rows(name)[1]]
+    assert any(x == 0.0 for x in lost)
+    assert any(0.0 < x < math.inf for x in lost)
+    assert any(x == math.inf for x in lost)
