@@ -18,7 +18,14 @@ from typing import TYPE_CHECKING, Any
 from attitude.base.errors import InputError
 from attitude.envelope.failure import BatchResult, EnvelopeJob, evaluate_batch
 from attitude.envelope.plan import EnvelopePlan, make_job
-from attitude.montecarlo.cluster import check_where, check_workers, connect, task_overhead_s
+from attitude.montecarlo.cluster import (
+    batch_ranges,
+    batches_as_they_finish,
+    check_where,
+    check_workers,
+    connect,
+    task_overhead_s,
+)
 from attitude.montecarlo.simulation import choose_batch_size
 
 if TYPE_CHECKING:
@@ -70,7 +77,7 @@ def simulate(
         threads = check_workers(client)
         overhead = task_overhead_s(client)
         size = batch_size or choose_batch_size(job.count, threads, failure_s, overhead)
-        batches = [(a, min(a + size, job.count)) for a in range(0, job.count, size)]
+        batches = batch_ranges(job.count, size)
         stage(f"{job.count} failures on {threads} workers: {len(batches)} tasks of {size}")
         rows, compute_s = _run_batches(client, job, batches, progress)
     rows.sort(key=lambda row: row["failure"])
@@ -94,25 +101,13 @@ def simulate(
 def _run_batches(
     client, job: EnvelopeJob, batches: list[tuple[int, int]], progress
 ) -> tuple[list[dict[str, Any]], float]:
-    """Send the job once to every worker, one task per batch; gather as they finish."""
-    from distributed import as_completed
-
-    shared = client.scatter(job, broadcast=True, hash=False)
-    futures = client.map(
-        evaluate_batch,
-        [shared] * len(batches),
-        [a for a, _ in batches],
-        [b for _, b in batches],
-        pure=False,
-    )
-    span = {future.key: batch for future, batch in zip(futures, batches, strict=True)}
+    """Gather the tasks as they finish (:func:`batches_as_they_finish`)."""
     rows: list[dict[str, Any]] = []
     done = failed = 0
     compute_s = 0.0
     if progress:
         progress(0, job.count, 0)
-    for future, result in as_completed(futures, client.loop, with_results=True, raise_errors=False):
-        first, stop = span[future.key]
+    for first, stop, result in batches_as_they_finish(client, evaluate_batch, job, batches):
         if isinstance(result, BatchResult):
             rows += result.rows
             compute_s += result.compute_s
@@ -127,5 +122,4 @@ def _run_batches(
         done += stop - first
         if progress:
             progress(done, job.count, failed)
-        future.release()
     return rows, compute_s

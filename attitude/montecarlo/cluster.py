@@ -18,7 +18,7 @@ import socket
 import tempfile
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from typing import Any
 
 import numpy as np
@@ -28,7 +28,15 @@ from attitude.base.signals import STOPPING
 from attitude.base.version import __version__
 from attitude.outputs.folder import held_signals
 
-__all__ = ["check_where", "check_workers", "connect", "probe_scheduler", "task_overhead_s"]
+__all__ = [
+    "batch_ranges",
+    "batches_as_they_finish",
+    "check_where",
+    "check_workers",
+    "connect",
+    "probe_scheduler",
+    "task_overhead_s",
+]
 
 _CONNECT_TIMEOUT_S = 10
 # A scheduler's address: the connection within this (s), and an answer within as much.
@@ -367,3 +375,32 @@ def check_workers(client) -> int:
                 key="--scheduler",
             )
     return sum(w["nthreads"] for w in client.scheduler_info()["workers"].values())
+
+
+def batch_ranges(count: int, size: int) -> list[tuple[int, int]]:
+    """[first, stop) of each task's items, ``size`` at a time over ``count``."""
+    return [(first, min(first + size, count)) for first in range(0, count, size)]
+
+
+def batches_as_they_finish(
+    client, evaluate: Callable[..., Any], job: Any, batches: list[tuple[int, int]]
+) -> Iterator[tuple[int, int, Any]]:
+    """Send ``job`` once to every worker, one task ``evaluate(job, first, stop)`` per
+    batch, and yield ``(first, stop, result)`` as the tasks finish, each released once
+    read; ``result`` is the task's value, or the exception of a task that died (a
+    worker killed, say)."""
+    from distributed import as_completed
+
+    shared = client.scatter(job, broadcast=True, hash=False)
+    futures = client.map(
+        evaluate,
+        [shared] * len(batches),
+        [a for a, _ in batches],
+        [b for _, b in batches],
+        pure=False,
+    )
+    span = {future.key: batch for future, batch in zip(futures, batches, strict=True)}
+    for future, result in as_completed(futures, client.loop, with_results=True, raise_errors=False):
+        first, stop = span[future.key]
+        yield first, stop, result
+        future.release()

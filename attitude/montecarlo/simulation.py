@@ -48,6 +48,8 @@ from numpy.typing import NDArray
 from attitude.base.errors import InputError
 from attitude.montecarlo.cluster import (
     WORKER_MODULES,
+    batch_ranges,
+    batches_as_they_finish,
     check_where,
     check_workers,
     connect,
@@ -195,7 +197,7 @@ def simulate(
         threads = check_workers(client)
         overhead = task_overhead_s(client)
         size = batch_size or choose_batch_size(mc.samples, threads, sample_s, overhead)
-        batches = [(a, min(a + size, mc.samples)) for a in range(0, mc.samples, size)]
+        batches = batch_ranges(mc.samples, size)
         stage(
             f"{mc.samples} samples on {threads} workers: {len(batches)} tasks of {size} "
             f"(Dask: {1e3 * overhead:.2g} ms a task)"
@@ -255,26 +257,12 @@ def _run_batches(
     batches: list[tuple[int, int]],
     progress: Callable[[int, int, int], None] | None,
 ) -> _Gathered:
-    """Send the job once to every worker, one task per batch, and gather the tasks as
-    they finish (each released as soon as it is read)."""
-    from distributed import as_completed
-
-    shared = client.scatter(job, broadcast=True, hash=False)
-    futures = client.map(
-        evaluate_batch,
-        [shared] * len(batches),
-        [a for a, _ in batches],
-        [b for _, b in batches],
-        pure=False,
-    )
-    span = {future.key: batch for future, batch in zip(futures, batches, strict=True)}
+    """Gather the tasks as they finish (:func:`batches_as_they_finish`)."""
     gathered = _Gathered(Envelope(mc.vectors, mc.plan.scenario.output_seconds()))
     done = 0
     if progress:
         progress(0, mc.samples, 0)
-    finished = as_completed(futures, client.loop, with_results=True, raise_errors=False)
-    for future, result in finished:
-        first, stop = span[future.key]
+    for first, stop, result in batches_as_they_finish(client, evaluate_batch, job, batches):
         if isinstance(result, BatchResult):
             gathered.add(result)
         else:
@@ -282,5 +270,4 @@ def _run_batches(
         done += stop - first
         if progress:
             progress(done, mc.samples, gathered.failed)
-        future.release()
     return gathered
