@@ -48,7 +48,15 @@ from attitude.laws.named_laws import (
 from attitude.laws.slews import SlewLimits
 from attitude.scenario.modes import WHEEL_CASES, Wheels
 
-__all__ = ["LAW_KEYS", "LAW_NAMES", "read_law", "read_sites", "read_slew", "read_wheels"]
+__all__ = [
+    "LAW_KEYS",
+    "LAW_NAMES",
+    "read_law",
+    "read_rotation",
+    "read_sites",
+    "read_slew",
+    "read_wheels",
+]
 
 # Each law's keys besides ``name``.
 LAW_KEYS: dict[str, tuple[str, ...]] = {
@@ -154,8 +162,9 @@ def _direction(table: Any, key: str, sites: dict[str, GroundSite], required: boo
     return table.quantity(key, "dimensionless", (3,))
 
 
-def _rotation(table: Any, what: str, required: bool) -> Rotation | None:
-    """``quaternion`` (w, x, y, z) or ``matrix``, or None when neither is given."""
+def read_rotation(table: Any, what: str, required: bool) -> Rotation | None:
+    """``quaternion`` (w, x, y, z, ``what``) or ``matrix``, or None when neither is
+    given and it is not ``required``."""
     given = [key for key in ("quaternion", "matrix") if table.has(key)]
     if len(given) > 1:
         table.fail("give one of quaternion and matrix, not both")
@@ -180,10 +189,12 @@ def read_law(table: Any, sites: dict[str, GroundSite]) -> AttitudeLaw:
     name = table.choice("name", LAW_NAMES)
     table.allow("name", *LAW_KEYS[name])
     if name == "inertial":
-        return _call(table, None, InertialLaw, _rotation(table, "body -> ICRF", True))
+        return _call(table, None, InertialLaw, read_rotation(table, "body -> ICRF", True))
     if name == "orbit_frame":
         frame = table.choice("frame", ORBIT_FRAMES, default="lvlh")
-        return _call(table, None, OrbitFrameLaw, frame, _rotation(table, f"body -> {frame}", False))
+        return _call(
+            table, None, OrbitFrameLaw, frame, read_rotation(table, f"body -> {frame}", False)
+        )
     if name == "nadir":
         steering = table.choice("yaw_steering", YAW_STEERING, default="none")
         vertical = table.choice("vertical", ("geodetic", "geocentric"), default="geodetic")

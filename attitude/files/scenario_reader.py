@@ -40,7 +40,7 @@ from attitude.environment.oem import OemOrbit
 from attitude.environment.orbit import Orbit, TleOrbit
 from attitude.environment.timescales import SCALES, as_time, time_from_tt_seconds
 from attitude.files.aem_reader import attitude_from_aem
-from attitude.files.law_reader import read_law, read_sites, read_slew, read_wheels
+from attitude.files.law_reader import read_law, read_rotation, read_sites, read_slew, read_wheels
 from attitude.outputs.aem_sampling import check_tolerance
 from attitude.outputs.formats import DEFAULT_FORMATS, OutputChoice, parse_formats
 from attitude.pointing.spec import KINDS, BodyVector, PointingSpec
@@ -315,31 +315,12 @@ def _checked(
     return result
 
 
-def _attitude(table: _Table) -> Rotation | None:
-    """The attitude given as a quaternion or a matrix (in the table's frame), or None."""
-    given = [key for key in ("quaternion", "matrix") if table.has(key)]
-    if len(given) > 1:
-        table.fail("give one of quaternion and matrix, not both")
-    if not given:
-        return None
-    if given[0] == "quaternion":
-        q = table.quantity("quaternion", "dimensionless", (4,))
-        norm = float(np.linalg.norm(q))
-        if abs(norm - 1.0) > 1e-6:
-            table.fail(f"quaternion must have unit norm, got |q| = {norm:.9g}", "quaternion")
-        return Rotation.from_quat(q, scalar_first=True)
-    a = table.quantity("matrix", "dimensionless", (3, 3))
-    if np.max(np.abs(a @ a.T - np.eye(3))) > 1e-6 or np.linalg.det(a) < 0:
-        table.fail(f"matrix must be a rotation (orthonormal, det +1), got {a.tolist()}", "matrix")
-    return Rotation.from_matrix(a)
-
-
 def _attitude_in_icrf(table: _Table, orbit: Orbit | None, at) -> Rotation | None:
     """The table's attitude (quaternion or matrix, or ``aem``) as body → ICRF at the
     epoch ``at`` (a ``Time``): a ``frame = "lvlh"``/``"rtn"`` attitude is composed with
     the orbit frame there, an AEM file is read at that epoch."""
     frame = table.choice("frame", ("icrf", *ORBIT_FRAMES), default="icrf")
-    attitude = _attitude(table)
+    attitude = read_rotation(table, "body -> the table's frame", False)
     if table.has("aem"):
         if attitude is not None:
             table.fail("give one of quaternion, matrix and aem, not two")

@@ -74,11 +74,8 @@ from scipy.spatial.transform import Rotation
 
 from attitude.base.errors import InputError
 from attitude.base.vectors import basis_across
-from attitude.files.scenario_reader import (
-    ScenarioFile,
-    ScenarioFileError,
-    _attitude,  # the attitude as the file gives it
-)
+from attitude.files.law_reader import read_rotation
+from attitude.files.scenario_reader import ScenarioFile, ScenarioFileError
 from attitude.files.scenario_reader import (
     _Table as Table,  # the reader's own errors: file, key, value
 )
@@ -408,7 +405,9 @@ def _nominal_values(loaded: ScenarioFile, root: Table) -> dict[str, Any]:
     if loaded.document.get("initial_state", {}).get("frame", "icrf") != "icrf":
         # The attitude in the orbit frame the file gives it in (the reader refuses a
         # frame with an AEM file, so it is a quaternion or a matrix).
-        nominal["attitude"] = _attitude(root.table("initial_state"))
+        nominal["attitude"] = read_rotation(
+            root.table("initial_state"), "body -> the table's frame", False
+        )  # the attitude as the file gives it
     return nominal
 
 
