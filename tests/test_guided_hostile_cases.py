@@ -18,13 +18,13 @@ import math
 import re
 import warnings
 
-import astropy.units as u
 import numpy as np
 import pytest
 from astropy.time import Time
 from cli_lines import said
+from eo_orbit import EPOCH, ORBIT
 
-from attitude import InputError, KeplerianOrbit, SunLaw
+from attitude import InputError, SunLaw
 from attitude.cli.main import main
 from attitude.files.scenario_reader import load_scenario
 from attitude.report.plan import plan_run
@@ -86,18 +86,7 @@ def _replace(old: str, new: str, text: str = BASE) -> str:
 
 def _apparent_sun_at(seconds: float) -> list[float]:
     """The apparent Sun from the spacecraft at ``seconds`` (ICRF unit vector)."""
-    epoch = Time("2025-05-01T10:00:00", scale="utc")
-    orbit = KeplerianOrbit(
-        epoch,
-        7078.137 * u.km,
-        0.001,
-        98.2 * u.deg,
-        170 * u.deg,
-        0 * u.deg,
-        mean_anomaly=0 * u.deg,
-        j2=True,
-    )
-    bound = SunLaw("+z", "+x").bind(epoch, 0.0, 1800.0, orbit)
+    bound = SunLaw("+z", "+x").bind(EPOCH, 0.0, 1800.0, ORBIT)
     return bound.state([seconds]).attitude[0].apply([0.0, 0.0, 1.0]).tolist()
 
 

@@ -32,13 +32,12 @@ import astropy.units as u
 import numpy as np
 import pytest
 from aem_read_back import interpolate_as_declared, read_back, rotation_angle
-from astropy.time import Time
 from csv_read_back import read_csv
+from eo_orbit import EPOCH, ORBIT
 
 from attitude import (
     BodyVector,
     InitialState,
-    KeplerianOrbit,
     NadirLaw,
     PointingSpec,
     Scenario,
@@ -54,17 +53,6 @@ from attitude.pointing.sampling import pointing_samples
 from attitude.pointing.search import pointing_analysis, search_grid
 from attitude.scenario.modes import ControlLoss, ControlResume, ModeChange, Wheels
 
-EPOCH = Time("2025-05-01T10:00:00", scale="utc")
-ORBIT = KeplerianOrbit(
-    EPOCH,
-    7078.137 * u.km,
-    0.001,
-    98.2 * u.deg,
-    170 * u.deg,
-    0 * u.deg,
-    mean_anomaly=0 * u.deg,
-    j2=True,
-)
 LIMITS = SlewLimits(1.0 * u.deg / u.s, 0.05 * u.deg / u.s**2)
 NADIR = NadirLaw("zero_doppler")
 SUN = SunLaw("-z", "+x", "orbit_normal")

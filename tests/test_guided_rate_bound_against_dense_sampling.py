@@ -8,12 +8,11 @@ seconds), an align-and-constrain law whose directions come within 0.3° of each 
 import astropy.units as u
 import numpy as np
 import pytest
-from astropy.time import Time
+from eo_orbit import EPOCH, ORBIT
 
 from attitude import (
     AlignConstrainLaw,
     GroundSite,
-    KeplerianOrbit,
     NadirLaw,
     SlewLimits,
     SunLaw,
@@ -23,17 +22,6 @@ from attitude.laws.slews import Slew
 from attitude.solver.inertia import principal_axes
 from attitude.trajectory.guided import GuidedMotion
 
-EPOCH = Time("2025-05-01T10:00:00", scale="utc")
-ORBIT = KeplerianOrbit(
-    EPOCH,
-    7078.137 * u.km,
-    0.001,
-    98.2 * u.deg,
-    170 * u.deg,
-    0 * u.deg,
-    mean_anomaly=0 * u.deg,
-    j2=True,
-)
 INERTIA = principal_axes([820.0, 1040.0, 610.0])
 
 

@@ -16,17 +16,15 @@ and ω(τ); the free motion starts from R(τ) with the total momentum I ω(τ) +
 4. ``hand_off_states`` for many τ at once equals the hand-off at each.
 """
 
-import astropy.units as u
 import numpy as np
 import pytest
-from astropy.time import Time
+from eo_orbit import EPOCH, ORBIT
 from gyrostat_reference import angle, integrate_gyrostat
 from scipy.spatial.transform import Rotation
 
 from attitude import (
     EulerSolver,
     InitialState,
-    KeplerianOrbit,
     NadirLaw,
     Scenario,
     Spacecraft,
@@ -36,17 +34,6 @@ from attitude import (
 from attitude.scenario.modes import ControlLoss, Wheels
 from attitude.trajectory.handoff import hand_off, hand_off_at, hand_off_states
 
-EPOCH = Time("2025-05-01T10:00:00", scale="utc")
-ORBIT = KeplerianOrbit(
-    EPOCH,
-    7078.137 * u.km,
-    0.001,
-    98.2 * u.deg,
-    170 * u.deg,
-    0 * u.deg,
-    mean_anomaly=0 * u.deg,
-    j2=True,
-)
 INERTIA = np.array([820.0, 1040.0, 610.0])
 H = np.array([0.3, 2.0, -0.4])  # N m s, body axes
 LAW = NadirLaw("zero_doppler")

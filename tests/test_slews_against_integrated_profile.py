@@ -20,23 +20,12 @@ import itertools
 import astropy.units as u
 import numpy as np
 import pytest
-from astropy.time import Time
+from eo_orbit import EPOCH, ORBIT
 from scipy.integrate import solve_ivp
 
-from attitude import GroundSite, InputError, KeplerianOrbit, NadirLaw, SunLaw, TargetLaw
+from attitude import GroundSite, InputError, NadirLaw, SunLaw, TargetLaw
 from attitude.laws.slews import Slew, SlewLimits
 
-EPOCH = Time("2025-05-01T10:00:00", scale="utc")
-ORBIT = KeplerianOrbit(
-    EPOCH,
-    7078.137 * u.km,
-    0.001,
-    98.2 * u.deg,
-    170 * u.deg,
-    0 * u.deg,
-    mean_anomaly=0 * u.deg,
-    j2=True,
-)
 LIMITS = SlewLimits(1.0 * u.deg / u.s, 0.05 * u.deg / u.s**2)
 T0 = 1000.0
 
