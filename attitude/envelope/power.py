@@ -34,6 +34,8 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
+from attitude.base.quaternions import rotation_rows
+
 __all__ = [
     "first_below",
     "first_below_many",
@@ -75,14 +77,7 @@ def mean_incidence(
     w, x, y, z) as R(q) b_p, the rotation matrix written row by row, against the Sun's
     unit directions ``sun`` (n, 3).  Element by element: an instant's value does not
     depend on the others computed with it."""
-    w, x, y, z = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
-    xx, yy, zz = x * x, y * y, z * z
-    xy, xz, yz, wx, wy, wz = x * y, x * z, y * z, w * x, w * y, w * z
-    rows = (
-        (1.0 - 2.0 * (yy + zz), 2.0 * (xy - wz), 2.0 * (xz + wy)),
-        (2.0 * (xy + wz), 1.0 - 2.0 * (xx + zz), 2.0 * (yz - wx)),
-        (2.0 * (xz - wy), 2.0 * (yz + wx), 1.0 - 2.0 * (xx + yy)),
-    )
+    rows = rotation_rows(q)
     total = np.zeros(q.shape[0])
     for b in panels:
         cosine = (rows[0][0] * b[0] + rows[0][1] * b[1] + rows[0][2] * b[2]) * sun[:, 0]

@@ -61,6 +61,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
+from attitude.base.quaternions import rotation_rows
 from attitude.pointing.extrema import Extremum, Problem, least_in_brackets
 from attitude.pointing.intervals import Interval, _assemble, _refine, append_across, join
 from attitude.pointing.shared_surroundings import SharedSurroundings
@@ -431,15 +432,7 @@ class _Evaluator:
             groups = [(int(k), piece == k) for k in np.unique(piece)]
         for k, mine in groups:
             q[mine] = self.pieces[k].solver.attitude_quaternion(τ[mine])
-        w, x, y, z = q[:, 0].copy(), q[:, 1].copy(), q[:, 2].copy(), q[:, 3].copy()
-        # The rotation matrix, row by row (R v for many v without a (n, 3, 3) product).
-        xx, yy, zz = x * x, y * y, z * z
-        xy, xz, yz, wx, wy, wz = x * y, x * z, y * z, w * x, w * y, w * z
-        rows = (
-            (1.0 - 2.0 * (yy + zz), 2.0 * (xy - wz), 2.0 * (xz + wy)),
-            (2.0 * (xy + wz), 1.0 - 2.0 * (xx + zz), 2.0 * (yz - wx)),
-            (2.0 * (xz - wy), 2.0 * (yz + wx), 1.0 - 2.0 * (xx + yy)),
-        )
+        rows = rotation_rows(q)  # R v for many v without an (n, 3, 3) product
 
         def rotate(v0, v1, v2):
             return [r[0] * v0 + r[1] * v1 + r[2] * v2 for r in rows]
