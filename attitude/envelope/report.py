@@ -11,7 +11,6 @@ replaced, and a run stopped midway leaves the folder as it was.
 from __future__ import annotations
 
 import math
-import shutil
 from html import escape
 from pathlib import Path
 from typing import Any
@@ -21,7 +20,7 @@ import numpy as np
 from attitude.base.version import __version__
 from attitude.envelope.engine import EnvelopeResult
 from attitude.envelope.plan import EnvelopePlan
-from attitude.outputs.budget import DISK_SHARE, ResourceError
+from attitude.outputs.budget import check_table_fits
 from attitude.outputs.folder import claim
 from attitude.report.page import _STYLE, _figures_and_files, _table
 from attitude.report.summaries import to_json, write_json
@@ -29,25 +28,12 @@ from attitude.report.summaries import to_json, write_json
 __all__ = ["OUTPUT_NAMES", "check_folder", "summary", "worst", "write_report"]
 
 OUTPUT_NAMES = ("envelope.parquet", "envelope.csv", "summary.json", "envelope.png", "report.html")
-_CSV_BYTES_PER_CELL = 24
-_FIXED_BYTES = 5_000_000  # the plot, the page, summary.json
 
 
 def check_folder(plan: EnvelopePlan, out_dir: str | Path) -> None:
     """Refuse, before anything runs, a folder that is not ours or a disk too small."""
     claim(out_dir, OUTPUT_NAMES, dry_run=True)
-    need = plan.count * len(plan.columns) * (_CSV_BYTES_PER_CELL + 8) + _FIXED_BYTES
-    where = Path(out_dir).expanduser().absolute()
-    while not where.exists():
-        where = where.parent
-    free = shutil.disk_usage(where).free
-    if need > DISK_SHARE * free:
-        raise ResourceError(
-            f"{out_dir}: the table of {plan.count:,} failures would take about "
-            f"{need / 1e9:.3g} GB, and its disk has {free / 1e9:.3g} GB free",
-            key="--out",
-            value=str(out_dir),
-        )
+    check_table_fits(out_dir, plan.count, len(plan.columns), "failures")
 
 
 def worst(table) -> int | None:

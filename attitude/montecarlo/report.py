@@ -18,7 +18,6 @@ failed or interrupted write is left):
 from __future__ import annotations
 
 import math
-import shutil
 from html import escape
 from pathlib import Path
 from typing import Any
@@ -35,7 +34,7 @@ from attitude.montecarlo.statistics import (
     PERCENTILES,
     describe,
 )
-from attitude.outputs.budget import DISK_SHARE, ResourceError
+from attitude.outputs.budget import check_table_fits
 from attitude.outputs.folder import claim
 from attitude.pointing.spec import interval_precision
 from attitude.report.page import (  # the page of attitude run, its look
@@ -65,27 +64,15 @@ OUTPUT_NAMES = (
 )
 _MAX_LISTED_FAILURES = 100
 _MAX_HISTOGRAMS = 16
-_CSV_BYTES_PER_CELL = 24
-_FIXED_BYTES = 5_000_000  # the plots, the page, statistics.json
 
 
 def check_folder(mc: MonteCarloPlan, out_dir: str | Path) -> None:
     """Refuse, before anything runs, a folder that is not ours or a disk too small for
     the table (CSV and Parquet) and the plots."""
     claim(out_dir, OUTPUT_NAMES, dry_run=True)
-    need = mc.samples * len(mc.columns) * (_CSV_BYTES_PER_CELL + 8) + _FIXED_BYTES
-    where = Path(out_dir).expanduser().absolute()
-    while not where.exists():
-        where = where.parent
-    free = shutil.disk_usage(where).free
-    if need > DISK_SHARE * free:
-        raise ResourceError(
-            f"{out_dir}: the table of {mc.samples:,} samples would take about "
-            f"{need / 1e9:.3g} GB, and its disk has {free / 1e9:.3g} GB free: run fewer "
-            "samples or use another disk",
-            key="--out",
-            value=str(out_dir),
-        )
+    check_table_fits(
+        out_dir, mc.samples, len(mc.columns), "samples", ": run fewer samples or use another disk"
+    )
 
 
 def _numeric(table, names: list[str]) -> list[str]:

@@ -36,6 +36,7 @@ __all__ = [
     "ResourceError",
     "available_memory_bytes",
     "check_fits",
+    "check_table_fits",
     "estimate",
     "free_disk_bytes",
     "size_text",
@@ -171,6 +172,32 @@ def _existing(path: Path) -> Path:
 def free_disk_bytes(out_dir: str | Path) -> int:
     """The free space of the disk that will hold ``out_dir`` (it need not exist yet)."""
     return shutil.disk_usage(_existing(Path(out_dir))).free
+
+
+# A job's table (Monte Carlo samples, envelope failures): a cell's bytes in the CSV
+# and the Parquet file, and the plots, the page and the summary beside them.
+_TABLE_CSV_BYTES_PER_CELL = 24
+_TABLE_PARQUET_BYTES_PER_CELL = 8
+_TABLE_FIXED_BYTES = 5_000_000
+
+
+def check_table_fits(
+    out_dir: str | Path, rows: int, columns: int, noun: str, advice: str = ""
+) -> None:
+    """Refuse (:class:`ResourceError`, key ``--out``) a job's table of ``rows``
+    ``noun`` (CSV and Parquet) with its plots and page that would take more than
+    :data:`DISK_SHARE` of the free space of the disk that holds ``out_dir``;
+    ``advice`` ends the message."""
+    cell = _TABLE_CSV_BYTES_PER_CELL + _TABLE_PARQUET_BYTES_PER_CELL
+    need = rows * columns * cell + _TABLE_FIXED_BYTES
+    free = free_disk_bytes(out_dir)
+    if need > DISK_SHARE * free:
+        raise ResourceError(
+            f"{out_dir}: the table of {rows:,} {noun} would take about "
+            f"{need / 1e9:.3g} GB, and its disk has {free / 1e9:.3g} GB free{advice}",
+            key="--out",
+            value=str(out_dir),
+        )
 
 
 def size_text(count: float) -> str:
