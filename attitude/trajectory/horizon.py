@@ -48,10 +48,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from attitude.environment.timescales import offline_time
+from attitude.scenario.events import State
+from attitude.scenario.modes import ModeEvent
 from attitude.scenario.scenario import Scenario
 from attitude.scenario.torques import ScenarioTorques
+from attitude.solver.euler_solver import EulerSolver
 from attitude.torques.models import MU_EARTH_M3_S2, GravityGradient
 from attitude.torques.solver import angles_between, first_crossing
+from attitude.trajectory.averaged_kicks import departure
+from attitude.trajectory.modes import uses_laws
 from attitude.trajectory.segments import Segment, segments
 from attitude.trajectory.torqued import TorquedMotion, scenario_torque_models
 from attitude.trajectory.trajectory import Trajectory, propagate
@@ -90,6 +95,7 @@ class ValidityHorizon:
     span_s: float
     step_s: float
     order: int
+    method: str = "splitting"
 
     @property
     def within_span(self) -> bool:
@@ -120,6 +126,7 @@ class ValidityHorizon:
             "searched_s": self.searched_s,
             "torqued_run": {
                 "model": "gravity gradient (point-mass Earth)",
+                "method": self.method,
                 "order": self.order,
                 "step_s": self.step_s,
             },
@@ -156,6 +163,8 @@ def validity_horizon(trajectory: Trajectory, orbit: Any) -> ValidityHorizon:
     settings = scenario.torques
     threshold = settings.horizon_threshold
     given = settings.step is not None or settings.accuracy is not None
+    if not given and _free_only(trajectory):
+        return _by_averaged_kicks(trajectory, orbit, threshold)
     step = settings.step if settings.step is not None else _step(trajectory, orbit)
     torques = ScenarioTorques(
         gravity_gradient=_interpolated(orbit, scenario),
@@ -177,6 +186,60 @@ def validity_horizon(trajectory: Trajectory, orbit: Any) -> ValidityHorizon:
     searched = min(crossing, scenario.stop_s)
     return ValidityHorizon(
         threshold, crossing, searched, scenario.stop_s, max(steps, default=step), torques.order
+    )
+
+
+def _free_only(trajectory: Trajectory) -> bool:
+    """Whether every segment of ``trajectory`` is torque-free (no burn, no law): the
+    gravity gradient is then the run alongside's only torque."""
+    scenario = trajectory.scenario
+    return (
+        not scenario.torques.burns
+        and not uses_laws(scenario)
+        and all(isinstance(segment.solver, EulerSolver) for segment in trajectory.segments)
+    )
+
+
+def _gradient(trajectory: Trajectory, orbit: Any) -> tuple[GravityGradient, float]:
+    """The gravity gradient on ``orbit`` (interpolated) and the orbit period (s) at the
+    epoch (two-body, from the radius there)."""
+    scenario = trajectory.scenario
+    with_orbit = scenario.with_torques(
+        ScenarioTorques(gravity_gradient=_interpolated(orbit, scenario))
+    )
+    gradient = scenario_torque_models(with_orbit)[0][2]
+    if not isinstance(gradient, GravityGradient):
+        raise TypeError(f"the first torque model is the gravity gradient, got {gradient!r}")
+    radius = float(np.linalg.norm(gradient.position(np.array([0.0]))[0]))
+    return gradient, 2.0 * math.pi * math.sqrt(radius**3 / gradient.mu)
+
+
+def _by_averaged_kicks(trajectory: Trajectory, orbit: Any, threshold: float) -> ValidityHorizon:
+    """The horizon of a torque-free ``trajectory`` by averaged kicks
+    (:mod:`attitude.trajectory.averaged_kicks`), segment by segment through its events."""
+    scenario = trajectory.scenario
+    gradient, period = _gradient(trajectory, orbit)
+    largest, crossing = 0.0, math.inf
+    state: State | None = None
+    for segment in trajectory.segments:
+        if segment.event is not None:  # the event, applied to the torqued state before it
+            assert state is not None and not isinstance(segment.event, ModeEvent)
+            state = segment.event.apply(state)
+        else:
+            state = segment.state
+        assert isinstance(segment.solver, EulerSolver)
+        found = departure(
+            state, segment.start_s, segment.end_s, segment.solver, gradient, period, threshold
+        )
+        largest = max(largest, found.largest_step_s)
+        if math.isfinite(found.crossing_s):
+            crossing = found.crossing_s
+            break
+        assert found.end_state is not None
+        state = found.end_state
+    searched = min(crossing, scenario.stop_s)
+    return ValidityHorizon(
+        threshold, crossing, searched, scenario.stop_s, largest, 2, "averaged kicks"
     )
 
 
