@@ -97,6 +97,7 @@ from scipy.spatial.transform import Rotation
 
 from attitude.base.quaternions import right_matrix, rotation_rows
 from attitude.scenario.events import State
+from attitude.solver.backends import TABLE_MIN_SAMPLES
 from attitude.solver.euler_solver import EulerSolver
 from attitude.torques.models import GravityGradient
 from attitude.torques.solver import angles_between
@@ -126,6 +127,11 @@ ORBIT_FRACTION = 0.5
 ACCEPTED_LAG = 2e-4
 # The first step: this fraction of the orbit period (the kick then sets the next).
 _FIRST_ORBIT_FRACTION = 1.0 / 64.0
+# The free run is compared a step at a time for its first this many nodes (a short
+# horizon computes nothing past its crossing), then this many nodes at once (its
+# solver evaluates them from a table: attitude.solver.backends.TABLE_MIN_SAMPLES);
+# and a step at a time in a refinement.
+COMPARED_AT_ONCE = TABLE_MIN_SAMPLES
 # A refinement restarts one step back at this fraction of the step.
 _REFINE = 1.0 / 8.0
 # The finite differences of a: the momentum moved by this fraction of |m|, divided by
@@ -147,6 +153,19 @@ class Departure:
     end_state: State | None
     largest_step_s: float
     steps: int
+
+
+@dataclass(frozen=True)
+class _Step:
+    """A step made: from ``t``, of ``h``, along ``through`` (the run before its kick),
+    its nodes and the attitudes there, and its kick's size."""
+
+    t: float
+    h: float
+    through: EulerSolver
+    nodes: NDArray[np.float64]
+    qs: NDArray[np.float64]
+    size: float
 
 
 class _Body:
@@ -174,6 +193,21 @@ class _Body:
 
     def principal_quaternions(self, q_body: NDArray[np.float64]) -> NDArray[np.float64]:
         return q_body if self.identity else q_body @ self.right.T
+
+
+def _hamilton(p: NDArray[np.float64], q: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Hamilton products p ⊗ q of quaternion stacks (n, 4), scalar first."""
+    pw, px, py, pz = p[:, 0], p[:, 1], p[:, 2], p[:, 3]
+    qw, qx, qy, qz = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
+    return np.stack(
+        [
+            pw * qw - px * qx - py * qy - pz * qz,
+            pw * qx + px * qw + py * qz - pz * qy,
+            pw * qy - px * qz + py * qw + pz * qx,
+            pw * qz + px * qy - py * qx + pz * qw,
+        ],
+        axis=-1,
+    )
 
 
 def _nodes(a: float, b: float, longest: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -204,6 +238,7 @@ class _Run:
         self.body, self.gradient, self.period = body, gradient, period
         self.free, self.threshold = free, threshold
         self.largest, self.steps = 0.0, 0
+        self.compared = 0  # nodes compared so far (a step at a time until COMPARED_AT_ONCE)
 
     def _potential(self, q: NDArray, u: tuple, factor: NDArray) -> NDArray[np.float64]:
         """V (J) at principal attitudes q, for the inertial unit positions u."""
@@ -225,7 +260,6 @@ class _Run:
         longest = min(TURNS * turn, self.period / 8.0)
         t, w = _nodes(tau - 0.5 * h, tau + 0.5 * h, longest)
         qs = through.attitude_quaternion(t)
-        angles = self.free(t, qs)
         r = self.gradient.position(t)
         radius = np.sqrt(np.einsum("ij,ij->i", r, r))
         u = tuple(r[:, i] / radius for i in range(3))
@@ -246,28 +280,29 @@ class _Run:
         attitude = Rotation.from_quat(q, scalar_first=True)
         delta = G * _DIFFERENCE / max(1.0, rate * 0.5 * h) if G > 0.0 else _DIFFERENCE
         a = np.empty(3)
+        # Each moved run's attitude at the nodes, as the body rotation vector from the
+        # run through the middle (q ⊗ δ = q_moved, small angles): a column of the
+        # linearized flow, ∂θ(s)/∂m_i.
+        conjugate = qs * np.array([1.0, -1.0, -1.0, -1.0])
+        columns = []
         for i in range(3):
             moved = m.copy()
             moved[i] += delta
-            solver = EulerSolver(self.body.moments, moved, attitude, tau)
-            a[i] = (
-                float(w @ (self._potential(solver.attitude_quaternion(t), u, factor) - V)) / delta
-            )
-        m_after = m + attitude.inv().apply(dL) + np.cross(m, a)
-        after = EulerSolver(self.body.moments, m_after, attitude * Rotation.from_rotvec(a), tau)
-        if G > 0.0:
-            energy = float(m @ (m / J))
-            # The motion's frequencies change by about this fraction (|m| and T): the
-            # attitude runs off by it times the turns of the step.
-            change = (
-                abs(float(np.linalg.norm(m_after)) - G) / G
-                + 0.5 * abs(float(m_after @ (m_after / J)) - energy) / energy
-            )
-            size = float(np.linalg.norm(a)) + float(np.linalg.norm(dL)) / G + change * rate * h
-        else:
-            size = math.inf
+            q_moved = EulerSolver(self.body.moments, moved, attitude, tau).attitude_quaternion(t)
+            a[i] = float(w @ (self._potential(q_moved, u, factor) - V)) / delta
+            product = _hamilton(conjugate, q_moved)
+            columns.append(2.0 * np.copysign(1.0, product[:, :1]) * product[:, 1:] / delta)
+        kick = attitude.inv().apply(dL) + np.cross(m, a)
+        after = EulerSolver(self.body.moments, m + kick, attitude * Rotation.from_rotvec(a), tau)
+        # The kick's size: how far it moves the attitude within the step, its momentum
+        # carried by the linearized flow (the shear of a tumbler, the growth near a
+        # separatrix), its rotation a as it is.
+        moved_by = columns[0] * kick[0] + columns[1] * kick[1] + columns[2] * kick[2]
+        size = float(np.linalg.norm(a)) + float(
+            np.sqrt(np.max(np.einsum("ij,ij->i", moved_by, moved_by)))
+        )
         self.largest, self.steps = max(self.largest, h), self.steps + 1
-        return t, angles, after, size
+        return t, qs, after, size
 
     def run(
         self,
@@ -276,36 +311,60 @@ class _Run:
         end: float,
         cap: float = math.inf,
         until: float = -math.inf,
-    ):
+    ) -> tuple[float, EulerSolver | None]:
         """From ``through`` at ``start`` to ``end``: the crossing (or inf) and the run
         after the last kick (None after a crossing).  Steps are at most ``cap`` before
-        ``until`` (a refinement: past it, they grow again)."""
+        ``until`` (a refinement: past it, they grow again, and are compared a step at a
+        time before it)."""
         t, h_next = start, min(cap, self.period * _FIRST_ORBIT_FRACTION)
-        before: tuple[float, EulerSolver, float] | None = None
+        target = min(KICK_FRACTION * self.threshold, LARGEST_KICK)
+        earlier: _Step | None = None  # the last step compared
+        pending: list[_Step] = []  # steps made, not yet compared
         while t < end:
             h = min(h_next, end - t)
             if end - (t + h) < 0.25 * h:  # no sliver of a step at the end
                 h = end - t
-            nodes, angles, after, size = self.kick(through, t + 0.5 * h, h)
-            target = min(KICK_FRACTION * self.threshold, LARGEST_KICK)
+            nodes, qs, after, size = self.kick(through, t + 0.5 * h, h)
             while size > 2.0 * target and h > _SHORTEST_STEP:  # too large a kick: shorter
                 h *= max(0.1, 0.9 * target / size)
-                nodes, angles, after, size = self.kick(through, t + 0.5 * h, h)
-            past = np.flatnonzero(angles >= self.threshold)
-            if past.size:
-                if size <= ACCEPTED_LAG * self.threshold or h <= _SHORTEST_STEP:
-                    k = int(past[0])
-                    low = float(nodes[k - 1]) if k > 0 else t
-                    return self._bisect(through, low, float(nodes[k])), None
-                back_t, back_through, back_h = before or (t, through, h)
-                return self.run(back_t, back_through, end, _REFINE * max(back_h, h), t + h)
-            before = (t, through, h)
-            growth = target / max(size, 1e-300)
-            h_next = min(self.period * ORBIT_FRACTION, 2.0 * h, h * growth)
-            if t + h < until:
-                h_next = min(h_next, cap)
+                nodes, qs, after, size = self.kick(through, t + 0.5 * h, h)
+            pending.append(_Step(t, h, through, nodes, qs, size))
             t, through = t + h, after
+            waiting = sum(p.nodes.size for p in pending)
+            if t < end and t >= until and self.compared >= COMPARED_AT_ONCE > waiting:
+                h_next = min(self.period * ORBIT_FRACTION, 2.0 * h, h * target / max(size, 1e-300))
+                continue
+            found = self._compare(pending, earlier, end)
+            if found is not None:
+                return found, None
+            earlier, pending = pending[-1], []
+            h_next = min(self.period * ORBIT_FRACTION, 2.0 * h, h * target / max(size, 1e-300))
+            if t < until:
+                h_next = min(h_next, cap)
         return math.inf, through
+
+    def _compare(self, pending: list[_Step], earlier: _Step | None, end: float) -> float | None:
+        """The crossing within the steps ``pending`` (``earlier``: the step before
+        them), compared with the free run in one call, or None: from a step whose kick
+        is small enough, bisected; from any other, searched again at an eighth of the
+        step from the step before it."""
+        nodes = np.concatenate([p.nodes for p in pending])
+        self.compared += nodes.size
+        angles = self.free(nodes, np.concatenate([p.qs for p in pending]))
+        past = np.flatnonzero(angles >= self.threshold)
+        if not past.size:
+            return None
+        first = int(past[0])
+        k = int(np.searchsorted(np.cumsum([p.nodes.size for p in pending]), first, "right"))
+        step = pending[k]
+        if step.size <= ACCEPTED_LAG * self.threshold or step.h <= _SHORTEST_STEP:
+            low = float(nodes[first - 1]) if first > 0 and nodes[first - 1] >= step.t else step.t
+            return self._bisect(step.through, low, float(nodes[first]))
+        back = pending[k - 1] if k > 0 else earlier or step
+        crossing, _ = self.run(
+            back.t, back.through, end, _REFINE * max(back.h, step.h), step.t + step.h
+        )
+        return crossing
 
     def _bisect(self, through: EulerSolver, low: float, high: float) -> float:
         """The first crossing in (low, high] on ``through``, to a millisecond."""
