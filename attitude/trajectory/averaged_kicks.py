@@ -41,48 +41,62 @@ changes by it, exactly to first order); a is what a plain impulse ΔL at the mid
 misses: a kick at time s moves the attitude by what the changed momentum turns it
 through until the middle (the shear of the spin phase by the changed energy and |m|,
 and the nutation that a momentum given at once excites but a torque spread over many
-turns does not).  Without a, the spinner of ``tests/test_validity_horizon_against_dop853.py``
-crosses 1° 90 % early: each impulse excites a nutation the torque never does.
+turns does not).  Without a, the 0.65 rad/s spinner of
+``tests/test_validity_horizon_against_dop853.py`` (on a circular orbit) crosses 1° at
+6 to 16 % of its horizon, at steps of 50 to 1000 s: each impulse excites a nutation
+the torque never does.
 
 The free flow handles the spin (every φ_s is exact, at any s), so H is not limited by
-it; the error of the map is of second order in the perturbation: over a step, O(ε²)
-with ε = |a| + |ΔL|/|m| the size of the kick, and over a run O(ε) relative to the
-effect being measured.  The step is set from the kick: each step's ε is held to
-:data:`KICK_FRACTION` of the threshold, and a step is at most :data:`ORBIT_FRACTION`
-of the orbit period (and at most twice the last).
+it.  The map's error is of second order in the perturbation: O(ε²) a step, ε the
+size of the kick, and O(ε) over a run relative to the effect measured.  The size that
+sets the step is how far the kick moves the attitude within the step: |a|, plus the
+kick's momentum carried by the linearized free flow to every node (the finite
+differences below give its columns), which holds the shear of a tumbler's phase
+(the frequencies change with |m| and T) and the growth of the linearized flow near a
+separatrix.  It is held to :data:`LARGEST_KICK` (and to :data:`KICK_FRACTION` of the
+threshold): a step whose kick exceeds twice that is made again shorter, the next
+step is scaled to it (at most twice the last), and a step is at most
+:data:`ORBIT_FRACTION` of the orbit period.
 
 **Evaluation.**  Every integral over a step is a Gauss–Legendre rule
 (:data:`NODES` nodes on each sub-interval of at most :data:`TURNS` fastest turns of
 the body, 2π/√(2T/I_min), and of an eighth of the orbit period): the attitudes at all
 the nodes come from one vectorized call of the exact solver through the middle state,
 the orbit's positions from one call of its (interpolated) position.  The integrand of
-V̄ holds the spin's first and second harmonics; eight nodes on two turns integrate
-them to about 1e-5.  a is a derivative of V̄: by finite differences with three more
-exact solvers from the middle state, its momentum moved by 1e-6 of |m| (less when the
-step is many turns long) along each axis, at the same nodes (the second-order
-remainder of a difference is below 1e-5 of a).
+V̄ holds the spin's first and second harmonics, at four nodes a turn: against eight a
+turn, the crossings of the hostile cases move by 2e-4 of themselves or less, except
+near the separatrix, where the flip is sharp (3.6e-3, most of that case's error).  a
+is a derivative of V̄: by finite differences with three more exact solvers from the
+middle state, its momentum moved by 1e-6 of |m| (less when the step is many turns
+long) along each axis, at the same nodes (a tenth of that moves the crossings by
+1.3e-5 of themselves or less).
 
 **The comparison.**  At each node, the attitude of the run through the middle state
 (every earlier kick included, not yet this step's) is compared with the scenario's
-own (the torque-free one): the angle between them.  Near the crossing, that run lags
-the torqued one by at most one kick, so a crossing found in a step whose kick is
-larger than :data:`ACCEPTED_LAG` of the threshold is searched again from the step
-before, at an eighth of the step, until it is not; the first node at or past the
-threshold, after the last below it, is then refined by bisection to a millisecond on
-the run through that step's middle.
+own (the torque-free one): the angle between them, a step at a time for the first
+:data:`COMPARED_AT_ONCE` nodes, then that many at once (the free run's solver then
+evaluates them from its table).  Near the crossing, that run lags the torqued one by
+at most the step's kick, so a crossing found in a step whose kick is larger than
+:data:`ACCEPTED_LAG` of the threshold is searched again from the step before, at an
+eighth of the step, until it is not; the first node at or past the threshold, after
+the last below it, is then refined by bisection to a millisecond on the run through
+that step's middle.
 
-**Accuracy** (stated by the horizon: 1 %).  Against DOP853
+**Accuracy** (stated by the horizon: 1 %).  Against DOP853 at rtol 1e-12
 (``tests/test_validity_horizon_against_dop853.py``,
-``tests/test_validity_horizon_hostile_cases_against_dop853.py``) the crossings of a
-tumbler, a spinner, a body near the separatrix, a slow body turning at the orbit rate,
-a fast spinner and a crossing minutes after the start come out within 2e-3 of
-themselves.  What limits it: the quadrature of the spin's harmonics (4 nodes a
-turn), the kick's second-order remainder (the step), and, near the crossing, the
-lag of the compared run (bounded by the refinement).  Not covered: a step whose
-kick is not small (a torque that turns the momentum by more than the threshold
-within a small fraction of a turn): the refinement then reaches steps of a
-millisecond, with a kick still not small, and the crossing is the first node of that
-search past the threshold.
+``tests/test_validity_horizon_hostile_cases_against_dop853.py``), the crossing comes
+4.1e-3 of itself early for a body near the separatrix (spinning about its
+intermediate axis), within 2e-4 for a slow body turning at the orbit rate, spinners
+at 3 and 4 rad/s, a crossing 2.5 minutes after the start under a huge torque, an
+impulse on a full tensor, and a tumbler on an eccentric orbit (2e-6); the
+Envisat-like tumbler of ``scenarios/tumbling_defunct_satellite.toml`` crosses 8.8e-4
+of itself before the splitting.  What limits it: the kick's second-order remainder
+(the step), the quadrature of the spin's harmonics (four nodes a turn: near a
+separatrix most), and, near the crossing, the lag of the compared run (bounded by the
+refinement).  Not covered: a kick that is not small even over a millisecond (a torque
+that turns the momentum by more than the threshold within a millisecond): the
+refinement stops there, and the crossing is the first node of that search past the
+threshold.
 """
 
 from __future__ import annotations
@@ -116,13 +130,13 @@ __all__ = [
 # turns of the body (module docstring, "Evaluation").
 NODES = 8
 TURNS = 2.0
-# A step's kick (|a| + |ΔL|/|m|, rad) is held to this fraction of the threshold, the
-# step to this fraction of the orbit period (module docstring).
+# A step's kick (how far it moves the attitude within the step, rad) is held to this
+# fraction of the threshold and to LARGEST_KICK, the step to this fraction of the
+# orbit period (module docstring).
 KICK_FRACTION = 0.1
 LARGEST_KICK = 1e-3
 ORBIT_FRACTION = 0.5
-# A crossing is accepted from a step whose lag (its kick, with what the momentum it
-# gives turns the attitude through in half a step) is below this fraction of the
+# A crossing is accepted from a step whose kick is below this fraction of the
 # threshold: the comparison then lags the torqued run by at most that angle.
 ACCEPTED_LAG = 2e-4
 # The first step: this fraction of the orbit period (the kick then sets the next).

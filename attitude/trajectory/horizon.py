@@ -4,37 +4,48 @@ A scenario with an orbit whose ``[torques]`` leave out the gravity gradient (a
 torque-free one, or one with burns alone) neglects the gravity-gradient torque of the
 Earth.  Its validity horizon is the time until that neglected torque would have moved
 the attitude by a threshold (1° by default, ``[torques] horizon_threshold``): the same
-scenario (the same events, the same burns) is propagated under gravity gradient too
-(``attitude.trajectory.torqued``) alongside the scenario's own trajectory, their
-attitudes are compared at every step of that run, over the whole span, a block of
-steps at a time, and the first crossing is refined by bisection to a millisecond
-(:func:`attitude.torques.solver.first_crossing`, which ``departure_time`` uses for one
-solver); the run goes no further than the block of the crossing.  An attitude reset
-puts both on the same attitude again; the horizon is the first crossing.  With burns,
-both runs are splittings at the scenario's step (or accuracy): the comparison also
-holds their difference in splitting error, at most the sum of their errors, which the
-summary states beside it.
+scenario (the same events, the same burns) is propagated under gravity gradient too,
+alongside the scenario's own trajectory, their attitudes are compared over the whole
+span, and the first crossing is refined by bisection to a millisecond; the run
+alongside goes no further than the crossing.  An attitude reset puts both on the same
+attitude again; the horizon is the first crossing.
 
 The accuracy is that of an estimate, stated with it: :data:`HORIZON_RELATIVE_ACCURACY`
 (1 %) of the horizon.  The horizon says when the torque-free answer has expired by a
 threshold that is itself a choice (1°): 1 % of a day is 14 minutes, far finer than a
-user reads "valid until then", and it lets the run alongside take a third fewer
-steps.  That run uses the scenario's ``[torques]`` step or accuracy and order when it
-states one; otherwise order 4 at a step of three tenths of the body's fastest turn (at
-the bound √(2T/I_min) of its rate), at most a fortieth of the orbit period.  What
-limits the estimate is the sampling: the angle between the runs wobbles within a turn,
-and a peak between two steps can cross first.  Against DOP853
-(``tests/test_validity_horizon_against_dop853.py``), the spinner's crossing after
-31 550 s comes out 4.6e-4 of the horizon late at this step (6e-4 at a fifth of a turn,
-1.2e-3 at half a turn); the tumbler's is the same to 1e-7 of it.  Half a turn is not
-enough everywhere: the tumbler of
+user reads "valid until then".
+
+**Torque-free scenarios** (no burn, no law, no ``[torques]`` step or accuracy), the
+default: the run alongside is :mod:`attitude.trajectory.averaged_kicks`, steps set by
+the size of the perturbation's kick (up to half an orbit), each kick the torque and
+the gradient of the potential averaged along the exact free flow, the events applied
+to its state as to the scenario's; the attitudes are compared at its quadrature nodes
+(four a turn).  Against DOP853 (``tests/test_validity_horizon_against_dop853.py``,
+``tests/test_validity_horizon_hostile_cases_against_dop853.py``) its crossings come
+within 4.1e-3 of themselves near a separatrix, within 2e-4 elsewhere (a tumbler,
+fast spinners, a slow body, a huge torque, an impulse on a full tensor).  The one-day
+spinner of ``benchmarks.horizon_share`` costs about 0.08 s of CPU in process, without
+numba.
+
+**Burns, laws, or a stated step**: the run alongside is the splitting
+(``attitude.trajectory.torqued``) at the scenario's ``[torques]`` step or accuracy and
+order when it states one; otherwise order 4 at a step of three tenths of the body's
+fastest turn (at the bound √(2T/I_min) of its rate), at most a fortieth of the orbit
+period; the attitudes are compared at every step, a block of steps at a time
+(:func:`attitude.torques.solver.first_crossing` refines).  A segment under a law has
+the law's attitude in both runs.  With burns, both runs are splittings at the
+scenario's step (or accuracy): the comparison also holds their difference in
+splitting error, at most the sum of their errors, which the summary states beside
+it.  What limits that estimate is the sampling: the angle between the runs wobbles
+within a turn, and a peak between two steps can cross first (the tumbler of
 ``tests/test_scenario_torques_against_torque_free_and_momentum_laws.py`` with a 5°
-threshold comes out 6.8 % late at that step, within 0.01 s at this one.  The orbit's position is
-interpolated (cubic Hermite, checked against the orbit within
-:data:`ORBIT_TOLERANCE_M`), and with gravity gradient as its only torque the run
-takes the compiled splitting loop (:mod:`attitude.torques.compiled_steps`) past its
-first :data:`attitude.torques.solver.PYTHON_LOOP_STEPS` steps: the whole day of a
-5 rpm spinner (28 500 steps) costs about 0.8 s of CPU, numba's start included.
+threshold comes out 6.8 % late at half a turn, within 0.01 s at three tenths).  With
+gravity gradient as its only torque that run takes the compiled splitting loop
+(:mod:`attitude.torques.compiled_steps`) past its first
+:data:`attitude.torques.solver.PYTHON_LOOP_STEPS` steps.
+
+Both runs read the orbit's position interpolated (cubic Hermite, checked against the
+orbit within :data:`ORBIT_TOLERANCE_M`).
 """
 
 from __future__ import annotations
