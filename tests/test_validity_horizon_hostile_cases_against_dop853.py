@@ -9,8 +9,9 @@ the horizon's stated accuracy, 1 % (``HORIZON_RELATIVE_ACCURACY``).
 - a body near the separatrix (spinning about its intermediate axis: the Dzhanibekov
   flip), where the linearized flow grows and the kick's effect with it;
 - a slow body turning at about the orbit rate (one sub-interval an eighth of an orbit);
-- a fast spinner, 3 rad/s (hundreds of turns in a step), and one about its minor axis
-  at 4 rad/s;
+- a fast spinner, 3 rad/s (hundreds of turns in a step), one about its minor axis at
+  4 rad/s, and the oblate 5 rpm spinner of ``benchmarks.horizon_share`` (its
+  sub-intervals the longest, its fastest turn nearest the bound that sets them);
 - a huge torque relative to the momentum: the crossing after two and a half minutes;
 - an off-axis angular impulse on a body given by a full inertia tensor (the events
   and the principal axes of the run alongside);
@@ -49,6 +50,7 @@ CASES = {
     "separatrix": (MOMENTS, [0.001, 0.1, 0.001], 1.0, 400.0, 0.2),
     "slow, about the orbit rate": (MOMENTS, [0.0002, 0.0011, 0.0003], 1.0, 400.0, 1.0),
     "fast spinner, 3 rad/s": (MOMENTS, [0.05, 0.05, 3.0], 0.002, 160.0, 0.02),
+    "oblate spinner, 5 rpm": ([850.0, 900.0, 1200.0], [0.02, 0.01, 0.52], 0.01, 300.0, 0.1),
     "minor axis, 4 rad/s": (MOMENTS, [4.0, 0.05, 0.05], 0.002, 100.0, 0.01),
     "huge torque, minutes": (MOMENTS, [0.003, 0.004, 0.005], 1.0, 400.0, 0.1),
 }
