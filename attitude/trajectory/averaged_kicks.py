@@ -134,8 +134,10 @@ TURNS = 2.0
 # fraction of the threshold and to LARGEST_KICK, the step to this fraction of the
 # orbit period (module docstring).
 KICK_FRACTION = 0.1
-LARGEST_KICK = 1e-3
+LARGEST_KICK = 5e-4
 ORBIT_FRACTION = 0.5
+# A step is at most this many times the last.
+GROWTH = 2.0
 # A crossing is accepted from a step whose kick is below this fraction of the
 # threshold: the comparison then lags the torqued run by at most that angle.
 ACCEPTED_LAG = 2e-4
@@ -224,6 +226,16 @@ def _hamilton(p: NDArray[np.float64], q: NDArray[np.float64]) -> NDArray[np.floa
     )
 
 
+def _basis(m: NDArray[np.float64]) -> list[NDArray[np.float64]]:
+    """An orthonormal basis whose first vector is along m (any, for m = 0)."""
+    G = float(np.linalg.norm(m))
+    first = m / G if G > 0.0 else np.array([1.0, 0.0, 0.0])
+    trial = np.eye(3)[int(np.argmin(np.abs(first)))]
+    second = np.cross(first, trial)
+    second /= np.linalg.norm(second)
+    return [first, second, np.cross(first, second)]
+
+
 def _nodes(a: float, b: float, longest: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     """Gauss–Legendre nodes and weights on [a, b], NODES on each of the fewest equal
     sub-intervals no longer than ``longest``."""
@@ -293,25 +305,34 @@ class _Run:
         )
         attitude = Rotation.from_quat(q, scalar_first=True)
         delta = G * _DIFFERENCE / max(1.0, rate * 0.5 * h) if G > 0.0 else _DIFFERENCE
-        a = np.empty(3)
-        # Each moved run's attitude at the nodes, as the body rotation vector from the
-        # run through the middle (q ⊗ δ = q_moved, small angles): a column of the
-        # linearized flow, ∂θ(s)/∂m_i.
+        basis = _basis(m)
+        # Along m the moved run is the same run faster (Euler's equations are quadratic
+        # in m): m(1 + ε) turns the attitude at s by ε (s − τ) ω(s), and V by
+        # −Γ·ε (s − τ) ω(s).  Across m, finite differences: each moved run's attitude at
+        # the nodes as the body rotation vector from the run through the middle
+        # (q ⊗ δ = q_moved, small angles).  Both give a column of the linearized
+        # flow, ∂θ(s)/∂m along the basis vector, and a's component along it.
+        omega = through.angular_momentum(t) / J
+        along = omega * ((t - tau) / G)[:, None] if G > 0.0 else np.zeros_like(omega)
+        torque = (2.0 * factor)[:, None] * np.stack(g, axis=-1)
+        components = [-float(w @ np.einsum("ij,ij->i", torque, along))]
+        columns = [along]
         conjugate = qs * np.array([1.0, -1.0, -1.0, -1.0])
-        columns = []
-        for i in range(3):
-            moved = m.copy()
-            moved[i] += delta
-            q_moved = EulerSolver(self.body.moments, moved, attitude, tau).attitude_quaternion(t)
-            a[i] = float(w @ (self._potential(q_moved, u, factor) - V)) / delta
+        for e in basis[1:]:
+            q_moved = EulerSolver(
+                self.body.moments, m + delta * e, attitude, tau
+            ).attitude_quaternion(t)
+            components.append(float(w @ (self._potential(q_moved, u, factor) - V)) / delta)
             product = _hamilton(conjugate, q_moved)
             columns.append(2.0 * np.copysign(1.0, product[:, :1]) * product[:, 1:] / delta)
+        a = components[0] * basis[0] + components[1] * basis[1] + components[2] * basis[2]
         kick = attitude.inv().apply(dL) + np.cross(m, a)
         after = EulerSolver(self.body.moments, m + kick, attitude * Rotation.from_rotvec(a), tau)
         # The kick's size: how far it moves the attitude within the step, its momentum
         # carried by the linearized flow (the shear of a tumbler, the growth near a
         # separatrix), its rotation a as it is.
-        moved_by = columns[0] * kick[0] + columns[1] * kick[1] + columns[2] * kick[2]
+        along_basis = [float(kick @ e) for e in basis]
+        moved_by = sum(column * c for column, c in zip(columns, along_basis, strict=True))
         size = float(np.linalg.norm(a)) + float(
             np.sqrt(np.max(np.einsum("ij,ij->i", moved_by, moved_by)))
         )
@@ -346,16 +367,23 @@ class _Run:
             t, through = t + h, after
             waiting = sum(p.nodes.size for p in pending)
             if t < end and t >= until and self.compared >= COMPARED_AT_ONCE > waiting:
-                h_next = min(self.period * ORBIT_FRACTION, 2.0 * h, h * target / max(size, 1e-300))
+                h_next = self._next(h, size, target)
                 continue
             found = self._compare(pending, earlier, end)
             if found is not None:
                 return found, None
             earlier, pending = pending[-1], []
-            h_next = min(self.period * ORBIT_FRACTION, 2.0 * h, h * target / max(size, 1e-300))
+            h_next = self._next(h, size, target)
             if t < until:
                 h_next = min(h_next, cap)
         return math.inf, through
+
+    def _next(self, h: float, size: float, target: float) -> float:
+        """The step after one of ``h`` whose kick had ``size``: scaled to ``target`` as
+        if the size went as the step's square (it grows between that and the step
+        itself), at most GROWTH times h and ORBIT_FRACTION of the orbit."""
+        scale = math.sqrt(target / max(size, 1e-300))
+        return min(self.period * ORBIT_FRACTION, GROWTH * h, h * scale)
 
     def _compare(self, pending: list[_Step], earlier: _Step | None, end: float) -> float | None:
         """The crossing within the steps ``pending`` (``earlier``: the step before
