@@ -74,7 +74,7 @@ long) along each axis, at the same nodes (a tenth of that moves the crossings by
 **The comparison.**  At each node, the attitude of the run through the middle state
 (every earlier kick included, not yet this step's) is compared with the scenario's
 own (the torque-free one): the angle between them, a step at a time for the first
-:data:`COMPARED_AT_ONCE` nodes, then that many at once (the free run's solver then
+:data:`ONE_STEP_AT_A_TIME` nodes, then :data:`COMPARED_AT_ONCE` at once (the free run's solver then
 evaluates them from its table).  Near the crossing, that run lags the torqued one by
 at most the step's kick, so a crossing found in a step whose kick is larger than
 :data:`ACCEPTED_LAG` of the threshold is searched again from the step before, at an
@@ -143,11 +143,12 @@ GROWTH = 2.0
 ACCEPTED_LAG = 2e-4
 # The first step: this fraction of the orbit period (the kick then sets the next).
 _FIRST_ORBIT_FRACTION = 1.0 / 64.0
-# The free run is compared a step at a time for its first this many nodes (a short
-# horizon computes nothing past its crossing), then this many nodes at once (its
-# solver evaluates them from a table: attitude.solver.backends.TABLE_MIN_SAMPLES);
+# The free run is compared a step at a time for its first ONE_STEP_AT_A_TIME nodes (a
+# short horizon computes little past its crossing), then COMPARED_AT_ONCE nodes at once
+# (its solver evaluates them from a table: attitude.solver.backends.TABLE_MIN_SAMPLES);
 # and a step at a time in a refinement.
 COMPARED_AT_ONCE = TABLE_MIN_SAMPLES
+ONE_STEP_AT_A_TIME = 2048
 # A refinement restarts one step back at this fraction of the step.
 _REFINE = 1.0 / 8.0
 # The finite differences of a: the momentum moved by this fraction of |m|, divided by
@@ -226,6 +227,11 @@ def _hamilton(p: NDArray[np.float64], q: NDArray[np.float64]) -> NDArray[np.floa
     )
 
 
+def _sinc_half(angle: float) -> float:
+    """sin(angle/2)/angle, the factor of a rotation vector in its quaternion."""
+    return 0.5 - angle * angle / 48.0 if angle < 1e-4 else math.sin(0.5 * angle) / angle
+
+
 def _basis(m: NDArray[np.float64]) -> list[NDArray[np.float64]]:
     """An orthonormal basis whose first vector is along m (any, for m = 0)."""
     G = float(np.linalg.norm(m))
@@ -264,7 +270,7 @@ class _Run:
         self.body, self.gradient, self.period = body, gradient, period
         self.free, self.threshold = free, threshold
         self.largest, self.steps = 0.0, 0
-        self.compared = 0  # nodes compared so far (a step at a time until COMPARED_AT_ONCE)
+        self.compared = 0  # nodes compared so far
 
     def _potential(self, q: NDArray, u: tuple, factor: NDArray) -> NDArray[np.float64]:
         """V (J) at principal attitudes q, for the inertial unit positions u."""
@@ -326,8 +332,11 @@ class _Run:
             product = _hamilton(conjugate, q_moved)
             columns.append(2.0 * np.copysign(1.0, product[:, :1]) * product[:, 1:] / delta)
         a = components[0] * basis[0] + components[1] * basis[1] + components[2] * basis[2]
-        kick = attitude.inv().apply(dL) + np.cross(m, a)
-        after = EulerSolver(self.body.moments, m + kick, attitude * Rotation.from_rotvec(a), tau)
+        kick = attitude.apply(dL, inverse=True) + np.cross(m, a)
+        angle = float(np.linalg.norm(a))
+        turn = np.array([math.cos(0.5 * angle), *(_sinc_half(angle) * a)])  # exp([a]×)
+        turned = Rotation.from_quat(_hamilton(q[None], turn[None])[0], scalar_first=True)
+        after = EulerSolver(self.body.moments, m + kick, turned, tau)
         # The kick's size: how far it moves the attitude within the step, its momentum
         # carried by the linearized flow (the shear of a tumbler, the growth near a
         # separatrix), its rotation a as it is.
@@ -366,7 +375,12 @@ class _Run:
             pending.append(_Step(t, h, through, nodes, qs, size))
             t, through = t + h, after
             waiting = sum(p.nodes.size for p in pending)
-            if t < end and t >= until and self.compared >= COMPARED_AT_ONCE > waiting:
+            if (
+                t < end
+                and t >= until
+                and self.compared >= ONE_STEP_AT_A_TIME
+                and waiting < COMPARED_AT_ONCE
+            ):
                 h_next = self._next(h, size, target)
                 continue
             found = self._compare(pending, earlier, end)
