@@ -334,8 +334,8 @@ class _Run:
         a = components[0] * basis[0] + components[1] * basis[1] + components[2] * basis[2]
         kick = attitude.apply(dL, inverse=True) + np.cross(m, a)
         angle = float(np.linalg.norm(a))
-        turn = np.array([math.cos(0.5 * angle), *(_sinc_half(angle) * a)])  # exp([a]×)
-        turned = Rotation.from_quat(_hamilton(q[None], turn[None])[0], scalar_first=True)
+        exp_a = np.array([math.cos(0.5 * angle), *(_sinc_half(angle) * a)])  # exp([a]×)
+        turned = Rotation.from_quat(_hamilton(q[None], exp_a[None])[0], scalar_first=True)
         after = EulerSolver(self.body.moments, m + kick, turned, tau)
         # The kick's size: how far it moves the attitude within the step, its momentum
         # carried by the linearized flow (the shear of a tumbler, the growth near a
