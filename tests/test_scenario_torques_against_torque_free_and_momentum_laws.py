@@ -47,9 +47,8 @@ I_TUMBLER = np.array([100.0, 200.0, 300.0])
 W_TUMBLER = np.array([0.05, 0.02, 0.03])
 R0 = Rotation.from_euler("ZYX", [10, 20, 30], degrees=True)
 # The horizon by averaged kicks against the splitting of departure_time: within a tenth
-# of its stated accuracy (1 %).  Their own error here is 3e-4 of it at 5° (the tumbler
-# turns once in 100 s), 4e-6 at 1°; the splitting alongside (departure_time's method)
-# agreed to 0.01 s.
+# of its stated accuracy (1 %).  Their own error here is 3e-5 of it at 1° and at 5°;
+# the splitting alongside (departure_time's method) agreed to 0.01 s.
 KICKS_AGREE = 1e-3
 
 

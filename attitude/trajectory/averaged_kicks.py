@@ -56,45 +56,54 @@ differences below give its columns), which holds the shear of a tumbler's phase
 separatrix.  It is held to :data:`LARGEST_KICK` (and to :data:`KICK_FRACTION` of the
 threshold): a step whose kick exceeds twice that is made again shorter, the next
 step is scaled to it (at most twice the last), and a step is at most
-:data:`ORBIT_FRACTION` of the orbit period.
+:data:`ORBIT_FRACTION` of the orbit period.  A long run is what sets the bound: the
+kicks' second-order remainder changes |m| and T, and the spin phase turns that into
+an angle growing with the time left; the 0.65 rad/s spinner of
+``tests/test_validity_horizon_against_dop853.py`` (its crossing after 31 550 s, the
+angle growing by 0.035° in 1000 s there) crosses 1.6 % early with kicks of 1e-3 rad,
+0.7 % at 5e-4.
 
-**Evaluation.**  Every integral over a step is a Gauss–Legendre rule
-(:data:`NODES` nodes on each sub-interval of at most :data:`TURNS` fastest turns of
-the body, 2π/√(2T/I_min), and of an eighth of the orbit period): the attitudes at all
-the nodes come from one vectorized call of the exact solver through the middle state,
-the orbit's positions from one call of its (interpolated) position.  The integrand of
-V̄ holds the spin's first and second harmonics, at four nodes a turn: against eight a
-turn, the crossings of the hostile cases move by 2e-4 of themselves or less, except
-near the separatrix, where the flip is sharp (3.6e-3, most of that case's error).  a
-is a derivative of V̄: by finite differences with three more exact solvers from the
-middle state, its momentum moved by 1e-6 of |m| (less when the step is many turns
-long) along each axis, at the same nodes (a tenth of that moves the crossings by
-1.3e-5 of themselves or less).
+**Evaluation.**  Every integral over a step is a Gauss–Legendre rule (:data:`NODES`
+nodes on each sub-interval of at most :data:`TURNS` fastest turns of the body at the
+bound √(2T/I_min) of its rate, and of an eighth of the orbit period): the attitudes at
+all the nodes come from one vectorized call of the exact solver through the middle
+state, the orbit's positions from one call of its (interpolated) position.  The
+integrand of V̄ holds the spin's first and second harmonics, at four nodes a bound
+turn (more a turn of the body, whose rate is below the bound): against eight, the
+crossings of the hostile cases move by 2e-4 of themselves or less, except the spinner
+about its minor axis, whose rate is the bound (1.3e-3, most of its error).  a is a
+derivative of V̄.  Along m it needs no other run: Euler's equations are quadratic in
+m, so the motion from m(1 + ε) is the same motion run 1 + ε times faster, which turns
+the attitude at s by ε (s − τ) ω(s) and changes V by −Γ·ε (s − τ) ω(s).  Across m, by
+finite differences with two more exact solvers from the middle state, its momentum
+moved by 1e-6 of |m| (less when the step is many turns long), at the same nodes (a
+tenth of that moves the crossings by 8e-6 of themselves or less).
 
 **The comparison.**  At each node, the attitude of the run through the middle state
-(every earlier kick included, not yet this step's) is compared with the scenario's
-own (the torque-free one): the angle between them, a step at a time for the first
-:data:`ONE_STEP_AT_A_TIME` nodes, then :data:`COMPARED_AT_ONCE` at once (the free run's solver then
-evaluates them from its table).  Near the crossing, that run lags the torqued one by
-at most the step's kick, so a crossing found in a step whose kick is larger than
-:data:`ACCEPTED_LAG` of the threshold is searched again from the step before, at an
-eighth of the step, until it is not; the first node at or past the threshold, after
-the last below it, is then refined by bisection to a millisecond on the run through
-that step's middle.
+(every earlier kick included, not yet this step's) is compared with the scenario's own
+(the torque-free one): the angle between them, a step at a time for the first
+:data:`ONE_STEP_AT_A_TIME` nodes, then :data:`COMPARED_AT_ONCE` at once (the free
+run's solver then evaluates them from its table).  Near the crossing, that run lags
+the torqued one by at most the step's kick, so a crossing found in a step whose kick
+is larger than :data:`ACCEPTED_LAG` of the threshold is searched again from the step
+before, at an eighth of the step, until it is not; the first node at or past the
+threshold, after the last below it, is then refined by bisection to a millisecond on
+the run through that step's middle.
 
 **Accuracy** (stated by the horizon: 1 %).  Against DOP853 at rtol 1e-12
 (``tests/test_validity_horizon_against_dop853.py``,
 ``tests/test_validity_horizon_hostile_cases_against_dop853.py``), the crossing comes
-4.1e-3 of itself early for a body near the separatrix (spinning about its
-intermediate axis), within 2e-4 for a slow body turning at the orbit rate, spinners
-at 3 and 4 rad/s, a crossing 2.5 minutes after the start under a huge torque, an
-impulse on a full tensor, and a tumbler on an eccentric orbit (2e-6); the
-Envisat-like tumbler of ``scenarios/tumbling_defunct_satellite.toml`` crosses 8.8e-4
-of itself before the splitting.  What limits it: the kick's second-order remainder
-(the step), the quadrature of the spin's harmonics (four nodes a turn: near a
-separatrix most), and, near the crossing, the lag of the compared run (bounded by the
-refinement).  Not covered: a kick that is not small even over a millisecond (a torque
-that turns the momentum by more than the threshold within a millisecond): the
+6.9e-3 of itself early for the spinner whose angle creeps up to the threshold after
+31550 s, 1.3e-3 early near the separatrix (spinning about the intermediate axis) and for
+a spinner at 4 rad/s about its minor axis, and within 2e-4 for a slow body turning at
+the orbit rate, spinners at 3 rad/s and 5 rpm, a crossing 2.5 minutes after the start
+under a huge torque, an impulse on a full tensor, and a tumbler on an eccentric orbit;
+the Envisat-like tumbler of ``scenarios/tumbling_defunct_satellite.toml`` crosses
+5.6e-4 of itself before the splitting.  What limits it: the kicks' second-order
+remainder over a long run (the step), the quadrature of the spin's harmonics (four
+nodes a bound turn), and, near the crossing, the lag of the compared run (bounded by
+the refinement).  Not covered: a kick that is not small even over a millisecond (a
+torque that turns the momentum by more than the threshold within a millisecond): the
 refinement stops there, and the crossing is the first node of that search past the
 threshold.
 """
