@@ -26,7 +26,7 @@ within 6.9e-3 of themselves for a spinner whose angle creeps up to the threshold
 after 31550 s, within 1.3e-3 near a separatrix and for a spinner about its minor
 axis, within 2e-4 elsewhere (a tumbler, fast spinners, a slow body, a huge torque, an
 impulse on a full tensor).  The one-day spinner of ``benchmarks.horizon_share``
-costs about 0.085 s of CPU in process, without numba.
+costs about 0.09 s of CPU in process, without numba.
 
 **Burns, laws, or a stated step**: the run alongside is the splitting
 (``attitude.trajectory.torqued``) at the scenario's ``[torques]`` step or accuracy and
