@@ -10,7 +10,11 @@ body (locked wheels, no torque), or the splitting with the exact gyroscopic flow
 (:func:`attitude.pointing.search.pointing_analysis`: torque-free segments on the
 motion's structure, others with rigorous rate bounds) against the surroundings of the
 whole job, built once per process and shared by every τ
-(:func:`attitude.pointing.shared_surroundings.shared_surroundings`).
+(:func:`attitude.pointing.shared_surroundings.shared_surroundings`).  A task's failures
+are searched together (:func:`attitude.pointing.search.pointing_analyses`: their
+torque-free searches as one set of arrays) and their power searches too
+(:func:`_power_search`); each row is the same, bit for bit, as the failure's alone
+(:func:`failure_metrics`), whatever the task it runs in.
 
 The metrics (columns of the table; times in s after τ; ``inf``: not within the window):
 
@@ -485,8 +489,9 @@ def evaluate_batch(job: EnvelopeJob, first: int, stop: int) -> BatchResult:
     """Failures ``first`` to ``stop − 1`` of ``job``, each a row (runs on a worker).  A
     failure whose motion is refused is a row with its error; the job goes on.
 
-    The power searches of the batch run together (:func:`_power_search`); each row is
-    the same bit for bit as :func:`failure_metrics` gives it alone."""
+    The pointing searches of the batch run together (:func:`_structures`), and so do
+    its power searches (:func:`_power_search`); each row is the same bit for bit as
+    :func:`failure_metrics` gives it alone."""
     started = time.process_time()
     rows = []
     searches: list[_Power] = []

@@ -48,6 +48,17 @@ the Sun visibility's partition (lit throughout, dark throughout, or cut at its r
 crossing) on the cubic through the ends (Gauss–Legendre, exact for it), with the lit
 fraction of the surroundings where the cell meets the Earth's shadow.
 
+**Many searches at once** (:func:`search_free_many`: the loss-of-control envelope's
+windows after each failure, each a run of pieces within one window of nodes): their nodes are put
+end to end in one window, where no cell joins two pieces, so that each call of the
+evaluator (the exact attitude of each piece, the surroundings, the cosines) serves all
+of them.  Everything else is element by element (each cell's bounds, cuts, crossings
+and Newton steps from its own values) or the search's own (its best extrema, the
+cells of its own that decide whether the envelope tightens their bounds, its
+intervals, its sums in the order it has alone, golden-section search on its own
+cells), so each search's result is the one :func:`search_free` gives it alone, bit
+for bit; a search costs a few evaluation calls whatever the number searched with it.
+
 **The envelope.**  |f − B| ≤ A: a vector whose Sun cosine cannot change sign (|B| > A
 throughout: a panel on the spin axis), or a cone the Sun cannot reach, is settled for
 the whole segment without a node; see :func:`_settled_by_envelope`.
@@ -72,9 +83,13 @@ __all__ = [
     "FreePlan",
     "FreeResult",
     "VectorMotion",
+    "fits_one_window",
     "free_plan",
+    "free_plans",
     "search_free",
+    "search_free_many",
     "vector_motion",
+    "vector_motions",
 ]
 
 # Nodes: the curvature bound's overshoot between nodes, M h²/8, at most this (a
@@ -216,66 +231,115 @@ def vector_motion(
     its expansion to first order plus the second-order remainder.  Each result is also
     capped by its analytic bound (module notes).
     """
-    moments = np.sort(np.asarray(solver.moments_of_inertia, dtype=np.float64))
-    G = float(solver.angular_momentum_norm)
-    least = float(moments[0])
-    if G == 0.0:
-        return {name: VectorMotion(0.0, 0.0) for name, _ in vectors}
-    fastest = math.sqrt(max(2.0 * solver.kinetic_energy, 0.0) / least)
-    spin_accel = (float(moments[2]) - least) / least * fastest * fastest / math.sqrt(3.0)
-    period = solver.period
-    periodic = math.isfinite(period) and period < end_s - start_s
-    window = period if periodic else max(end_s - start_s, 0.0)
-    # Hundreds of samples a turn of the body, within [256, 16384].
-    turns = window * fastest / (2.0 * math.pi)
-    samples = int(min(max(_SAMPLES_PER_TURN * turns, _MOTION_SAMPLES_LEAST), _MOTION_SAMPLES))
-    t = start_s + window * np.arange(samples + 1.0) / samples
-    tensor = np.asarray(solver.inertia_tensor, dtype=np.float64)
-    inverse = np.asarray(np.linalg.inv(tensor), dtype=np.float64)
+    return vector_motions([solver], vectors, [(start_s, end_s)])[0]
+
+
+def vector_motions(
+    solvers: list[EulerSolver],
+    vectors: list[tuple[str, NDArray[np.float64]]],
+    spans: list[tuple[float, float]],
+) -> list[dict[str, VectorMotion]]:
+    """:func:`vector_motion` of each solver over its span (``spans[i]``: start and
+    end): each solver's ω at its own samples, then the arithmetic of all in one pass
+    over their samples put end to end (element by element, each sample with its own
+    solver's constants; each maximum over its solver's samples alone), so that each
+    result is the one :func:`vector_motion` gives it alone, bit for bit."""
+    out: list[dict[str, VectorMotion] | None] = [None] * len(solvers)
+    live = []  # (index, start_s, scalars) of the solvers with a momentum
+    ω_parts, tensors, inverses, gaps = [], [], [], []
+    for i, (solver, (start_s, end_s)) in enumerate(zip(solvers, spans, strict=True)):
+        moments = np.sort(np.asarray(solver.moments_of_inertia, dtype=np.float64))
+        G = float(solver.angular_momentum_norm)
+        least = float(moments[0])
+        if G == 0.0:
+            out[i] = {name: VectorMotion(0.0, 0.0) for name, _ in vectors}
+            continue
+        fastest = math.sqrt(max(2.0 * solver.kinetic_energy, 0.0) / least)
+        spin_accel = (float(moments[2]) - least) / least * fastest * fastest / math.sqrt(3.0)
+        period = solver.period
+        periodic = math.isfinite(period) and period < end_s - start_s
+        window = period if periodic else max(end_s - start_s, 0.0)
+        # Hundreds of samples a turn of the body, within [256, 16384].
+        turns = window * fastest / (2.0 * math.pi)
+        samples = int(min(max(_SAMPLES_PER_TURN * turns, _MOTION_SAMPLES_LEAST), _MOTION_SAMPLES))
+        t = start_s + window * np.arange(samples + 1.0) / samples
+        tensor = np.asarray(solver.inertia_tensor, dtype=np.float64)
+        inverse = np.asarray(np.linalg.inv(tensor), dtype=np.float64)
+        spacing = window / samples
+        gap = 0.5 * spacing
+        # A bound on the third derivative of ω: each component of Euler's equations is
+        # a product of two others with a coefficient at most Λ = (I3 − I1)/I1 (principal
+        # axes), and every component is at most Ω, so by Leibniz's rule each component
+        # of ω⁽ᵏ⁾ is at most k! Λᵏ Ω^(k+1), and |ω⁽³⁾| ≤ √3 · 6 Λ³ Ω⁴.
+        Λ = (float(moments[2]) - least) / least
+        third = math.sqrt(3.0) * 6.0 * Λ**3 * fastest**4
+        # |ω⃛| + 2|ω̈||ω| + 2|ω̇|² ≤ (6√3 Λ³ + 4√3 Λ² + 6 Λ²) Ω⁴ by the same majorant.
+        second = (6.0 * math.sqrt(3.0) * Λ**3 + (4.0 * math.sqrt(3.0) + 6.0) * Λ**2) * fastest**4
+        ω_parts.append(solver.angular_velocity(t))
+        tensors.append(tensor)
+        inverses.append(inverse)
+        gaps.append(gap)
+        scalars = (fastest, spin_accel, periodic, window, spacing, gap, third, second)
+        live.append((i, start_s, t.size, scalars))
+    if not live:
+        return out  # type: ignore[return-value]
+    counts = [size for _, _, size, _ in live]
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.intp)
+    # Each sample's solver's I and I⁻¹ ((3, 3, samples): matrix[i, j] a column) and Δ/2.
+    tensor_of = np.repeat(np.stack(tensors, axis=-1), counts, axis=-1)
+    inverse_of = np.repeat(np.stack(inverses, axis=-1), counts, axis=-1)
+    gap_of = np.repeat(np.array(gaps), counts)
     # Columns (x, y, z) of the samples: ω, m = Iω, α = I⁻¹(m × ω), and ω̈ = α̇ =
     # I⁻¹((m × ω) × ω + m × α).
-    ω = _columns(solver.angular_velocity(t))
-    m = _apply(tensor, ω)
+    ω = _columns(np.concatenate(ω_parts))
+    m = _apply(tensor_of, ω)
     mω = _cross(m, ω)
-    α = _apply(inverse, mω)
-    α_rate = _apply(inverse, _add(_cross(mω, ω), _cross(m, α)))
-    spacing = window / samples
-    gap = 0.5 * spacing
+    α = _apply(inverse_of, mω)
+    α_rate = _apply(inverse_of, _add(_cross(mω, ω), _cross(m, α)))
     size = _norm(m)
     m_hat = (m[0] / size, m[1] / size, m[2] / size)
     drift = _cross(m_hat, ω)  # dm̂/dt in the body (ṁ = m × ω)
-    # A bound on the third derivative of ω: each component of Euler's equations is a
-    # product of two others with a coefficient at most Λ = (I3 − I1)/I1 (principal
-    # axes), and every component is at most Ω, so by Leibniz's rule each component of
-    # ω⁽ᵏ⁾ is at most k! Λᵏ Ω^(k+1), and |ω⁽³⁾| ≤ √3 · 6 Λ³ Ω⁴.
-    Λ = (float(moments[2]) - least) / least
-    third = math.sqrt(3.0) * 6.0 * Λ**3 * fastest**4
-    # |ω⃛| + 2|ω̈||ω| + 2|ω̇|² ≤ (6√3 Λ³ + 4√3 Λ² + 6 Λ²) Ω⁴ by the same majorant.
-    second = (6.0 * math.sqrt(3.0) * Λ**3 + (4.0 * math.sqrt(3.0) + 6.0) * Λ**2) * fastest**4
-    out = {}
+    found: list[dict[str, VectorMotion]] = [{} for _ in live]
     for name, b in vectors:
         ωb = _cross_vector(ω, b)
         αb = _cross_vector(α, b)
         # |ω × b| within Δ/2 of a sample: Taylor's expansion to second order there,
         # and the third-order remainder.
-        taylor = _norm(ωb) + _norm(αb) * gap + 0.5 * _norm(_cross_vector(α_rate, b)) * gap * gap
-        rate = min(float(np.max(taylor)) + third * gap**3 / 6.0, fastest)
+        taylor = (
+            _norm(ωb) + _norm(αb) * gap_of + 0.5 * _norm(_cross_vector(α_rate, b)) * gap_of * gap_of
+        )
         # |d̈| = |α × b + ω × (ω × b)| within Δ/2 of a sample: its value and exact rate
         # there (α̇ × b + α × (ω × b) + ω × (α × b)), and the second-order remainder.
         bend = _add(αb, _cross(ω, ωb))
         bend_rate = _add(_add(_cross_vector(α_rate, b), _cross(α, ωb)), _cross(ω, αb))
-        bent = float(np.max(_norm(bend) + _norm(bend_rate) * gap)) + 0.5 * second * gap * gap
         tilt = m_hat[0] * b[0] + m_hat[1] * b[1] + m_hat[2] * b[2]
         # |d/dt (b·m̂)| = |b·(m̂ × ω)|, whose own rate is at most Ω² + A.
         tilt_rate = drift[0] * b[0] + drift[1] * b[1] + drift[2] * b[2]
-        slack = (float(np.max(np.abs(tilt_rate))) + (fastest * fastest + spin_accel) * gap) * gap
-        values = None
-        if window > 0.0:
-            values = tilt[:-1] if periodic else tilt
-        out[name] = VectorMotion(
-            rate, min(bent, spin_accel + fastest * rate), values, start_s, spacing, periodic, slack
-        )
-    return out
+        # Each solver's maxima over its own samples (a maximum is exact, in any order).
+        taylor_max = np.maximum.reduceat(taylor, starts)
+        bend_max = np.maximum.reduceat(_norm(bend) + _norm(bend_rate) * gap_of, starts)
+        tilt_rate_max = np.maximum.reduceat(np.abs(tilt_rate), starts)
+        for j, (_, start_s, count, scalars) in enumerate(live):
+            fastest, spin_accel, periodic, window, spacing, gap, third, second = scalars
+            rate = min(float(taylor_max[j]) + third * gap**3 / 6.0, fastest)
+            bent = float(bend_max[j]) + 0.5 * second * gap * gap
+            slack = (float(tilt_rate_max[j]) + (fastest * fastest + spin_accel) * gap) * gap
+            values = None
+            if window > 0.0:
+                own = tilt[starts[j] : starts[j] + count]
+                values = np.array(own[:-1] if periodic else own)
+            found[j][name] = VectorMotion(
+                rate,
+                min(bent, spin_accel + fastest * rate),
+                values,
+                start_s,
+                spacing,
+                periodic,
+                slack,
+            )
+    for j, (i, _, _, _) in enumerate(live):
+        out[i] = found[j]
+    return out  # type: ignore[return-value]
 
 
 def _columns(v: NDArray[np.float64]):
@@ -331,9 +395,30 @@ def free_plan(
     """The :class:`FreePlan` of a segment, or None when a bound is not finite (a piece
     of the surroundings evaluated exactly, an orbit inside the limb's sphere): the
     segment is then searched on a grid (:mod:`attitude.pointing.search`)."""
+    return free_plans([solver], spec, shared, [(start_s, end_s)])[0]
+
+
+def free_plans(
+    solvers: list[EulerSolver],
+    spec: PointingSpec,
+    shared: SharedSurroundings,
+    spans: list[tuple[float, float]],
+) -> list[FreePlan | None]:
+    """:func:`free_plan` of each solver over its span (``spans[i]``), the motions'
+    bounds of all found together (:func:`vector_motions`): each the same, bit for bit,
+    as alone."""
     vectors = [(v.name, v.vector) for v in spec.body_vectors]
-    motion = vector_motion(solver, vectors, start_s, end_s)
     sky = shared.rate_bounds()
+    motions = vector_motions(solvers, vectors, spans)
+    return [
+        _plan(motion, sky, vectors, start_s, end_s)
+        for motion, (start_s, end_s) in zip(motions, spans, strict=True)
+    ]
+
+
+def _plan(motion, sky, vectors, start_s: float, end_s: float) -> FreePlan | None:
+    """The :class:`FreePlan` from a segment's :class:`VectorMotion` of each vector and
+    the sky's rate bounds."""
     targets = [t for t in TARGETS if f"{t}_1" in sky]
     bend = {}
     for name, _ in vectors:

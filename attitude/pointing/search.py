@@ -19,7 +19,10 @@ for the span on a 10 s grid with the geometry's rate bound, so that none is miss
 however short (:func:`attitude.pointing.intervals.isolate`), and kept with the shared
 surroundings for every later search of the same span.  Many searches of short spans
 within one long one (the envelope's windows after each failure) share one search of
-the long span (:func:`orbit_intervals`), each cut to its span.
+the long span (:func:`orbit_intervals`), each cut to its span; :func:`pointing_analyses`
+runs such searches together, their torque-free searches as one set of arrays
+(:func:`attitude.pointing.free_search.search_free_many`), each analysis the same, bit
+for bit, as :func:`pointing_analysis` gives it alone.
 
 **Torque-free segments** (:mod:`attitude.pointing.free_search`): the structure of the
 closed-form motion bounds how fast each body vector's cosines with the Sun, the Moon
@@ -72,6 +75,7 @@ from attitude.pointing.free_search import (
     FreeResult,
     fits_one_window,
     free_plan,
+    free_plans,
     search_free,
     search_free_many,
 )
@@ -321,13 +325,15 @@ def search_grid(
     stop_s: float | None = None,
     surroundings: SharedSurroundings | None = None,
     orbit: OrbitIntervals | None = None,
+    planned: dict[int, FreePlan | None] | None = None,
 ) -> SearchGrid:
     """The search grid of :func:`pointing_analysis` over [start_s, stop_s] (the output
     span by default), from the rates of the motion and the orbit (see the module notes).
     ``surroundings``: the shared surroundings to plan on, if they cover the span (by
     default the process's cached ones); ``orbit``: the orbit's intervals over a span
     holding this one, whose rate bounds serve here too (else the orbit is sampled over
-    this span).
+    this span); ``planned``: the free plans of some segments (by index) found already,
+    on these surroundings over this span (:func:`pointing_analyses`).
     """
     scenario = trajectory.scenario
     spec = for_scenario(spec, scenario)  # the scenario's orbit, when the spec has none
@@ -353,7 +359,10 @@ def search_grid(
         a, b = max(segment.start_s, start_s), min(segment.end_s, stop_s)
         plan = None
         if shared is not None and isinstance(segment.solver, EulerSolver):
-            plan = free_plan(segment.solver, spec, shared, a, b)
+            if planned is not None and k in planned:
+                plan = planned[k]
+            else:
+                plan = free_plan(segment.solver, spec, shared, a, b)
         if plan is not None:
             plans[k] = plan
             count += plan.count
@@ -1013,11 +1022,13 @@ def pointing_analysis(
     return search.result()
 
 
-def _prepared(trajectory, spec, start_s, stop_s, grid, surroundings, orbit, extrema) -> _Search:
+def _prepared(
+    trajectory, spec, start_s, stop_s, grid, surroundings, orbit, extrema, planned=None
+) -> _Search:
     """The search of :func:`pointing_analysis`, planned, with the orbit's intervals."""
     spec = for_scenario(spec, trajectory.scenario)  # the scenario's orbit, if the spec has none
     if grid is None:
-        grid = search_grid(trajectory, spec, start_s, stop_s, surroundings, orbit)
+        grid = search_grid(trajectory, spec, start_s, stop_s, surroundings, orbit, planned)
     shared = surroundings
     if shared is None or not shared.covers(grid.start_s, grid.stop_s):
         shared = shared_surroundings(trajectory, spec, grid.start_s, grid.stop_s)
@@ -1058,9 +1069,10 @@ def pointing_analyses(
     .search_free_many`), each with its own decisions and element by element, so that
     each analysis is the one :func:`pointing_analysis` gives alone, bit for bit; the
     others are searched alone."""
+    planned = _free_plans(trajectories, spec, spans, surroundings)
     searches = [
-        _prepared(trajectory, spec, a, b, None, surroundings, orbit, extrema)
-        for trajectory, (a, b) in zip(trajectories, spans, strict=True)
+        _prepared(trajectory, spec, a, b, None, surroundings, orbit, extrema, plans)
+        for trajectory, (a, b), plans in zip(trajectories, spans, planned, strict=True)
     ]
     together: list[tuple[_Search, list[FreePiece]]] = []
     for search in searches:
@@ -1087,6 +1099,37 @@ def pointing_analyses(
         for (search, run), result in zip(together, results, strict=True):
             search.take_free(run, result)
     return [search.result() for search in searches]
+
+
+def _free_plans(
+    trajectories: list[Trajectory],
+    spec: PointingSpec,
+    spans: list[tuple[float, float]],
+    surroundings: SharedSurroundings | None,
+) -> list[dict[int, FreePlan | None] | None]:
+    """The free plans of every torque-free segment of the trajectories of one scenario
+    over their spans, found together (:func:`attitude.pointing.free_search.free_plans`)
+    as :func:`search_grid` finds each (by segment index); None for a trajectory whose
+    plans :func:`search_grid` finds itself (other scenarios, surroundings that do not
+    cover its span)."""
+    out: list[dict[int, FreePlan | None] | None] = [None] * len(trajectories)
+    if not trajectories or surroundings is None or not spec.body_vectors:
+        return out
+    scenario = trajectories[0].scenario
+    spec = for_scenario(spec, scenario)
+    where, solvers, parts = [], [], []
+    for i, (trajectory, (start_s, stop_s)) in enumerate(zip(trajectories, spans, strict=True)):
+        if trajectory.scenario is not scenario or not surroundings.covers(start_s, stop_s):
+            continue
+        out[i] = {}
+        for k, segment in _in_span(trajectory, start_s, stop_s):
+            if isinstance(segment.solver, EulerSolver):
+                where.append((i, k))
+                solvers.append(segment.solver)
+                parts.append((max(segment.start_s, start_s), min(segment.end_s, stop_s)))
+    for (i, k), plan in zip(where, free_plans(solvers, spec, surroundings, parts), strict=True):
+        out[i][k] = plan  # type: ignore[index]
+    return out
 
 
 def _batch_key(search: _Search) -> tuple:
