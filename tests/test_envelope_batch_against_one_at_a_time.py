@@ -86,3 +86,36 @@ def test_the_batches_cover_every_outcome_of_the_power_search():
     assert any(x == 0.0 for x in lost)
     assert any(0.0 < x < math.inf for x in lost)
     assert any(x == math.inf for x in lost)
+
+
+def test_a_refused_failure_in_a_task_is_its_own_row(monkeypatch):
+    """A failure whose motion is refused, and one whose search is refused within the
+    task's searches together: each its own failed row, naming the error; the others the
+    same rows as before, bit for bit (the task's searches run again one at a time)."""
+    import attitude.envelope.failure as failure
+
+    job, batch = _rows("locked, threshold 0.3")
+    real = failure.motion_after
+
+    def motion_after(job, k):
+        if k == 2:
+            raise ValueError("no motion for failure 2")
+        trajectory = real(job, k)
+        if k == 5:
+            solver = trajectory.segments[0].solver
+
+            def refused(t, scalar_first=True):
+                raise OverflowError("the attitude of failure 5 overflows")
+
+            solver.attitude_quaternion = refused
+        return trajectory
+
+    monkeypatch.setattr(failure, "motion_after", motion_after)
+    rows = evaluate_batch(job, 0, job.count).rows
+    for k, (row, before) in enumerate(zip(rows, batch, strict=True)):
+        if k in (2, 5):
+            assert row["status"] == "failed"
+            assert ("failure 2" if k == 2 else "failure 5") in row["error"]
+            assert all(math.isnan(row[c]) for c in job.columns)
+        else:
+            assert all(_same(row[c], before[c]) for c in before), k
