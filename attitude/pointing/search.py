@@ -793,8 +793,11 @@ class _Search:
         # exact path: the same ephemeris nodes), the trajectory's attitude.
         env = self.shared.exact(times)
         attitude = self.trajectory.attitude(times)
+        wanted = {name for _, (name, _), _ in found}  # the vectors with an extremum
         angles = {
-            v.name: vector_angles(attitude.apply(v.vector), env) for v in self.spec.body_vectors
+            v.name: vector_angles(attitude.apply(v.vector), env)
+            for v in self.spec.body_vectors
+            if v.name in wanted
         }
         for k, (which, (name, quantity), extremum) in enumerate(found):
             if quantity == "cos_incidence" and extremum.value == 0.0:
