@@ -56,7 +56,7 @@ differences below give its columns), which holds the shear of a tumbler's phase
 separatrix.  It is held to :data:`LARGEST_KICK` (and to :data:`KICK_FRACTION` of the
 threshold): a step whose kick exceeds twice that is made again shorter, the next
 step is scaled to it (at most twice the last), and a step is at most
-:data:`ORBIT_FRACTION` of the orbit period.  A long run is what sets the bound: the
+:data:`ORBIT_FRACTION` of the orbit period (and :data:`MOST_NODES` nodes).  A long run is what sets the bound: the
 kicks' second-order remainder changes |m| and T, and the spin phase turns that into
 an angle growing with the time left; the 0.65 rad/s spinner of
 ``tests/test_validity_horizon_against_dop853.py`` (its crossing after 31 550 s, the
@@ -145,8 +145,10 @@ TURNS = 2.0
 KICK_FRACTION = 0.1
 LARGEST_KICK = 5e-4
 ORBIT_FRACTION = 0.5
-# A step is at most this many times the last.
+# A step is at most this many times the last, and has at most this many nodes (its
+# arrays: some 30 of them, 8 bytes a node).
 GROWTH = 2.0
+MOST_NODES = 1 << 16
 # A crossing is accepted from a step whose kick is below this fraction of the
 # threshold: the comparison then lags the torqued run by at most that angle.
 ACCEPTED_LAG = 2e-4
@@ -280,6 +282,7 @@ class _Run:
         self.free, self.threshold = free, threshold
         self.largest, self.steps = 0.0, 0
         self.compared = 0  # nodes compared so far
+        self.sub = 1.0  # the last step's sub-interval (s)
 
     def _potential(self, q: NDArray, u: tuple, factor: NDArray) -> NDArray[np.float64]:
         """V (J) at principal attitudes q, for the inertial unit positions u."""
@@ -299,6 +302,7 @@ class _Run:
         rate = math.sqrt(max(float(m @ (m / J)), 0.0) / float(J.min()))
         turn = 2.0 * math.pi / rate if rate > 0.0 else math.inf
         longest = min(TURNS * turn, self.period / 8.0)
+        self.sub = longest
         t, w = _nodes(tau - 0.5 * h, tau + 0.5 * h, longest)
         qs = through.attitude_quaternion(t)
         r = self.gradient.position(t)
@@ -369,7 +373,10 @@ class _Run:
         after the last kick (None after a crossing).  Steps are at most ``cap`` before
         ``until`` (a refinement: past it, they grow again, and are compared a step at a
         time before it)."""
-        t, h_next = start, min(cap, self.period * _FIRST_ORBIT_FRACTION)
+        m = np.asarray(through.angular_momentum(start), dtype=np.float64)
+        rate = math.sqrt(max(float(m @ (m / self.body.J)), 0.0) / float(self.body.J.min()))
+        self.sub = min(TURNS * 2.0 * math.pi / rate, self.period / 8.0) if rate > 0.0 else 1.0
+        t, h_next = start, min(cap, self.period * _FIRST_ORBIT_FRACTION, self._most())
         target = min(KICK_FRACTION * self.threshold, LARGEST_KICK)
         earlier: _Step | None = None  # the last step compared
         pending: list[_Step] = []  # steps made, not yet compared
@@ -406,7 +413,12 @@ class _Run:
         if the size went as the step's square (it grows between that and the step
         itself), at most GROWTH times h and ORBIT_FRACTION of the orbit."""
         scale = math.sqrt(target / max(size, 1e-300))
-        return min(self.period * ORBIT_FRACTION, GROWTH * h, h * scale)
+        return min(self.period * ORBIT_FRACTION, GROWTH * h, h * scale, self._most())
+
+    def _most(self) -> float:
+        """The longest step of at most MOST_NODES nodes (a fast body's step is many
+        turns: its arrays, not the kick, bound it)."""
+        return MOST_NODES / NODES * self.sub
 
     def _compare(self, pending: list[_Step], earlier: _Step | None, end: float) -> float | None:
         """The crossing within the steps ``pending`` (``earlier``: the step before
