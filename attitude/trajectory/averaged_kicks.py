@@ -47,18 +47,18 @@ turns does not).  Without a, the 0.65 rad/s spinner of
 the torque never does.
 
 The free flow handles the spin (every φ_s is exact, at any s), so H is not limited by
-it.  The map's error is of second order in the perturbation: O(ε²) a step, ε the
-size of the kick, and O(ε) over a run relative to the effect measured.  The size that
-sets the step is how far the kick moves the attitude within the step: |a|, plus the
-kick's momentum carried by the linearized free flow to every node (the finite
-differences below give its columns), which holds the shear of a tumbler's phase
-(the frequencies change with |m| and T) and the growth of the linearized flow near a
-separatrix.  It is held to :data:`LARGEST_KICK` (and to :data:`KICK_FRACTION` of the
-threshold): a step whose kick exceeds twice that is made again shorter, the next
-step is scaled to it (at most twice the last), and a step is at most
-:data:`ORBIT_FRACTION` of the orbit period (and :data:`MOST_NODES` nodes).  A long run is what sets the bound: the
-kicks' second-order remainder changes |m| and T, and the spin phase turns that into
-an angle growing with the time left; the 0.65 rad/s spinner of
+it.  The map's error is of second order in the perturbation: O(ε²) a step, ε the size
+of the kick, and O(ε) over a run relative to the effect measured.  The size that sets
+the step is how far the kick moves the attitude within the step: |a|, plus the kick's
+momentum carried by the linearized free flow to every node (the finite differences
+below give its columns), which holds the shear of a tumbler's phase (the frequencies
+change with |m| and T) and the growth of the linearized flow near a separatrix.  It is
+held to :data:`LARGEST_KICK` (and to :data:`KICK_FRACTION` of the threshold): a step
+whose kick exceeds twice that is made again shorter, the next step is scaled to it (at
+most twice the last), and a step is at most :data:`ORBIT_FRACTION` of the orbit period
+(and :data:`MOST_NODES` nodes).  A long run is what sets the bound: the kicks'
+second-order remainder changes |m| and T, and the spin phase turns that into an angle
+growing with the time left; the 0.65 rad/s spinner of
 ``tests/test_validity_horizon_against_dop853.py`` (its crossing after 31 550 s, the
 angle growing by 0.035° in 1000 s there) crosses 1.6 % early with kicks of 1e-3 rad,
 0.7 % at 5e-4.
@@ -401,7 +401,7 @@ class _Run:
                 continue
             found = self._compare(pending, earlier, end)
             if found is not None:
-                return found, None
+                return found
             earlier, pending = pending[-1], []
             h_next = self._next(h, size, target)
             if t < until:
@@ -420,28 +420,35 @@ class _Run:
         turns: its arrays, not the kick, bound it)."""
         return MOST_NODES / NODES * self.sub
 
-    def _compare(self, pending: list[_Step], earlier: _Step | None, end: float) -> float | None:
-        """The crossing within the steps ``pending`` (``earlier``: the step before
-        them), compared with the free run in one call, or None: from a step whose kick
-        is small enough, bisected; from any other, searched again at an eighth of the
-        step from the step before it."""
+    def _compare(
+        self, pending: list[_Step], earlier: _Step | None, end: float
+    ) -> tuple[float, EulerSolver | None] | None:
+        """The steps ``pending`` (``earlier``: the step before them) compared with the
+        free run in one call: None if none of them can hold the crossing, else what
+        :meth:`run` returns.  The run compared lags the torqued one by at most the
+        step's kick (its size), so a step whose angle comes within its size of the
+        threshold may hold the crossing: if its kick is small enough, the first node
+        at or past the threshold is bisected (none: no crossing there); if not, the
+        run is searched again at an eighth of the step from the step before it."""
         nodes = np.concatenate([p.nodes for p in pending])
         self.compared += nodes.size
         angles = self.free(nodes, np.concatenate([p.qs for p in pending]))
-        past = np.flatnonzero(angles >= self.threshold)
-        if not past.size:
-            return None
-        first = int(past[0])
-        k = int(np.searchsorted(np.cumsum([p.nodes.size for p in pending]), first, "right"))
-        step = pending[k]
-        if step.size <= ACCEPTED_LAG * self.threshold or step.h <= _SHORTEST_STEP:
-            low = float(nodes[first - 1]) if first > 0 and nodes[first - 1] >= step.t else step.t
-            return self._bisect(step.through, low, float(nodes[first]))
-        back = pending[k - 1] if k > 0 else earlier or step
-        crossing, _ = self.run(
-            back.t, back.through, end, _REFINE * max(back.h, step.h), step.t + step.h
-        )
-        return crossing
+        start = 0
+        for k, step in enumerate(pending):
+            stop = start + step.nodes.size
+            here = angles[start:stop]
+            if step.size <= ACCEPTED_LAG * self.threshold or step.h <= _SHORTEST_STEP:
+                past = np.flatnonzero(here >= self.threshold)
+                if past.size:
+                    first = start + int(past[0])
+                    low = float(nodes[first - 1]) if first > start else step.t
+                    return self._bisect(step.through, low, float(nodes[first])), None
+            elif np.any(here >= self.threshold - step.size):
+                back = pending[k - 1] if k > 0 else earlier or step
+                cap = _REFINE * max(back.h, step.h)
+                return self.run(back.t, back.through, end, cap, step.t + step.h)
+            start = stop
+        return None
 
     def _bisect(self, through: EulerSolver, low: float, high: float) -> float:
         """The first crossing in (low, high] on ``through``, to a millisecond."""
