@@ -102,7 +102,7 @@ after the start under a huge torque, an impulse on a full tensor, and a tumbler 
 eccentric orbit; the Envisat-like tumbler of ``scenarios/tumbling_defunct_satellite.toml``
 crosses 5.6e-4 of itself before the splitting.  **Not met over days**: the 5 rpm
 spinner of ``benchmarks.horizon_share`` (nutating after its pulse) crosses 0.05° after
-10 610 s (DOP853) 2.3 % early, 0.2° after 52 390 s 2.0 % late, and 1° after about 2.7
+10 610 s (DOP853) 2.1 % early, 0.2° after 52 390 s 4.6 % late, and 1° after about 2.7
 days 10.6 % late against the splitting (converged there to 0.2 %); with steps of a
 fortieth of an orbit, 2.9 %.  The error grows with the run, faster than the kick
 size says: the kicks' second-order remainder, over steps long against the orbit's
@@ -377,16 +377,20 @@ class _Run:
         through: EulerSolver,
         end: float,
         cap: float = math.inf,
-        until: float = -math.inf,
-    ) -> tuple[float, EulerSolver | None]:
-        """From ``through`` at ``start`` to ``end``: the crossing (or inf) and the run
-        after the last kick (None after a crossing).  Steps are at most ``cap`` before
-        ``until`` (a refinement: past it, they grow again, and are compared a step at a
-        time before it)."""
+        until: float = math.inf,
+    ) -> tuple[float, EulerSolver | None, float]:
+        """From ``through`` at ``start`` towards ``end``: the crossing (or inf), the run
+        after the last kick (None after a crossing) and the time it reached.  A
+        refinement (``until`` finite) takes steps of at most ``cap``, compares each, and
+        returns at the first step's end at or past ``until`` without a crossing, for
+        the run it refines to go on from there (no recursion deeper than the
+        refinements of one crossing)."""
+        refining = math.isfinite(until)
         m = np.asarray(through.angular_momentum(start), dtype=np.float64)
         rate = math.sqrt(max(float(m @ (m / self.body.J)), 0.0) / float(self.body.J.min()))
         self.sub = min(TURNS * 2.0 * math.pi / rate, self.period / 8.0) if rate > 0.0 else 1.0
-        t, h_next = start, min(cap, self.period * _FIRST_ORBIT_FRACTION, self._most())
+        first = min(cap, self.period * _FIRST_ORBIT_FRACTION, self._most())
+        t, h_next = start, first
         target = min(KICK_FRACTION * self.threshold, LARGEST_KICK)
         earlier: _Step | None = None  # the last step compared
         pending: list[_Step] = []  # steps made, not yet compared
@@ -403,20 +407,25 @@ class _Run:
             waiting = sum(p.nodes.size for p in pending)
             if (
                 t < end
-                and t >= until
+                and not refining
                 and self.compared >= ONE_STEP_AT_A_TIME
                 and waiting < COMPARED_AT_ONCE
             ):
                 h_next = self._next(h, size, target)
                 continue
             found = self._compare(pending, earlier, end)
-            if found is not None:
-                return found
             earlier, pending = pending[-1], []
-            h_next = self._next(h, size, target)
-            if t < until:
-                h_next = min(h_next, cap)
-        return math.inf, through
+            h_next = min(self._next(h, size, target), cap)
+            if found is not None:
+                crossing, resumed, reached = found
+                if math.isfinite(crossing) or resumed is None:
+                    return found
+                # The refinement found none up to its end: on from there.
+                through, t, earlier = resumed, reached, None
+                h_next = min(cap, self.period * _FIRST_ORBIT_FRACTION, self._most())
+            elif refining and t >= until:
+                return math.inf, through, t
+        return math.inf, through, t
 
     def _next(self, h: float, size: float, target: float) -> float:
         """The step after one of ``h`` whose kick had ``size``: scaled to ``target`` as
@@ -432,7 +441,7 @@ class _Run:
 
     def _compare(
         self, pending: list[_Step], earlier: _Step | None, end: float
-    ) -> tuple[float, EulerSolver | None] | None:
+    ) -> tuple[float, EulerSolver | None, float] | None:
         """The steps ``pending`` (``earlier``: the step before them) compared with the
         free run in one call: None if none of them can hold the crossing, else what
         :meth:`run` returns.  The run compared lags the torqued one by at most the
@@ -452,7 +461,8 @@ class _Run:
                 if past.size:
                     first = start + int(past[0])
                     low = float(nodes[first - 1]) if first > start else step.t
-                    return self._bisect(step.through, low, float(nodes[first])), None
+                    crossing = self._bisect(step.through, low, float(nodes[first]))
+                    return crossing, None, crossing
             elif np.any(here >= self.threshold - step.size):
                 back = pending[k - 1] if k > 0 else earlier or step
                 cap = _REFINE * max(back.h, step.h)
@@ -493,7 +503,7 @@ def departure(
     m, attitude = body.principal(state)
     run = _Run(body, gradient, period_s, angles, threshold)
     through = EulerSolver(body.moments, m, attitude, start_s)
-    crossing, after = run.run(start_s, through, end_s)
+    crossing, after, _ = run.run(start_s, through, end_s)
     end_state = None
     if after is not None:
         end_state = body.body(after.angular_momentum(end_s), after.attitude(end_s), state.inertia)

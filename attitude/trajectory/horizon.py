@@ -26,7 +26,7 @@ within 6.9e-3 of themselves for a spinner whose angle creeps up to the threshold
 after 31550 s, within 1.3e-3 near a separatrix and for a spinner about its minor
 axis, within 2e-4 elsewhere (a tumbler, fast spinners, a slow body, a huge torque, an
 impulse on a full tensor); not to 1 % over days (the nutating 5 rpm spinner of the
-benchmark: 2 % at 14 hours, 10.6 % at 2.7 days; the module's docstring says why).
+benchmark: 4.6 % at 14 hours, 10.6 % at 2.7 days; the module's docstring says why).
 The one-day spinner of ``benchmarks.horizon_share`` costs about 0.09 s of CPU in
 process, without numba.
 
