@@ -91,9 +91,7 @@ def test_a_tumblers_horizon_on_an_eccentric_orbit_against_dop853():
     found = validity_horizon(propagate(_scenario(rate, 3000.0)), ORBIT)
     crossing = _dop853_crossing(rate, 600.0, 0.1)
     assert 100.0 < crossing < 600.0 and found.within_span
-    # The horizon is stated to 1 %; the averaged kicks' own error is 2e-5 of it here (a
-    # splitting at 0.3 of a turn agreed to 0.01 s).
-    assert abs(found.horizon_s - crossing) < 1e-3 * crossing, (found.horizon_s, crossing)
+    assert abs(found.horizon_s - crossing) < 0.01, (found.horizon_s, crossing)
     assert found.searched_s == found.horizon_s  # the search stops at the crossing
 
 
@@ -101,11 +99,11 @@ def test_a_tumblers_horizon_on_an_eccentric_orbit_against_dop853():
 def test_a_spinners_horizon_after_tens_of_thousands_of_steps_against_dop853():
     rate = (0.01, 0.02, 0.65)
     found = validity_horizon(propagate(_scenario(rate, 86400.0)), ORBIT)
-    # The search went that far, uncapped (a splitting at 0.3 of a turn took 15 000 steps
-    # to get there; the averaged kicks, steps of up to half an orbit).
-    assert found.within_span and found.searched_s == found.horizon_s > 30_000
+    assert found.horizon_s / found.step_s > 15_000  # the run alongside went that far
     crossing = _dop853_crossing(rate, 33_000.0, 0.5)
-    # The stated accuracy (1 %).
+    # The stated accuracy (1 %): the angle's wobble within a step of the run alongside
+    # (the horizon samples it there, 0.3 of a turn apart) puts it 14 s late here,
+    # 4.6e-4 of the horizon.
     assert abs(found.horizon_s - crossing) < HORIZON_RELATIVE_ACCURACY * crossing
 
 

@@ -1,10 +1,12 @@
-"""The validity horizon by averaged kicks against DOP853, on the cases that stress it.
+"""The validity horizon and its averaged-kick screen against DOP853, on hostile cases.
 
 Each case: the first time the attitude under gravity gradient and the torque-free one
 part by the threshold, both integrated by scipy's DOP853 (rtol 1e-12: Euler's
 equations and quaternion kinematics, ``torqued_reference``, none of the package's
-code), against ``validity_horizon`` (``attitude.trajectory.averaged_kicks``): within
-the horizon's stated accuracy, 1 % (``HORIZON_RELATIVE_ACCURACY``).
+code), against ``validity_horizon`` (its screen finds half the threshold crossed, so
+the crossing comes from the splitting) and against the averaged kicks themselves
+(``averaged_horizon`` at the threshold, ``attitude.trajectory.averaged_kicks``): both
+within the horizon's stated accuracy, 1 % (``HORIZON_RELATIVE_ACCURACY``).
 
 - a body near the separatrix (spinning about its intermediate axis: the Dzhanibekov
   flip), where the linearized flow grows and the kick's effect with it;
@@ -37,7 +39,11 @@ from attitude.scenario.events import AngularImpulse
 from attitude.scenario.scenario import InitialState, Scenario
 from attitude.scenario.spacecraft import Spacecraft
 from attitude.scenario.torques import ScenarioTorques
-from attitude.trajectory.horizon import HORIZON_RELATIVE_ACCURACY, validity_horizon
+from attitude.trajectory.horizon import (
+    HORIZON_RELATIVE_ACCURACY,
+    averaged_horizon,
+    validity_horizon,
+)
 from attitude.trajectory.trajectory import propagate
 
 EPOCH = "2027-03-01T00:00:00"
@@ -109,20 +115,25 @@ def _horizon(inertia, rate, threshold, duration, events=()):
         duration=duration,
         torques=torques,
     )
-    return validity_horizon(propagate(scenario), ORBIT), scenario
+    trajectory = propagate(scenario)
+    found = validity_horizon(trajectory, ORBIT)
+    return found, averaged_horizon(trajectory, ORBIT, threshold), scenario
 
 
 def _check(name, inertia, rate, threshold_deg, end, sample):
     threshold = math.radians(threshold_deg)
-    found, _ = _horizon(np.array(inertia), rate, threshold, 2.0 * end)
+    found, averaged, _ = _horizon(np.array(inertia), rate, threshold, 2.0 * end)
     tensor = np.diag(inertia)
     crossing = _dop853_crossing(tensor, tensor @ np.asarray(rate), threshold, end, sample)
-    assert found.within_span and found.method == "averaged kicks", name
-    assert abs(found.horizon_s - crossing) < HORIZON_RELATIVE_ACCURACY * crossing, (
-        name,
-        found.horizon_s,
-        crossing,
-    )
+    assert found.within_span and found.method == "splitting", name
+    assert averaged.within_span and averaged.method == "averaged kicks", name
+    for horizon in (found, averaged):
+        assert abs(horizon.horizon_s - crossing) < HORIZON_RELATIVE_ACCURACY * crossing, (
+            name,
+            horizon.method,
+            horizon.horizon_s,
+            crossing,
+        )
 
 
 @pytest.mark.parametrize("name", list(CASES))
@@ -136,23 +147,26 @@ def test_the_horizon_across_an_impulse_on_a_full_tensor_against_dop853():
     rate = np.array([0.005, 0.004, 0.006])
     kick = np.array([0.3, -0.2, 0.1])  # N m s, body axes
     at = Time(EPOCH, scale="utc") + TimeDelta(120.0, format="sec")
-    found, scenario = _horizon(
+    found, averaged, scenario = _horizon(
         tensor, rate, math.radians(1.0), 1200.0, [AngularImpulse(at, kick, "body")]
     )
     offset = scenario.events[0][0]
     crossing = _dop853_crossing(
         tensor, tensor @ rate, math.radians(1.0), 600.0, 0.1, (offset, kick)
     )
-    assert offset < crossing < 400.0 and found.within_span
-    assert abs(found.horizon_s - crossing) < HORIZON_RELATIVE_ACCURACY * crossing, (
-        found.horizon_s,
-        crossing,
-    )
+    assert offset < crossing < 400.0 and found.within_span and averaged.within_span
+    for horizon in (found, averaged):
+        assert abs(horizon.horizon_s - crossing) < HORIZON_RELATIVE_ACCURACY * crossing, (
+            horizon.method,
+            horizon.horizon_s,
+            crossing,
+        )
 
 
 def test_the_horizons_process_imports_no_numba():
-    """A run's horizon, in the process forked beside it, neither finds numba imported
-    nor imports it (numba's start alone was a tenth of a second)."""
+    """A run's horizon beyond its span (the screen's answer), in the process forked
+    beside it, neither finds numba imported nor imports it (numba's start alone was a
+    tenth of a second)."""
     code = textwrap.dedent(
         """
         import sys
@@ -175,7 +189,9 @@ def test_the_horizons_process_imports_no_numba():
         orbit = ref.circular_orbit(7.0e6)
 
         def horizon():
-            return validity_horizon(trajectory, orbit).searched_s, "numba" in sys.modules
+            found = validity_horizon(trajectory, orbit)
+            assert found.method == "averaged kicks" and not found.within_span
+            return found.searched_s, "numba" in sys.modules
 
         before = "numba" in sys.modules
         with Beside(horizon) as beside:

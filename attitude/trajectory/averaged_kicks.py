@@ -90,8 +90,9 @@ before, at an eighth of the step, until it is not; the first node at or past the
 threshold, after the last below it, is then refined by bisection to a millisecond on
 the run through that step's middle.
 
-**Accuracy** (the horizon states 1 %; verified to it for horizons up to about nine
-hours, not beyond).  Against DOP853 at rtol 1e-12
+**Accuracy** (to 1 % for crossings up to about nine hours, not beyond: so
+:func:`attitude.trajectory.horizon.validity_horizon` uses it as a screen, at half its
+threshold, and states only the splitting's crossings).  Against DOP853 at rtol 1e-12
 (``tests/test_validity_horizon_against_dop853.py``,
 ``tests/test_validity_horizon_hostile_cases_against_dop853.py``), the crossing comes
 6.9e-3 of itself early for the spinner whose angle creeps up to the threshold after

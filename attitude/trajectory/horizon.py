@@ -16,21 +16,26 @@ threshold that is itself a choice (1°): 1 % of a day is 14 minutes, far finer t
 user reads "valid until then".
 
 **Torque-free scenarios** (no burn, no law, no ``[torques]`` step or accuracy), the
-default: the run alongside is :mod:`attitude.trajectory.averaged_kicks`, steps set by
-the size of the perturbation's kick (up to half an orbit), each kick the torque and
-the gradient of the potential averaged along the exact free flow, the events applied
-to its state as to the scenario's; the attitudes are compared at its quadrature nodes
-(four a turn).  Against DOP853 (``tests/test_validity_horizon_against_dop853.py``,
-``tests/test_validity_horizon_hostile_cases_against_dop853.py``) its crossings come
-within 6.9e-3 of themselves for a spinner whose angle creeps up to the threshold
-after 31550 s, within 1.3e-3 near a separatrix and for a spinner about its minor
-axis, within 2e-4 elsewhere (a tumbler, fast spinners, a slow body, a huge torque, an
-impulse on a full tensor); not to 1 % over days (the nutating 5 rpm spinner of the
-benchmark: 4.6 % at 14 hours, 10.6 % at 2.7 days; the module's docstring says why).
-The one-day spinner of ``benchmarks.horizon_share`` costs about 0.09 s of CPU in
-process, without numba.
+default, are first **screened** by :mod:`attitude.trajectory.averaged_kicks`: long
+steps set by the size of the perturbation's kick (up to half an orbit), each kick the
+torque and the gradient of the potential averaged along the exact free flow, the
+events applied to its state as to the scenario's, its attitude compared with the
+scenario's at its quadrature nodes (four a turn).  When that run stays below
+:data:`SCREEN_FRACTION` (a half) of the threshold over the whole span, the horizon is
+beyond the span; that is the answer, without numba, in about 0.1 s of CPU for a day of
+a 5 rpm spinner.  Otherwise the horizon is computed as below, by the splitting: every
+crossing the summary states comes from it.  The averaged kicks are an estimate whose
+error grows with the run (the module's docstring): against DOP853
+(``tests/test_validity_horizon_hostile_cases_against_dop853.py``) their crossings
+come within 1.3e-3 of themselves on hostile cases of minutes, but the nutating 5 rpm
+spinner of ``benchmarks.horizon_share`` crosses 1° 10.6 % late about 2.7 days in.
+Hence the factor two: on that spinner over eight days, the averaged run crosses half
+of a threshold from 0.25° to 4° at 0.51 to 0.64 of the time the splitting crosses the
+threshold (``tests/test_validity_horizon_screen_against_the_splitting.py``), so a span
+that it finds below half the threshold is below the threshold with room to spare.
 
-**Burns, laws, or a stated step**: the run alongside is the splitting
+**The splitting** (burns, laws, a stated step, or a torque-free scenario whose screen
+finds half the threshold crossed): the run alongside is the splitting
 (``attitude.trajectory.torqued``) at the scenario's ``[torques]`` step or accuracy and
 order when it states one; otherwise order 4 at a step of three tenths of the body's
 fastest turn (at the bound √(2T/I_min) of its rate), at most a fortieth of the orbit
@@ -75,10 +80,20 @@ from attitude.trajectory.segments import Segment, segments
 from attitude.trajectory.torqued import TorquedMotion, scenario_torque_models
 from attitude.trajectory.trajectory import Trajectory, propagate
 
-__all__ = ["HORIZON_RELATIVE_ACCURACY", "ORBIT_TOLERANCE_M", "ValidityHorizon", "validity_horizon"]
+__all__ = [
+    "HORIZON_RELATIVE_ACCURACY",
+    "ORBIT_TOLERANCE_M",
+    "SCREEN_FRACTION",
+    "ValidityHorizon",
+    "averaged_horizon",
+    "validity_horizon",
+]
 
 # The horizon is an estimate to this fraction of itself (module docstring).
 HORIZON_RELATIVE_ACCURACY = 1e-2
+# A torque-free span whose averaged kicks stay below this fraction of the threshold is
+# beyond the horizon (module docstring: the averaged run's error stays well within it).
+SCREEN_FRACTION = 0.5
 
 _TURN_FRACTION = 0.3
 _ORBIT_FRACTION = 1.0 / 40.0
@@ -178,7 +193,17 @@ def validity_horizon(trajectory: Trajectory, orbit: Any) -> ValidityHorizon:
     threshold = settings.horizon_threshold
     given = settings.step is not None or settings.accuracy is not None
     if not given and _free_only(trajectory):
-        return _by_averaged_kicks(trajectory, orbit, threshold)
+        screen = averaged_horizon(trajectory, orbit, SCREEN_FRACTION * threshold)
+        if not screen.within_span:
+            return ValidityHorizon(
+                threshold,
+                math.inf,
+                screen.searched_s,
+                screen.span_s,
+                screen.step_s,
+                screen.order,
+                screen.method,
+            )
     step = settings.step if settings.step is not None else _step(trajectory, orbit)
     torques = ScenarioTorques(
         gravity_gradient=_interpolated(orbit, scenario),
@@ -228,9 +253,11 @@ def _gradient(trajectory: Trajectory, orbit: Any) -> tuple[GravityGradient, floa
     return gradient, 2.0 * math.pi * math.sqrt(radius**3 / gradient.mu)
 
 
-def _by_averaged_kicks(trajectory: Trajectory, orbit: Any, threshold: float) -> ValidityHorizon:
-    """The horizon of a torque-free ``trajectory`` by averaged kicks
-    (:mod:`attitude.trajectory.averaged_kicks`), segment by segment through its events."""
+def averaged_horizon(trajectory: Trajectory, orbit: Any, threshold: float) -> ValidityHorizon:
+    """The first time the averaged kicks (:mod:`attitude.trajectory.averaged_kicks`) part
+    from a torque-free ``trajectory`` by ``threshold`` rad, segment by segment through
+    its events: the screen of :func:`validity_horizon` (at :data:`SCREEN_FRACTION` of
+    its threshold), an estimate whose accuracy the module docstring states."""
     scenario = trajectory.scenario
     gradient, period = _gradient(trajectory, orbit)
     largest, crossing = 0.0, math.inf
