@@ -10,8 +10,9 @@ torque-free rigid body of momentum I ω_law + h).
 - **attitude**: failures as the envelope computes them on a worker, a task of
   ``BATCH`` consecutive failures (``attitude.envelope.failure.evaluate_batch``: for
   each the hand-off, the exact pointing search on the shared surroundings, the rate,
-  the flips; the power searches of the task together), the task's CPU divided by
-  ``BATCH``; and a task of one failure, for the cost of a failure alone.
+  the flips; the pointing searches of the task as one set of arrays, its power
+  searches together), the task's CPU divided by ``BATCH``; and a task of one
+  failure, for the cost of a failure alone.
 - **Basilisk** (bsk, ``/work/venv-bench``), as its users would do it: one simulation per
   failure, a rigid hub from the same initial state (σ_BN, ω_BN_B from our hand-off), RK4
   at 0.1 s over the hour, every step recorded; its cost is the simulation alone (the

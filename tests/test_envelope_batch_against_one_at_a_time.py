@@ -1,10 +1,13 @@
-"""The envelope's batch of failures (their power searches run together,
+"""The envelope's batch of failures (their pointing searches run as one set of arrays,
+``attitude.pointing.search.pointing_analyses``, and their power searches together,
 ``attitude.envelope.failure._power_search``) against the same failures computed one at
-a time (``failure_metrics``, and a batch of one): the same rows, bit for bit.
+a time (``failure_metrics``, and a batch of one) and in tasks of other sizes: the same
+rows, bit for bit.
 
-Each failure's points in the batched search, and their order, are those it has alone,
-and every step of the search is element by element, so the rows must be identical,
-not merely within the search's precision.  The failures span imaging, a slew, the
+Each failure's points in the batched searches are those it has alone, every step is
+element by element, and every decision (an extremum's best, a count of cells) is the
+failure's own, so the rows must be identical, not merely within the search's
+precision.  The failures span imaging, a slew, the
 station pass and charging, in and out of the Earth's shadow, with the power threshold
 reached at the loss, later in the window, and never; both wheel cases.
 """
@@ -58,6 +61,24 @@ def test_batch_rows_against_failures_one_at_a_time(name):
         assert all(_same(together[c], metrics[c]) for c in metrics)
 
 
+@pytest.mark.parametrize("size", [2, 3, 5])
+def test_batch_rows_against_tasks_of_other_sizes(size):
+    """The rows whatever the task they ran in: the failures cut into tasks of ``size``."""
+    job, batch = _rows("locked, threshold 0.3")
+    rows = [
+        row
+        for first in range(0, job.count, size)
+        for row in evaluate_batch(job, first, min(first + size, job.count)).rows
+    ]
+    assert len(rows) == len(batch)
+    for together, other in zip(batch, rows, strict=True):
+        assert list(together) == list(other)
+        differing = {
+            c: (together[c], other[c]) for c in together if not _same(together[c], other[c])
+        }
+        assert not differing, (together["failure"], differing)
+
+
 def test_the_batches_cover_every_outcome_of_the_power_search():
     """Power at or below the threshold at the loss, reaching it later, and never:
     else the comparison above would be idle."""
@@ -65,3 +86,36 @@ def test_the_batches_cover_every_outcome_of_the_power_search():
     assert any(x == 0.0 for x in lost)
     assert any(0.0 < x < math.inf for x in lost)
     assert any(x == math.inf for x in lost)
+
+
+def test_a_refused_failure_in_a_task_is_its_own_row(monkeypatch):
+    """A failure whose motion is refused, and one whose search is refused within the
+    task's searches together: each its own failed row, naming the error; the others the
+    same rows as before, bit for bit (the task's searches run again one at a time)."""
+    import attitude.envelope.failure as failure
+
+    job, batch = _rows("locked, threshold 0.3")
+    real = failure.motion_after
+
+    def motion_after(job, k):
+        if k == 2:
+            raise ValueError("no motion for failure 2")
+        trajectory = real(job, k)
+        if k == 5:
+            solver = trajectory.segments[0].solver
+
+            def refused(t, scalar_first=True):
+                raise OverflowError("the attitude of failure 5 overflows")
+
+            solver.attitude_quaternion = refused
+        return trajectory
+
+    monkeypatch.setattr(failure, "motion_after", motion_after)
+    rows = evaluate_batch(job, 0, job.count).rows
+    for k, (row, before) in enumerate(zip(rows, batch, strict=True)):
+        if k in (2, 5):
+            assert row["status"] == "failed"
+            assert ("failure 2" if k == 2 else "failure 5") in row["error"]
+            assert all(math.isnan(row[c]) for c in job.columns)
+        else:
+            assert all(_same(row[c], before[c]) for c in before), k

@@ -10,7 +10,11 @@ body (locked wheels, no torque), or the splitting with the exact gyroscopic flow
 (:func:`attitude.pointing.search.pointing_analysis`: torque-free segments on the
 motion's structure, others with rigorous rate bounds) against the surroundings of the
 whole job, built once per process and shared by every τ
-(:func:`attitude.pointing.shared_surroundings.shared_surroundings`).
+(:func:`attitude.pointing.shared_surroundings.shared_surroundings`).  A task's failures
+are searched together (:func:`attitude.pointing.search.pointing_analyses`: their
+torque-free searches as one set of arrays) and their power searches too
+(:func:`_power_search`); each row is the same, bit for bit, as the failure's alone
+(:func:`failure_metrics`), whatever the task it runs in.
 
 The metrics (columns of the table; times in s after τ; ``inf``: not within the window):
 
@@ -52,7 +56,12 @@ from attitude.envelope.power import (
     mean_incidence,
     power_fraction,
 )
-from attitude.pointing.search import OrbitIntervals, pointing_analysis
+from attitude.pointing.search import (
+    OrbitIntervals,
+    PointingAnalysis,
+    pointing_analyses,
+    pointing_analysis,
+)
 from attitude.pointing.shared_surroundings import SharedSurroundings, shared_surroundings
 from attitude.pointing.spec import PointingSpec
 from attitude.scenario.events import State
@@ -195,21 +204,78 @@ def failure_metrics(job: EnvelopeJob, k: int) -> dict[str, Any]:
     return row
 
 
+def _extrema(job: EnvelopeJob) -> list[tuple[str, str]]:
+    """The extrema the rows need: each panel's least Sun angle."""
+    return [(v.name, "sun_angle") for v in job.spec.body_vectors if v.kind == "panel"]
+
+
 def _structure(job: EnvelopeJob, k: int) -> tuple[dict[str, Any], _Power | None]:
     """Failure ``k``'s row but for the power search's two columns, and that search."""
     τ = float(job.seconds[k])
-    end = τ + job.window
     trajectory = motion_after(job, k)
     shared = _surroundings(job, trajectory)
     analysis = pointing_analysis(
         trajectory,
         job.spec,
         τ,
-        end,
+        τ + job.window,
         surroundings=shared,
         orbit=job.orbit,
-        extrema=[(v.name, "sun_angle") for v in job.spec.body_vectors if v.kind == "panel"],
+        extrema=_extrema(job),
     )
+    return _row(job, k, trajectory, analysis, shared)
+
+
+def _structures(job: EnvelopeJob, ks: list[int]) -> list[Any]:
+    """:func:`_structure` of failures ``ks``, their pointing searches together
+    (:func:`attitude.pointing.search.pointing_analyses`: each the same, bit for bit, as
+    alone): for each, its (row, power search), or the exception that refused it.  If
+    the searches together are refused, each is searched alone (to name the one)."""
+    out: list[Any] = [None] * len(ks)
+    motions = []
+    for j, k in enumerate(ks):
+        try:
+            motions.append((j, k, motion_after(job, k)))
+        except Exception as exc:
+            out[j] = exc
+    if not motions:
+        return out
+    shared = _surroundings(job, motions[0][2])
+    try:
+        analyses = pointing_analyses(
+            [trajectory for _, _, trajectory in motions],
+            job.spec,
+            [(float(job.seconds[k]), float(job.seconds[k]) + job.window) for _, k, _ in motions],
+            surroundings=shared,
+            orbit=job.orbit,
+            extrema=_extrema(job),
+        )
+    except Exception:
+        for j, k, _ in motions:
+            try:
+                out[j] = _structure(job, k)
+            except Exception as exc:
+                out[j] = exc
+        return out
+    for (j, k, trajectory), analysis in zip(motions, analyses, strict=True):
+        try:
+            out[j] = _row(job, k, trajectory, analysis, shared)
+        except Exception as exc:
+            out[j] = exc
+    return out
+
+
+def _row(
+    job: EnvelopeJob,
+    k: int,
+    trajectory: Trajectory,
+    analysis: PointingAnalysis,
+    shared: SharedSurroundings,
+) -> tuple[dict[str, Any], _Power | None]:
+    """Failure ``k``'s row from its pointing ``analysis``, but for the power search's
+    two columns, and that search."""
+    τ = float(job.seconds[k])
+    end = τ + job.window
     row: dict[str, Any] = {}
     firsts = []
     for item in analysis.vectors:
@@ -423,21 +489,23 @@ def evaluate_batch(job: EnvelopeJob, first: int, stop: int) -> BatchResult:
     """Failures ``first`` to ``stop − 1`` of ``job``, each a row (runs on a worker).  A
     failure whose motion is refused is a row with its error; the job goes on.
 
-    The power searches of the batch run together (:func:`_power_search`); each row is
-    the same bit for bit as :func:`failure_metrics` gives it alone."""
+    The pointing searches of the batch run together (:func:`_structures`), and so do
+    its power searches (:func:`_power_search`); each row is the same bit for bit as
+    :func:`failure_metrics` gives it alone."""
     started = time.process_time()
     rows = []
     searches: list[_Power] = []
-    for k in range(first, stop):
+    ks = list(range(first, stop))
+    for k, found in zip(ks, _structures(job, ks), strict=True):
         row: dict[str, Any] = {"failure": k, "tau_s": float(job.seconds[k])}
-        try:
-            metrics, power = _structure(job, k)
+        if isinstance(found, Exception):  # a refused motion is this failure's row
+            _failed(row, job, found)
+        else:
+            metrics, power = found
             row.update(metrics, status="ok", error="")
             if power is not None:
                 power.row = row
                 searches.append(power)
-        except Exception as exc:  # a refused motion is this failure's row, not the job's end
-            _failed(row, job, exc)
         rows.append(row)
     if searches:
         try:

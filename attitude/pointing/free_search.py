@@ -48,6 +48,17 @@ the Sun visibility's partition (lit throughout, dark throughout, or cut at its r
 crossing) on the cubic through the ends (Gauss–Legendre, exact for it), with the lit
 fraction of the surroundings where the cell meets the Earth's shadow.
 
+**Many searches at once** (:func:`search_free_many`: the loss-of-control envelope's
+windows after each failure, each a run of pieces within one window of nodes): their nodes are put
+end to end in one window, where no cell joins two pieces, so that each call of the
+evaluator (the exact attitude of each piece, the surroundings, the cosines) serves all
+of them.  Everything else is element by element (each cell's bounds, cuts, crossings
+and Newton steps from its own values) or the search's own (its best extrema, the
+cells of its own that decide whether the envelope tightens their bounds, its
+intervals, its sums in the order it has alone, golden-section search on its own
+cells), so each search's result is the one :func:`search_free` gives it alone, bit
+for bit; a search costs a few evaluation calls whatever the number searched with it.
+
 **The envelope.**  |f − B| ≤ A: a vector whose Sun cosine cannot change sign (|B| > A
 throughout: a panel on the spin axis), or a cone the Sun cannot reach, is settled for
 the whole segment without a node; see :func:`_settled_by_envelope`.
@@ -72,9 +83,13 @@ __all__ = [
     "FreePlan",
     "FreeResult",
     "VectorMotion",
+    "fits_one_window",
     "free_plan",
+    "free_plans",
     "search_free",
+    "search_free_many",
     "vector_motion",
+    "vector_motions",
 ]
 
 # Nodes: the curvature bound's overshoot between nodes, M h²/8, at most this (a
@@ -216,66 +231,115 @@ def vector_motion(
     its expansion to first order plus the second-order remainder.  Each result is also
     capped by its analytic bound (module notes).
     """
-    moments = np.sort(np.asarray(solver.moments_of_inertia, dtype=np.float64))
-    G = float(solver.angular_momentum_norm)
-    least = float(moments[0])
-    if G == 0.0:
-        return {name: VectorMotion(0.0, 0.0) for name, _ in vectors}
-    fastest = math.sqrt(max(2.0 * solver.kinetic_energy, 0.0) / least)
-    spin_accel = (float(moments[2]) - least) / least * fastest * fastest / math.sqrt(3.0)
-    period = solver.period
-    periodic = math.isfinite(period) and period < end_s - start_s
-    window = period if periodic else max(end_s - start_s, 0.0)
-    # Hundreds of samples a turn of the body, within [256, 16384].
-    turns = window * fastest / (2.0 * math.pi)
-    samples = int(min(max(_SAMPLES_PER_TURN * turns, _MOTION_SAMPLES_LEAST), _MOTION_SAMPLES))
-    t = start_s + window * np.arange(samples + 1.0) / samples
-    tensor = np.asarray(solver.inertia_tensor, dtype=np.float64)
-    inverse = np.asarray(np.linalg.inv(tensor), dtype=np.float64)
+    return vector_motions([solver], vectors, [(start_s, end_s)])[0]
+
+
+def vector_motions(
+    solvers: list[EulerSolver],
+    vectors: list[tuple[str, NDArray[np.float64]]],
+    spans: list[tuple[float, float]],
+) -> list[dict[str, VectorMotion]]:
+    """:func:`vector_motion` of each solver over its span (``spans[i]``: start and
+    end): each solver's ω at its own samples, then the arithmetic of all in one pass
+    over their samples put end to end (element by element, each sample with its own
+    solver's constants; each maximum over its solver's samples alone), so that each
+    result is the one :func:`vector_motion` gives it alone, bit for bit."""
+    out: list[dict[str, VectorMotion] | None] = [None] * len(solvers)
+    live = []  # (index, start_s, scalars) of the solvers with a momentum
+    ω_parts, tensors, inverses, gaps = [], [], [], []
+    for i, (solver, (start_s, end_s)) in enumerate(zip(solvers, spans, strict=True)):
+        moments = np.sort(np.asarray(solver.moments_of_inertia, dtype=np.float64))
+        G = float(solver.angular_momentum_norm)
+        least = float(moments[0])
+        if G == 0.0:
+            out[i] = {name: VectorMotion(0.0, 0.0) for name, _ in vectors}
+            continue
+        fastest = math.sqrt(max(2.0 * solver.kinetic_energy, 0.0) / least)
+        spin_accel = (float(moments[2]) - least) / least * fastest * fastest / math.sqrt(3.0)
+        period = solver.period
+        periodic = math.isfinite(period) and period < end_s - start_s
+        window = period if periodic else max(end_s - start_s, 0.0)
+        # Hundreds of samples a turn of the body, within [256, 16384].
+        turns = window * fastest / (2.0 * math.pi)
+        samples = int(min(max(_SAMPLES_PER_TURN * turns, _MOTION_SAMPLES_LEAST), _MOTION_SAMPLES))
+        t = start_s + window * np.arange(samples + 1.0) / samples
+        tensor = np.asarray(solver.inertia_tensor, dtype=np.float64)
+        inverse = np.asarray(np.linalg.inv(tensor), dtype=np.float64)
+        spacing = window / samples
+        gap = 0.5 * spacing
+        # A bound on the third derivative of ω: each component of Euler's equations is
+        # a product of two others with a coefficient at most Λ = (I3 − I1)/I1 (principal
+        # axes), and every component is at most Ω, so by Leibniz's rule each component
+        # of ω⁽ᵏ⁾ is at most k! Λᵏ Ω^(k+1), and |ω⁽³⁾| ≤ √3 · 6 Λ³ Ω⁴.
+        Λ = (float(moments[2]) - least) / least
+        third = math.sqrt(3.0) * 6.0 * Λ**3 * fastest**4
+        # |ω⃛| + 2|ω̈||ω| + 2|ω̇|² ≤ (6√3 Λ³ + 4√3 Λ² + 6 Λ²) Ω⁴ by the same majorant.
+        second = (6.0 * math.sqrt(3.0) * Λ**3 + (4.0 * math.sqrt(3.0) + 6.0) * Λ**2) * fastest**4
+        ω_parts.append(solver.angular_velocity(t))
+        tensors.append(tensor)
+        inverses.append(inverse)
+        gaps.append(gap)
+        scalars = (fastest, spin_accel, periodic, window, spacing, gap, third, second)
+        live.append((i, start_s, t.size, scalars))
+    if not live:
+        return out  # type: ignore[return-value]
+    counts = [size for _, _, size, _ in live]
+    starts = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.intp)
+    # Each sample's solver's I and I⁻¹ ((3, 3, samples): matrix[i, j] a column) and Δ/2.
+    tensor_of = np.repeat(np.stack(tensors, axis=-1), counts, axis=-1)
+    inverse_of = np.repeat(np.stack(inverses, axis=-1), counts, axis=-1)
+    gap_of = np.repeat(np.array(gaps), counts)
     # Columns (x, y, z) of the samples: ω, m = Iω, α = I⁻¹(m × ω), and ω̈ = α̇ =
     # I⁻¹((m × ω) × ω + m × α).
-    ω = _columns(solver.angular_velocity(t))
-    m = _apply(tensor, ω)
+    ω = _columns(np.concatenate(ω_parts))
+    m = _apply(tensor_of, ω)
     mω = _cross(m, ω)
-    α = _apply(inverse, mω)
-    α_rate = _apply(inverse, _add(_cross(mω, ω), _cross(m, α)))
-    spacing = window / samples
-    gap = 0.5 * spacing
+    α = _apply(inverse_of, mω)
+    α_rate = _apply(inverse_of, _add(_cross(mω, ω), _cross(m, α)))
     size = _norm(m)
     m_hat = (m[0] / size, m[1] / size, m[2] / size)
     drift = _cross(m_hat, ω)  # dm̂/dt in the body (ṁ = m × ω)
-    # A bound on the third derivative of ω: each component of Euler's equations is a
-    # product of two others with a coefficient at most Λ = (I3 − I1)/I1 (principal
-    # axes), and every component is at most Ω, so by Leibniz's rule each component of
-    # ω⁽ᵏ⁾ is at most k! Λᵏ Ω^(k+1), and |ω⁽³⁾| ≤ √3 · 6 Λ³ Ω⁴.
-    Λ = (float(moments[2]) - least) / least
-    third = math.sqrt(3.0) * 6.0 * Λ**3 * fastest**4
-    # |ω⃛| + 2|ω̈||ω| + 2|ω̇|² ≤ (6√3 Λ³ + 4√3 Λ² + 6 Λ²) Ω⁴ by the same majorant.
-    second = (6.0 * math.sqrt(3.0) * Λ**3 + (4.0 * math.sqrt(3.0) + 6.0) * Λ**2) * fastest**4
-    out = {}
+    found: list[dict[str, VectorMotion]] = [{} for _ in live]
     for name, b in vectors:
         ωb = _cross_vector(ω, b)
         αb = _cross_vector(α, b)
         # |ω × b| within Δ/2 of a sample: Taylor's expansion to second order there,
         # and the third-order remainder.
-        taylor = _norm(ωb) + _norm(αb) * gap + 0.5 * _norm(_cross_vector(α_rate, b)) * gap * gap
-        rate = min(float(np.max(taylor)) + third * gap**3 / 6.0, fastest)
+        taylor = (
+            _norm(ωb) + _norm(αb) * gap_of + 0.5 * _norm(_cross_vector(α_rate, b)) * gap_of * gap_of
+        )
         # |d̈| = |α × b + ω × (ω × b)| within Δ/2 of a sample: its value and exact rate
         # there (α̇ × b + α × (ω × b) + ω × (α × b)), and the second-order remainder.
         bend = _add(αb, _cross(ω, ωb))
         bend_rate = _add(_add(_cross_vector(α_rate, b), _cross(α, ωb)), _cross(ω, αb))
-        bent = float(np.max(_norm(bend) + _norm(bend_rate) * gap)) + 0.5 * second * gap * gap
         tilt = m_hat[0] * b[0] + m_hat[1] * b[1] + m_hat[2] * b[2]
         # |d/dt (b·m̂)| = |b·(m̂ × ω)|, whose own rate is at most Ω² + A.
         tilt_rate = drift[0] * b[0] + drift[1] * b[1] + drift[2] * b[2]
-        slack = (float(np.max(np.abs(tilt_rate))) + (fastest * fastest + spin_accel) * gap) * gap
-        values = None
-        if window > 0.0:
-            values = tilt[:-1] if periodic else tilt
-        out[name] = VectorMotion(
-            rate, min(bent, spin_accel + fastest * rate), values, start_s, spacing, periodic, slack
-        )
-    return out
+        # Each solver's maxima over its own samples (a maximum is exact, in any order).
+        taylor_max = np.maximum.reduceat(taylor, starts)
+        bend_max = np.maximum.reduceat(_norm(bend) + _norm(bend_rate) * gap_of, starts)
+        tilt_rate_max = np.maximum.reduceat(np.abs(tilt_rate), starts)
+        for j, (_, start_s, count, scalars) in enumerate(live):
+            fastest, spin_accel, periodic, window, spacing, gap, third, second = scalars
+            rate = min(float(taylor_max[j]) + third * gap**3 / 6.0, fastest)
+            bent = float(bend_max[j]) + 0.5 * second * gap * gap
+            slack = (float(tilt_rate_max[j]) + (fastest * fastest + spin_accel) * gap) * gap
+            values = None
+            if window > 0.0:
+                own = tilt[starts[j] : starts[j] + count]
+                values = np.array(own[:-1] if periodic else own)
+            found[j][name] = VectorMotion(
+                rate,
+                min(bent, spin_accel + fastest * rate),
+                values,
+                start_s,
+                spacing,
+                periodic,
+                slack,
+            )
+    for j, (i, _, _, _) in enumerate(live):
+        out[i] = found[j]
+    return out  # type: ignore[return-value]
 
 
 def _columns(v: NDArray[np.float64]):
@@ -331,9 +395,30 @@ def free_plan(
     """The :class:`FreePlan` of a segment, or None when a bound is not finite (a piece
     of the surroundings evaluated exactly, an orbit inside the limb's sphere): the
     segment is then searched on a grid (:mod:`attitude.pointing.search`)."""
+    return free_plans([solver], spec, shared, [(start_s, end_s)])[0]
+
+
+def free_plans(
+    solvers: list[EulerSolver],
+    spec: PointingSpec,
+    shared: SharedSurroundings,
+    spans: list[tuple[float, float]],
+) -> list[FreePlan | None]:
+    """:func:`free_plan` of each solver over its span (``spans[i]``), the motions'
+    bounds of all found together (:func:`vector_motions`): each the same, bit for bit,
+    as alone."""
     vectors = [(v.name, v.vector) for v in spec.body_vectors]
-    motion = vector_motion(solver, vectors, start_s, end_s)
     sky = shared.rate_bounds()
+    motions = vector_motions(solvers, vectors, spans)
+    return [
+        _plan(motion, sky, vectors, start_s, end_s)
+        for motion, (start_s, end_s) in zip(motions, spans, strict=True)
+    ]
+
+
+def _plan(motion, sky, vectors, start_s: float, end_s: float) -> FreePlan | None:
+    """The :class:`FreePlan` from a segment's :class:`VectorMotion` of each vector and
+    the sky's rate bounds."""
     targets = [t for t in TARGETS if f"{t}_1" in sky]
     bend = {}
     for name, _ in vectors:
@@ -399,6 +484,7 @@ class _Evaluator:
         self.targets = [t for t in TARGETS if t != "nadir" or spec.orbit is not None]
         self.tensors = [np.asarray(p.solver.inertia_tensor, dtype=np.float64) for p in pieces]
         self.inverses = [np.linalg.inv(t) for t in self.tensors]
+        self.inverses_stacked = np.array(self.inverses).reshape(-1, 3, 3)
         axes, momenta = [], []
         for piece in pieces:
             momentum = np.asarray(piece.solver.inertial_angular_momentum, dtype=np.float64)
@@ -440,25 +526,23 @@ class _Evaluator:
         # The body momentum m = Qᵀ H (H the segment's inertial momentum, constant: the
         # solver's Q maps m onto it by construction), ω = I⁻¹ m and α = I⁻¹(m × ω)
         # (Euler's equations without torque): no second pass of the solver over τ.
-        ω_in = [np.empty(n) for _ in range(3)]
-        α_in = [np.empty(n) for _ in range(3)]
-        for k, mine in groups:
-            h = self.momenta[k]
-            inverse = self.inverses[k]
-            r = [[c[mine] for c in row] for row in rows]
-            m = [r[0][i] * h[0] + r[1][i] * h[1] + r[2][i] * h[2] for i in range(3)]
-            ω = [
-                inverse[i, 0] * m[0] + inverse[i, 1] * m[1] + inverse[i, 2] * m[2] for i in range(3)
-            ]
-            mω = (m[1] * ω[2] - m[2] * ω[1], m[2] * ω[0] - m[0] * ω[2], m[0] * ω[1] - m[1] * ω[0])
-            α = [
-                inverse[i, 0] * mω[0] + inverse[i, 1] * mω[1] + inverse[i, 2] * mω[2]
-                for i in range(3)
-            ]
-            for i in range(3):
-                # Inertial: ω_in = R ω.
-                ω_in[i][mine] = r[i][0] * ω[0] + r[i][1] * ω[1] + r[i][2] * ω[2]
-                α_in[i][mine] = r[i][0] * α[0] + r[i][1] * α[1] + r[i][2] * α[2]
+        # Each point takes its piece's H and I⁻¹ (element by element: a point's values
+        # do not depend on the others evaluated with it).
+        if len(groups) == 1:
+            h = self.momenta[groups[0][0]]
+            inverse = self.inverses[groups[0][0]]
+        else:
+            h = self.momenta[piece].T
+            inverse = np.moveaxis(self.inverses_stacked[piece], 0, -1)
+        m = [rows[0][i] * h[0] + rows[1][i] * h[1] + rows[2][i] * h[2] for i in range(3)]
+        ω = [inverse[i, 0] * m[0] + inverse[i, 1] * m[1] + inverse[i, 2] * m[2] for i in range(3)]
+        mω = (m[1] * ω[2] - m[2] * ω[1], m[2] * ω[0] - m[0] * ω[2], m[0] * ω[1] - m[1] * ω[0])
+        α = [
+            inverse[i, 0] * mω[0] + inverse[i, 1] * mω[1] + inverse[i, 2] * mω[2] for i in range(3)
+        ]
+        # Inertial: ω_in = R ω.
+        ω_in = [rows[i][0] * ω[0] + rows[i][1] * ω[1] + rows[i][2] * ω[2] for i in range(3)]
+        α_in = [rows[i][0] * α[0] + rows[i][1] * α[1] + rows[i][2] * α[2] for i in range(3)]
         sky = self.shared.targets(τ, accelerations=bool(bent))
         f: dict[str, list] = {t: [] for t in wanted}
         df: dict[str, list] = {t: [] for t in wanted}
@@ -865,6 +949,36 @@ def _nodes(pieces: list[FreePiece]) -> tuple[NDArray[np.float64], NDArray[np.int
     return np.concatenate(times), np.concatenate(owner)
 
 
+def _eclipse_ends(shadow: list[Interval], umbra: list[Interval]) -> NDArray[np.float64]:
+    return np.array([x for i in [*shadow, *umbra] for x in (i.start_s, i.end_s)], dtype=np.float64)
+
+
+def _with_ends(τ, owner, ends):
+    """The nodes τ (of pieces ``owner``) with the eclipses' ``ends`` inside them added:
+    the lit fraction has kinks there."""
+    inside = ends[(ends > τ[0]) & (ends < τ[-1])]
+    if inside.size:
+        piece_of = owner[np.clip(np.searchsorted(τ, inside, side="right") - 1, 0, τ.size - 1)]
+        order = np.lexsort((np.concatenate([τ, inside]), np.concatenate([owner, piece_of])))
+        τ = np.concatenate([τ, inside])[order]
+        owner = np.concatenate([owner, piece_of])[order]
+    return τ, owner
+
+
+def _bend_bounds(pieces: list[FreePiece], conditions: list[_Condition], names: list[str]):
+    """The bound on |g''| of each condition on each piece: (conditions, pieces)."""
+    return np.array(
+        [
+            [
+                p.plan.bend[(names[c.vector], c.target)]
+                + (p.plan.limb_bend if c.kind == "limb" else 0.0)
+                for p in pieces
+            ]
+            for c in conditions
+        ]
+    ).reshape(len(conditions), len(pieces))
+
+
 def search_free(
     pieces: list[FreePiece],
     spec: PointingSpec,
@@ -887,53 +1001,117 @@ def search_free(
     evaluate = _Evaluator(pieces, spec, shared)
     conditions = conditions_of(spec)
     names = [v.name for v in spec.body_vectors]
-    M = np.array(
-        [
-            [
-                p.plan.bend[(names[c.vector], c.target)]
-                + (p.plan.limb_bend if c.kind == "limb" else 0.0)
-                for p in pieces
-            ]
-            for c in conditions
-        ]
-    ).reshape(len(conditions), len(pieces))
+    M = _bend_bounds(pieces, conditions, names)
     out: dict[str, list[Interval]] = {c.name: [] for c in conditions}
     best: dict[str, Extremum] = {}
     integral = dict.fromkeys(names, 0.0)
     dark = dict.fromkeys(names, False)
-    ends = np.array([x for i in [*shadow, *umbra] for x in (i.start_s, i.end_s)], dtype=np.float64)
+    ends = _eclipse_ends(shadow, umbra)
     τ_all, owner_all = _nodes(pieces)
+    alone = np.zeros(len(pieces), dtype=np.intp)  # every piece is of the one search
     first = 0
     while first < τ_all.size - 1:
         last = min(first + WINDOW_NODES, τ_all.size - 1)
-        τ, owner = τ_all[first : last + 1], owner_all[first : last + 1]
-        # The eclipses' ends are nodes (the lit fraction has kinks there).
-        inside = ends[(ends > τ[0]) & (ends < τ[-1])]
-        if inside.size:
-            piece_of = owner[np.clip(np.searchsorted(τ, inside, side="right") - 1, 0, τ.size - 1)]
-            order = np.lexsort((np.concatenate([τ, inside]), np.concatenate([owner, piece_of])))
-            τ = np.concatenate([τ, inside])[order]
-            owner = np.concatenate([owner, piece_of])[order]
-        window = _Window(evaluate, spec, shared, pieces, conditions, M, τ, owner, shadow, umbra)
+        τ, owner = _with_ends(τ_all[first : last + 1], owner_all[first : last + 1], ends)
+        window = _Window(
+            evaluate, spec, shared, pieces, conditions, M, τ, owner, alone, [shadow], [umbra]
+        )
         # The last window's intervals reach the pieces' end (its node may be before it).
         end_s = pieces[-1].end_s if last == τ_all.size - 1 else None
         found = window.search(
-            precision_s, problems, incumbents, best, tolerance, extremum_precision_s, end_s
-        )
+            precision_s, [problems], [incumbents], [best], tolerance, extremum_precision_s, [end_s]
+        )[0]
         for name, pieces_found in found.items():
             if first == 0:
                 join(out[name], pieces_found, float(τ[0]))
             else:
                 append_across(out[name], pieces_found, float(τ[0]))
-        for name, value in window.incidence().items():
+        for name, value in window.incidence()[0].items():
             integral[name] += value
-        for name, value in window.dark().items():
+        for name, value in window.dark()[0].items():
             dark[name] = dark[name] or value
         for k in range(int(owner[0]), int(owner[-1]) + (1 if last == τ_all.size - 1 else 0)):
             for motion in pieces[k].plan.motion.values():
                 motion.release()  # the pieces behind: their tables are not needed again
         first = last
     return FreeResult(out, best, integral, dark, evaluate.points)
+
+
+def fits_one_window(pieces: list[FreePiece]) -> bool:
+    """Whether :func:`search_free` searches ``pieces`` in one window (what
+    :func:`search_free_many` takes)."""
+    return sum(max(math.ceil((p.end_s - p.start_s) / p.plan.step_s), 1) + 1 for p in pieces) <= (
+        WINDOW_NODES + 1
+    )
+
+
+def search_free_many(
+    runs: list[list[FreePiece]],
+    spec: PointingSpec,
+    shared: SharedSurroundings,
+    precision_s: float,
+    extremum_precision_s: float,
+    tolerance: float,
+    problems: list[dict[str, Problem]],
+    incumbents: list[dict[str, Extremum | None]],
+    shadows: list[list[Interval]],
+    umbras: list[list[Interval]],
+) -> list[FreeResult]:
+    """:func:`search_free` of many independent searches at once (the envelope's
+    windows after each failure): ``runs[g]`` the consecutive pieces of search g, each
+    within one window (:func:`fits_one_window`), with its ``problems[g]`` (the same
+    names for all, each its own rate bounds), its ``incumbents[g]`` and its eclipses
+    ``shadows[g]``, ``umbras[g]``.  Their nodes form one window in which no cell joins
+    two pieces; each call of the evaluator serves every search, and every quantity of a
+    search is computed element by element from its own points, with its own decisions
+    (its extrema, its counts), so that each result is the one :func:`search_free` gives
+    for that search alone, bit for bit."""
+    pieces = [p for run in runs for p in run]
+    evaluate = _Evaluator(pieces, spec, shared)
+    conditions = conditions_of(spec)
+    names = [v.name for v in spec.body_vectors]
+    M = _bend_bounds(pieces, conditions, names)
+    group_of = np.concatenate(
+        [np.full(len(run), g, dtype=np.intp) for g, run in enumerate(runs)]
+    ).astype(np.intp)
+    times, owners, offset = [], [], 0
+    for run, shadow, umbra in zip(runs, shadows, umbras, strict=True):
+        if not fits_one_window(run):
+            raise ValueError("search_free_many takes searches of one window each")
+        τ, owner = _nodes(run)
+        τ, owner = _with_ends(τ, owner + offset, _eclipse_ends(shadow, umbra))
+        times.append(τ)
+        owners.append(owner)
+        offset += len(run)
+    τ_all, owner_all = np.concatenate(times), np.concatenate(owners)
+    window = _Window(
+        evaluate, spec, shared, pieces, conditions, M, τ_all, owner_all, group_of, shadows, umbras
+    )
+    best: list[dict[str, Extremum]] = [{} for _ in runs]
+    found = window.search(
+        precision_s,
+        problems,
+        incumbents,
+        best,
+        tolerance,
+        extremum_precision_s,
+        [run[-1].end_s for run in runs],
+    )
+    incidence, dark = window.incidence(), window.dark()
+    results = []
+    for g in range(len(runs)):
+        start_s = float(times[g][0])
+        out: dict[str, list[Interval]] = {c.name: [] for c in conditions}
+        for name, pieces_found in found[g].items():
+            join(out[name], pieces_found, start_s)
+        integral = {name: 0.0 + incidence[g].get(name, 0.0) for name in names}
+        darks = {name: False or dark[g].get(name, False) for name in names}
+        results.append(FreeResult(out, best[g], integral, darks, int(times[g].size)))
+    for run in runs:
+        for piece in run:
+            for motion in piece.plan.motion.values():
+                motion.release()
+    return results
 
 
 def _in_any(τ: NDArray[np.float64], intervals: list[Interval]) -> NDArray[np.bool_]:
@@ -946,14 +1124,49 @@ def _in_any(τ: NDArray[np.float64], intervals: list[Interval]) -> NDArray[np.bo
     return (k >= 0) & (τ <= ends[np.maximum(k, 0)])
 
 
-class _Window:
-    """One window of nodes (τ, each of a piece: ``owner``), searched."""
+def _by_group(group: NDArray[np.intp], count: int):
+    """(g, indices) of each search g that ``group`` (each element's search) holds, the
+    indices in their order: one search's elements in the order it has alone."""
+    if count == 1:
+        return [(0, np.arange(group.size))] if group.size else []
+    order = np.argsort(group, kind="stable")
+    cuts = np.searchsorted(group[order], np.arange(count + 1))
+    return [(g, order[cuts[g] : cuts[g + 1]]) for g in range(count) if cuts[g + 1] > cuts[g]]
 
-    def __init__(self, evaluate, spec, shared, pieces, conditions, M, τ, owner, shadow, umbra):
+
+def _in_any_of(
+    τ: NDArray[np.float64], group: NDArray[np.intp], lists: list[list[Interval]]
+) -> NDArray[np.bool_]:
+    """:func:`_in_any` of each time in the intervals of its search (``group``)."""
+    if len(lists) == 1:
+        return _in_any(τ, lists[0])
+    out = np.zeros(τ.shape, dtype=bool)
+    for g, which in _by_group(group, len(lists)):
+        if lists[g]:
+            out[which] = _in_any(τ[which], lists[g])
+    return out
+
+
+class _Window:
+    """One window of nodes (τ, each of a piece: ``owner``), searched: the nodes of one
+    search, or of many independent ones (:func:`search_free_many`; ``group``: each
+    piece's search, whose nodes are contiguous, with its eclipses ``shadows[g]`` and
+    ``umbras[g]``), each search's extrema, intervals and sums its own."""
+
+    def __init__(
+        self, evaluate, spec, shared, pieces, conditions, M, τ, owner, group, shadows, umbras
+    ):
         self.evaluate, self.spec, self.shared, self.pieces = evaluate, spec, shared, pieces
         self.fraction_rate = pieces[0].plan.sky.get("fraction_1", math.inf)
         self.conditions, self.M, self.τ, self.owner = conditions, M, τ, owner
-        self.shadow, self.umbra = shadow, umbra
+        self.shadows, self.umbras = shadows, umbras
+        self.groups = len(shadows)
+        self.piece_group = group
+        self.node_group = group[owner]
+        cuts = np.searchsorted(self.node_group, np.arange(self.groups + 1))
+        # Each search's nodes: τ[first[g] : first[g + 1]].
+        self.first = cuts
+        self.any_shadow = any(bool(s) for s in shadows)
         self.limb_rate = shared.rate_bounds().get("limb_1", 0.0)
         # Which targets the conditions look at (the cuts and crossings ask only those),
         # and the Sun's bend for the incidence's integral.
@@ -963,6 +1176,7 @@ class _Window:
         self.g = at_nodes[0]
         # Cells join neighbouring nodes of one piece.
         self.cell = np.flatnonzero(owner[1:] == owner[:-1])
+        self.cell_group = self.node_group[self.cell]
         K = len(conditions)
         i = self.cell
         k = np.repeat(np.arange(K), i.size)
@@ -980,7 +1194,7 @@ class _Window:
         self.cross = np.full(self.status.size, np.nan)
         self._cosines: dict = {}
         self._envelopes: dict = {}
-        self.found: dict[str, list[Interval]] = {}
+        self.found: list[dict[str, list[Interval]]] = [{} for _ in shadows]
 
     def _condition_envelope(self, cells: _Cells):
         """For :func:`_settle`: each cell's angle bounds to its condition's target and
@@ -1012,15 +1226,17 @@ class _Window:
     def search(
         self, precision_s, problems, incumbents, best, tolerance, extremum_precision_s, end_s=None
     ):
-        """Every condition's intervals over the window (returned; to ``end_s`` if given,
-        else to its last node) and the extrema of ``problems`` (folded into ``best``).
-        The crossings' estimates and the extrema's first Newton points are evaluated in
-        one call."""
+        """Every condition's intervals over the window, for each search g (returned; to
+        ``end_s[g]`` if given, else to its last node) and the extrema of
+        ``problems[g]`` (folded into ``best[g]``, from ``incumbents[g]``).  The
+        crossings' estimates and the extrema's first Newton points are evaluated in one
+        call."""
         crossing = self.status == 1
         cells = self.cells.take(crossing)
         h = cells.b - cells.a
         c = _cubic(cells.ga, cells.da, cells.gb, cells.db, h)
         x = cells.a + _cubic_root(c, cells.ga, cells.gb) * h
+        problems_of, problems = problems, problems[0]  # each search's, and their names
         newton = self._extrema_start(problems, incumbents, best, tolerance)
         points = np.concatenate([x, newton.x])
         owners = np.concatenate([cells.p, newton.piece])
@@ -1036,28 +1252,42 @@ class _Window:
             )
         times = self._crossings(cells, x, at, precision_s)
         self.cross[crossing] = times
-        self._extrema_finish(newton, at, x.size, problems, best, tolerance, extremum_precision_s)
-        return self._intervals(cells, times, self.τ[-1] if end_s is None else end_s)
+        self._extrema_finish(newton, at, x.size, problems_of, best, tolerance, extremum_precision_s)
+        ends = [
+            self.τ[self.first[g + 1] - 1] if e is None else e
+            for g, e in enumerate(end_s or [None] * self.groups)
+        ]
+        return self._intervals(cells, times, ends)
 
-    def _intervals(self, cells: _Cells, times, end_s: float) -> dict[str, list[Interval]]:
-        """Each condition's intervals over the window from its crossings' ``times`` (a
-        crossing at each event where the condition's value jumps across 0)."""
+    def _intervals(self, cells: _Cells, times, end_s: list[float]):
+        """Each search's conditions' intervals over the window from its crossings'
+        ``times`` (a crossing at each event where the condition's value jumps across 0),
+        to its ``end_s``."""
         entering = cells.ga <= 0.0
-        # Events inside the window: the pieces' last nodes and the next ones' first.
-        τ, owner = self.τ, self.owner
-        boundary = np.flatnonzero(owner[1:] != owner[:-1])
-        w = np.array([τ[0], end_s])
-        out = {}
+        # Events inside the window: a search's pieces' last nodes and the next ones' first.
+        τ, owner, node_group = self.τ, self.owner, self.node_group
+        boundary = np.flatnonzero((owner[1:] != owner[:-1]) & (node_group[1:] == node_group[:-1]))
+        out: list[dict[str, list[Interval]]] = [{} for _ in range(self.groups)]
+        cell_group = self.piece_group[cells.p]
         for index, condition in enumerate(self.conditions):
             mine = np.flatnonzero(cells.k == index)
-            g = self.g[index]
-            jumps = boundary[(g[boundary] > 0.0) != (g[boundary + 1] > 0.0)]
-            at = np.concatenate([times[mine], τ[jumps + 1]])
-            enters = np.concatenate([entering[mine], g[jumps + 1] > 0.0])
-            order = np.argsort(at, kind="stable")
-            pieces = _assemble(w, np.array([g[0] > 0.0]), at[order], enters[order])
-            self.found[condition.name] = pieces
-            out[condition.name] = pieces
+            g_all = self.g[index]
+            jumps_all = boundary[(g_all[boundary] > 0.0) != (g_all[boundary + 1] > 0.0)]
+            jump_group = node_group[jumps_all]
+            for group in range(self.groups):
+                if self.groups == 1:
+                    own, jumps = mine, jumps_all
+                else:
+                    own = mine[cell_group[mine] == group]
+                    jumps = jumps_all[jump_group == group]
+                first = self.first[group]
+                w = np.array([τ[first], end_s[group]])
+                at = np.concatenate([times[own], τ[jumps + 1]])
+                enters = np.concatenate([entering[own], g_all[jumps + 1] > 0.0])
+                order = np.argsort(at, kind="stable")
+                pieces = _assemble(w, np.array([g_all[first] > 0.0]), at[order], enters[order])
+                self.found[group][condition.name] = pieces
+                out[group][condition.name] = pieces
         return out
 
     def _crossings(self, cells: _Cells, x, at, precision_s: float) -> NDArray[np.float64]:
@@ -1106,12 +1336,13 @@ class _Window:
     # ------------------------------------------------------------------ extrema
 
     def _quantities(
-        self, values: _Values, τ: NDArray[np.float64], fraction=None
+        self, values: _Values, τ: NDArray[np.float64], fraction=None, group=None
     ) -> dict[str, NDArray]:
-        """Each problem's function (to minimize) at τ (the lit fraction there, if known)."""
+        """Each problem's function (to minimize) at τ (the lit fraction there, if known;
+        ``group``: each time's search)."""
         out = {}
         if fraction is None:
-            fraction = self._fraction(τ)
+            fraction = self._fraction(τ, group)
         for j, v in enumerate(self.spec.body_vectors):
             for quantity, q in self._vector_quantities(values, j, fraction).items():
                 out[f"{v.name}.{quantity}.low"] = q
@@ -1130,27 +1361,36 @@ class _Window:
             q["earth_limb_angle"] = values.angle["nadir"][j] - values.limb
         return q
 
-    def _fraction(self, τ: NDArray[np.float64]) -> NDArray[np.float64]:
-        """The lit fraction: 1 outside the shadow, 0 in umbra, the surroundings' else."""
+    def _fraction(self, τ: NDArray[np.float64], group=None) -> NDArray[np.float64]:
+        """The lit fraction at τ (``group``: each time's search; None: the window's one
+        search): 1 outside the shadow, 0 in umbra, the surroundings' else."""
         fraction = np.ones(τ.shape)
-        if not self.shadow:
+        if not self.any_shadow:
             return fraction
-        in_umbra = _in_any(τ, self.umbra)
-        partial = _in_any(τ, self.shadow) & ~in_umbra
+        if group is None:
+            assert self.groups == 1
+            group = np.zeros(τ.shape, dtype=np.intp)
+        in_umbra = _in_any_of(τ, group, self.umbras)
+        partial = _in_any_of(τ, group, self.shadows) & ~in_umbra
         fraction[in_umbra] = 0.0
         if np.any(partial):
             fraction[partial] = self.shared.at(τ[partial]).sunlit_fraction
         return fraction
 
-    def _cell_in(self, intervals: list[Interval]) -> NDArray[np.bool_]:
-        """Whether each cell (between nodes) meets one of the intervals."""
-        a, b = self.τ[self.cell], self.τ[self.cell + 1]
-        if not intervals:
-            return np.zeros(a.size, dtype=bool)
-        starts = np.array([i.start_s for i in intervals])
-        ends = np.array([i.end_s for i in intervals])
-        k = np.searchsorted(starts, b, side="left") - 1  # the last interval starting before b
-        return (k >= 0) & (ends[np.maximum(k, 0)] > a)
+    def _cell_in(self, lists: list[list[Interval]]) -> NDArray[np.bool_]:
+        """Whether each cell (between nodes) meets one of its search's intervals
+        (``lists[g]``)."""
+        out = np.zeros(self.cell.size, dtype=bool)
+        for g, which in _by_group(self.cell_group, self.groups):
+            intervals = lists[g]
+            if not intervals:
+                continue
+            a, b = self.τ[self.cell[which]], self.τ[self.cell[which] + 1]
+            starts = np.array([i.start_s for i in intervals])
+            ends = np.array([i.end_s for i in intervals])
+            k = np.searchsorted(starts, b, side="left") - 1  # the last one starting before b
+            out[which] = (k >= 0) & (ends[np.maximum(k, 0)] > a)
+        return out
 
     def _cosine_bounds(self, target: str):
         """Bounds (low, high), (vectors, cells), on every vector's cosine with ``target``
@@ -1207,7 +1447,12 @@ class _Window:
             if ask_where is None:
                 return lo, hi
             ask = np.flatnonzero(ask_where(lo, hi))
-            if ask.size <= _ENVELOPE_LEAST:
+            if self.groups > 1:  # each search's own count
+                counts = np.bincount(self.cell_group[ask], minlength=self.groups)
+                ask = ask[counts[self.cell_group[ask]] > _ENVELOPE_LEAST]
+                if not ask.size:
+                    return lo, hi
+            elif ask.size <= _ENVELOPE_LEAST:
                 return lo, hi  # a few cells: Newton's steps cost less than the envelope
             env_low, env_high = self._envelope_at(j, target, ask)
             if as_cosine:
@@ -1221,11 +1466,11 @@ class _Window:
         if quantity == "cos_incidence":
             low, high = tighten(np.maximum(low, 0.0), np.maximum(high, 0.0), True, interesting)
             low, high = np.maximum(low, 0.0), np.maximum(high, 0.0)
-            if not self.shadow:
+            if not self.any_shadow:
                 return low, high
             # The lit fraction: 1 outside the shadow, 0 in umbra, and in the penumbra
             # at most the ends' greater plus its rate over half the cell.
-            outside = ~self._cell_in(self.shadow)
+            outside = ~self._cell_in(self.shadows)
             fraction = self._node_fraction
             most = np.maximum(fraction[i], fraction[i + 1]) + self.fraction_rate * 0.5 * h
             return np.where(outside, low, 0.0), np.where(
@@ -1263,22 +1508,33 @@ class _Window:
         bounds could beat them (by ``tolerance``), and Newton's first points in them
         (where the quantity is smooth; the rest go to golden-section search)."""
         τ = self.τ
-        self._node_fraction = self._fraction(τ)
+        self._node_fraction = self._fraction(τ, self.node_group)
         on_nodes = self._quantities(self.values, τ, self._node_fraction)
         self._node_problems = on_nodes
-        for name in problems:
-            known = best.get(name) or incumbents.get(name)
-            if known is not None:
-                best[name] = known
-        self._fold(on_nodes, τ, problems, best)
+        for mine, theirs in zip(best, incumbents, strict=True):
+            for name in problems:
+                known = mine.get(name) or theirs.get(name)
+                if known is not None:
+                    mine[name] = known
+        for g in range(self.groups):
+            nodes = slice(int(self.first[g]), int(self.first[g + 1]))
+            self._fold({n: on_nodes[n][nodes] for n in problems}, τ[nodes], problems, best[g])
+        cells = self.cell_group
+
+        def each(name: str, missing: float):
+            # Each cell's search's best value of a problem.
+            if self.groups == 1:
+                return best[0][name].value if name in best[0] else missing
+            return np.array([b[name].value if name in b else missing for b in best])[cells]
+
         candidates: dict[str, NDArray[np.intp]] = {}
         for j, v in enumerate(self.spec.body_vectors):
             for quantity in _QUANTITIES[: 3 if self.values.limb is None else 5]:
                 keys = (f"{v.name}.{quantity}.low", f"{v.name}.{quantity}.high")
                 if not any(key in problems for key in keys):
                     continue
-                low_best = best[keys[0]].value if keys[0] in best else -np.inf
-                high_best = -best[keys[1]].value if keys[1] in best else np.inf
+                low_best = each(keys[0], -np.inf)
+                high_best = -each(keys[1], -np.inf)
 
                 def interesting(lo, hi, lb=low_best, hb=high_best):
                     return (lo < lb - tolerance) | (hi > hb + tolerance)
@@ -1286,33 +1542,39 @@ class _Window:
                 low, high = self._cell_bounds(j, quantity, interesting)
                 for name, bound in ((keys[0], low), (keys[1], -high)):
                     if name in problems:
-                        candidates[name] = np.flatnonzero(bound < best[name].value - tolerance)
+                        candidates[name] = np.flatnonzero(bound < each(name, np.nan) - tolerance)
         return _Newton.start(self, candidates)
 
     def _extrema_finish(self, newton, at, offset, problems, best, tolerance, precision_s):
         """Newton's steps from the first points' values (``at``, from ``offset``), then
         golden-section search for what is left."""
         τ, on_nodes = self.τ, self._node_problems
-        left = newton.run(self, at, offset, problems, best, tolerance)
+        left = newton.run(self, at, offset, problems[0], best, tolerance)
+        # Golden-section search, each search's cells alone (few are left to it).
+        for g in range(self.groups):
+            nodes = slice(int(self.first[g]), int(self.first[g + 1]))
 
-        def evaluate(t: NDArray[np.float64], piece: NDArray[np.intp]):
-            return self._quantities(self.evaluate(t, piece, angles=True), t)
+            def evaluate(t: NDArray[np.float64], piece: NDArray[np.intp], g=g):
+                group = np.full(t.shape, g, dtype=np.intp)
+                return self._quantities(self.evaluate(t, piece, angles=True), t, group=group)
 
-        brackets: dict[str, tuple[NDArray[np.float64], ...]] = {}
-        for name, cells in left.items():
-            i = self.cell[cells]
-            values = on_nodes[name]
-            brackets[name] = (τ[i], τ[i + 1], values[i], values[i + 1])
-        if any(b[0].size for b in brackets.values()):
-            found = least_in_brackets(
-                _PiecewiseCall(evaluate, τ, self.owner),
-                brackets,
-                problems,
-                best,
-                tolerance,
-                precision_s,
-            )
-            best.update(found)
+            brackets: dict[str, tuple[NDArray[np.float64], ...]] = {}
+            for name, cells in left.items():
+                if self.groups > 1:
+                    cells = cells[self.cell_group[cells] == g]
+                i = self.cell[cells]
+                values = on_nodes[name]
+                brackets[name] = (τ[i], τ[i + 1], values[i], values[i + 1])
+            if any(b[0].size for b in brackets.values()):
+                found = least_in_brackets(
+                    _PiecewiseCall(evaluate, τ[nodes], self.owner[nodes]),
+                    brackets,
+                    problems[g],
+                    best[g],
+                    tolerance,
+                    precision_s,
+                )
+                best[g].update(found)
 
     def _fold(self, quantities, times, problems, best) -> None:
         """Fold the values of the problems at ``times`` into ``best``."""
@@ -1324,13 +1586,14 @@ class _Window:
 
     # ---------------------------------------------------------------- incidence
 
-    def incidence(self) -> dict[str, float]:
-        """Each vector's integral of max(f_sun, 0) × lit fraction over the window, on the
-        quintic through each cell's ends (their values, slopes and bends) of the Sun's
-        visibility: in closed form, h (f0 + f1)/2 + h² (f0' − f1')/10 + h³ (f0'' +
-        f1'')/120, on a cell lit throughout and outside the shadow; by 4 Gauss–Legendre
-        points (exact for a quintic) on the lit part of a cell cut by a crossing, or
-        with the lit fraction where the cell meets the shadow."""
+    def incidence(self) -> list[dict[str, float]]:
+        """Each search's integral of max(f_sun, 0) × lit fraction over the window, for
+        each vector, on the quintic through each cell's ends (their values, slopes and
+        bends) of the Sun's visibility: in closed form, h (f0 + f1)/2 + h² (f0' −
+        f1')/10 + h³ (f0'' + f1'')/120, on a cell lit throughout and outside the
+        shadow; by 4 Gauss–Legendre points (exact for a quintic) on the lit part of a
+        cell cut by a crossing, or with the lit fraction where the cell meets the
+        shadow."""
         index_of = {
             k: c.vector for k, c in enumerate(self.conditions) if c.name.endswith(".sun_visible")
         }
@@ -1348,12 +1611,14 @@ class _Window:
         entering = cells.ga <= 0.0
         a[cut] = np.where(entering[cut], cross[cut], a[cut])
         b[cut] = np.where(entering[cut], b[cut], cross[cut])
+        group = self.piece_group[cells.p]
         meets = np.zeros(h.size, dtype=bool)
-        if self.shadow:
+        if self.any_shadow:
+            shadows = self.shadows
             meets = (
-                _in_any(0.5 * (a + b), self.shadow)
-                | _in_any(a, self.shadow)
-                | _in_any(b, self.shadow)
+                _in_any_of(0.5 * (a + b), group, shadows)
+                | _in_any_of(a, group, shadows)
+                | _in_any_of(b, group, shadows)
             )
         whole = ~cut & ~meets
         total = np.zeros(h.size)
@@ -1381,23 +1646,41 @@ class _Window:
             weight = np.ones_like(f)
             shaded = meets[rows]
             if np.any(shaded):
-                weight[shaded] = self._fraction(x[shaded].ravel()).reshape(-1, _GAUSS_X.size)
-            total[rows] = (f * weight) @ _GAUSS_W * 0.5 * (hi - lo)
-        sums = np.bincount(vector, weights=total, minlength=len(self.spec.body_vectors))
-        return {self.spec.body_vectors[j].name: float(sums[j]) for j in set(index_of.values())}
+                points = np.repeat(group[rows][shaded], _GAUSS_X.size)
+                weight[shaded] = self._fraction(x[shaded].ravel(), points).reshape(
+                    -1, _GAUSS_X.size
+                )
+            # The Gauss sum written out: each cell's sum in one order, whatever the
+            # cells summed with it (a matrix product's order may depend on their count).
+            fw = f * weight
+            w = _GAUSS_W
+            total[rows] = (
+                (fw[:, 0] * w[0] + fw[:, 1] * w[1] + fw[:, 2] * w[2] + fw[:, 3] * w[3])
+                * 0.5
+                * (hi - lo)
+            )
+        # np.bincount adds each bin's weights in their order: a search's cells in the
+        # order it has alone.
+        V = len(self.spec.body_vectors)
+        sums = np.bincount(group * V + vector, weights=total, minlength=self.groups * V)
+        names = [(j, self.spec.body_vectors[j].name) for j in sorted(set(index_of.values()))]
+        return [{name: float(sums[g * V + j]) for j, name in names} for g in range(self.groups)]
 
-    def dark(self) -> dict[str, bool]:
-        """Whether each vector saw no Sun at some time of the window."""
-        out = {}
-        span = (self.τ[0], self.τ[-1])
-        in_umbra = any(i.end_s > span[0] and i.start_s < span[1] for i in self.umbra)
-        for condition in self.conditions:
-            if condition.name.endswith(".sun_visible"):
-                name = self.spec.body_vectors[condition.vector].name
-                pieces = self.found[condition.name]
-                lit = len(pieces) == 1 and pieces[0].starts_before and pieces[0].ends_after
-                out[name] = in_umbra or not lit
-        return out
+    def dark(self) -> list[dict[str, bool]]:
+        """Whether each search's each vector saw no Sun at some time of the window."""
+        outs = []
+        for g in range(self.groups):
+            out = {}
+            span = (self.τ[self.first[g]], self.τ[self.first[g + 1] - 1])
+            in_umbra = any(i.end_s > span[0] and i.start_s < span[1] for i in self.umbras[g])
+            for condition in self.conditions:
+                if condition.name.endswith(".sun_visible"):
+                    name = self.spec.body_vectors[condition.vector].name
+                    pieces = self.found[g][condition.name]
+                    lit = len(pieces) == 1 and pieces[0].starts_before and pieces[0].ends_after
+                    out[name] = in_umbra or not lit
+            outs.append(out)
+        return outs
 
 
 class _PiecewiseCall:
@@ -1446,7 +1729,7 @@ class _Newton:
         self = cls()
         values, τ = window.values, window.τ
         index = {v.name: j for j, v in enumerate(window.spec.body_vectors)}
-        shadow = window._cell_in(window.shadow)
+        shadow = window._cell_in(window.shadows)
         for name, cells in candidates.items():
             vector, quantity, end = name.rsplit(".", 2)
             target = _TARGET_OF[quantity]
@@ -1486,14 +1769,16 @@ class _Newton:
 
     def _fold(self, window: _Window, at: _Values, times, which, points, best) -> None:
         """Fold each row's quantity at its own points (``which``: the rows' cells being
-        stepped, ``points``: their indices into ``at``) into ``best``."""
+        stepped, ``points``: their indices into ``at``) into each search's ``best[g]``."""
         for k in np.unique(self.which_row[which]).tolist():
             name, j, target, _, kind, _ = self.rows[k]
-            there = points[self.which_row[which] == k]
+            mine = self.which_row[which] == k
+            there = points[mine]
+            group = window.cell_group[self.cells[which[mine]]]
             if kind == "cosine":
                 q = np.maximum(at.f[target][j][there], 0.0)  # outside the shadow: lit
             elif kind == "shaded":
-                q = np.maximum(at.f[target][j][there], 0.0) * window._fraction(times[there])
+                q = np.maximum(at.f[target][j][there], 0.0) * window._fraction(times[there], group)
             else:
                 q = at.angle[target][j][there]
                 if kind == "limb":
@@ -1501,9 +1786,10 @@ class _Newton:
                     q = q - at.limb[there]
             if name.endswith(".high"):
                 q = -q
-            i = int(np.argmin(q))
-            if q[i] < best[name].value:
-                best[name] = Extremum(float(times[there][i]), float(q[i]))
+            for g, own in _by_group(group, window.groups):
+                i = int(np.argmin(q[own]))
+                if q[own][i] < best[g][name].value:
+                    best[g][name] = Extremum(float(times[there][own][i]), float(q[own][i]))
 
     def targets(self) -> set[str]:
         """The targets of the rows (what their steps evaluate)."""
@@ -1550,9 +1836,10 @@ class _Newton:
                 if r[4] == "shaded":  # (f F)' and (f F)'' with F the lit fraction
                     f = at.f[r[2]][r[1]][there]
                     t = times[there]
-                    F = window._fraction(t)
-                    ahead = window._fraction(t + _FRACTION_STEP_S)
-                    behind = window._fraction(t - _FRACTION_STEP_S)
+                    group = window.cell_group[self.cells[which[mine]]]
+                    F = window._fraction(t, group)
+                    ahead = window._fraction(t + _FRACTION_STEP_S, group)
+                    behind = window._fraction(t - _FRACTION_STEP_S, group)
                     F1 = (ahead - behind) / (2.0 * _FRACTION_STEP_S)
                     F2 = (ahead - 2.0 * F + behind) / _FRACTION_STEP_S**2
                     bend[mine] = bend[mine] * F + 2.0 * slope[mine] * F1 + f * F2

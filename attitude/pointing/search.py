@@ -19,7 +19,10 @@ for the span on a 10 s grid with the geometry's rate bound, so that none is miss
 however short (:func:`attitude.pointing.intervals.isolate`), and kept with the shared
 surroundings for every later search of the same span.  Many searches of short spans
 within one long one (the envelope's windows after each failure) share one search of
-the long span (:func:`orbit_intervals`), each cut to its span.
+the long span (:func:`orbit_intervals`), each cut to its span; :func:`pointing_analyses`
+runs such searches together, their torque-free searches as one set of arrays
+(:func:`attitude.pointing.free_search.search_free_many`), each analysis the same, bit
+for bit, as :func:`pointing_analysis` gives it alone.
 
 **Torque-free segments** (:mod:`attitude.pointing.free_search`): the structure of the
 closed-form motion bounds how fast each body vector's cosines with the Sun, the Moon
@@ -66,7 +69,16 @@ from attitude.environment.orbit import Orbit
 from attitude.environment.timescales import SECONDS_PER_DAY
 from attitude.pointing.eclipse import SUN_RADIUS_M
 from attitude.pointing.extrema import Extremum, Problem, least_of_each
-from attitude.pointing.free_search import FreePiece, FreePlan, free_plan, search_free
+from attitude.pointing.free_search import (
+    FreePiece,
+    FreePlan,
+    FreeResult,
+    fits_one_window,
+    free_plan,
+    free_plans,
+    search_free,
+    search_free_many,
+)
 from attitude.pointing.intervals import (
     Interval,
     append_across,
@@ -91,6 +103,7 @@ __all__ = [
     "VectorAnalysis",
     "check_pointing",
     "orbit_intervals",
+    "pointing_analyses",
     "pointing_analysis",
     "search_grid",
 ]
@@ -312,13 +325,15 @@ def search_grid(
     stop_s: float | None = None,
     surroundings: SharedSurroundings | None = None,
     orbit: OrbitIntervals | None = None,
+    planned: dict[int, FreePlan | None] | None = None,
 ) -> SearchGrid:
     """The search grid of :func:`pointing_analysis` over [start_s, stop_s] (the output
     span by default), from the rates of the motion and the orbit (see the module notes).
     ``surroundings``: the shared surroundings to plan on, if they cover the span (by
     default the process's cached ones); ``orbit``: the orbit's intervals over a span
     holding this one, whose rate bounds serve here too (else the orbit is sampled over
-    this span).
+    this span); ``planned``: the free plans of some segments (by index) found already,
+    on these surroundings over this span (:func:`pointing_analyses`).
     """
     scenario = trajectory.scenario
     spec = for_scenario(spec, scenario)  # the scenario's orbit, when the spec has none
@@ -344,7 +359,10 @@ def search_grid(
         a, b = max(segment.start_s, start_s), min(segment.end_s, stop_s)
         plan = None
         if shared is not None and isinstance(segment.solver, EulerSolver):
-            plan = free_plan(segment.solver, spec, shared, a, b)
+            if planned is not None and k in planned:
+                plan = planned[k]
+            else:
+                plan = free_plan(segment.solver, spec, shared, a, b)
         if plan is not None:
             plans[k] = plan
             count += plan.count
@@ -613,16 +631,7 @@ class _Search:
 
     def free(self, pieces: list[FreePiece]) -> None:
         """Search consecutive torque-free segments together (free_search)."""
-        problems, incumbents = {}, {}
-        for name, quantity in self.wanted:
-            rate = self._rate(name, quantity)
-            low, high = self.lows[(name, quantity)], self.highs[(name, quantity)]
-            problems[f"{name}.{quantity}.low"] = Problem(np.empty(0), rate, low)
-            problems[f"{name}.{quantity}.high"] = Problem(np.empty(0), rate, None)
-            incumbents[f"{name}.{quantity}.low"] = low
-            incumbents[f"{name}.{quantity}.high"] = (
-                None if high is None else Extremum(high.time_s, -high.value)
-            )
+        problems, incumbents = self.free_problems()
         result = search_free(
             pieces,
             self.spec,
@@ -635,6 +644,24 @@ class _Search:
             self.orbit.get("shadow", []),
             self.orbit.get("umbra", []),
         )
+        self.take_free(pieces, result)
+
+    def free_problems(self) -> tuple[dict[str, Problem], dict[str, Extremum | None]]:
+        """The extremum problems of a free search, and the best known of each."""
+        problems, incumbents = {}, {}
+        for name, quantity in self.wanted:
+            rate = self._rate(name, quantity)
+            low, high = self.lows[(name, quantity)], self.highs[(name, quantity)]
+            problems[f"{name}.{quantity}.low"] = Problem(np.empty(0), rate, low)
+            problems[f"{name}.{quantity}.high"] = Problem(np.empty(0), rate, None)
+            incumbents[f"{name}.{quantity}.low"] = low
+            incumbents[f"{name}.{quantity}.high"] = (
+                None if high is None else Extremum(high.time_s, -high.value)
+            )
+        return problems, incumbents
+
+    def take_free(self, pieces: list[FreePiece], result: FreeResult) -> None:
+        """Fold a free search's result in."""
         self.evaluations += result.evaluations
         start_s = pieces[0].start_s
         self._add(result.intervals, start_s)
@@ -766,8 +793,11 @@ class _Search:
         # exact path: the same ephemeris nodes), the trajectory's attitude.
         env = self.shared.exact(times)
         attitude = self.trajectory.attitude(times)
+        wanted = {name for _, (name, _), _ in found}  # the vectors with an extremum
         angles = {
-            v.name: vector_angles(attitude.apply(v.vector), env) for v in self.spec.body_vectors
+            v.name: vector_angles(attitude.apply(v.vector), env)
+            for v in self.spec.body_vectors
+            if v.name in wanted
         }
         for k, (which, (name, quantity), extremum) in enumerate(found):
             if quantity == "cos_incidence" and extremum.value == 0.0:
@@ -990,14 +1020,128 @@ def pointing_analysis(
     ``extrema``: the (vector name, quantity) pairs of :data:`EXTREMA` to find (all by
     default); the others are left out of each vector's ``extrema``.
     """
+    search = _prepared(trajectory, spec, start_s, stop_s, grid, surroundings, orbit, extrema)
+    _searched(search)
+    return search.result()
+
+
+def _prepared(
+    trajectory, spec, start_s, stop_s, grid, surroundings, orbit, extrema, planned=None
+) -> _Search:
+    """The search of :func:`pointing_analysis`, planned, with the orbit's intervals."""
     spec = for_scenario(spec, trajectory.scenario)  # the scenario's orbit, if the spec has none
     if grid is None:
-        grid = search_grid(trajectory, spec, start_s, stop_s, surroundings, orbit)
+        grid = search_grid(trajectory, spec, start_s, stop_s, surroundings, orbit, planned)
     shared = surroundings
     if shared is None or not shared.covers(grid.start_s, grid.stop_s):
         shared = shared_surroundings(trajectory, spec, grid.start_s, grid.stop_s)
     search = _Search(trajectory, spec, grid, shared, extrema)
     search.orbit_only(orbit)
+    return search
+
+
+def _one_free_run(search: _Search) -> list[FreePiece] | None:
+    """The pieces of a search whose span is one run of torque-free segments in one
+    window of nodes (what :func:`pointing_analyses` searches together), else None."""
+    if not search.spec.body_vectors:
+        return None
+    grid, run = search.grid, []
+    for k, segment in _in_span(search.trajectory, grid.start_s, grid.stop_s):
+        a, b = max(segment.start_s, grid.start_s), min(segment.end_s, grid.stop_s)
+        if b <= a and not (a == b == grid.start_s == grid.stop_s):
+            continue
+        plan = grid.plans[k] if k < len(grid.plans) else None
+        if plan is None or not isinstance(segment.solver, EulerSolver):
+            return None
+        run.append(FreePiece(segment.solver, plan, a, b, b < grid.stop_s))
+    return run if run and fits_one_window(run) else None
+
+
+def pointing_analyses(
+    trajectories: list[Trajectory],
+    spec: PointingSpec,
+    spans: list[tuple[float, float]],
+    surroundings: SharedSurroundings | None = None,
+    orbit: OrbitIntervals | None = None,
+    extrema: Collection[tuple[str, str]] | None = None,
+) -> list[PointingAnalysis]:
+    """:func:`pointing_analysis` of each trajectory over its span (``spans[i]``: start
+    and stop, TT s), the same analyses, found together: the searches whose spans are
+    one run of torque-free segments (the envelope's windows after each failure) are
+    searched as one set of arrays (:func:`attitude.pointing.free_search
+    .search_free_many`), each with its own decisions and element by element, so that
+    each analysis is the one :func:`pointing_analysis` gives alone, bit for bit; the
+    others are searched alone."""
+    planned = _free_plans(trajectories, spec, spans, surroundings)
+    searches = [
+        _prepared(trajectory, spec, a, b, None, surroundings, orbit, extrema, plans)
+        for trajectory, (a, b), plans in zip(trajectories, spans, planned, strict=True)
+    ]
+    together: list[tuple[_Search, list[FreePiece]]] = []
+    for search in searches:
+        run = _one_free_run(search)
+        if run is None or (together and _batch_key(search) != _batch_key(together[0][0])):
+            _searched(search)
+        else:
+            together.append((search, run))
+    if together:
+        first = together[0][0]
+        problems = [search.free_problems() for search, _ in together]
+        results = search_free_many(
+            [run for _, run in together],
+            first.spec,
+            first.shared,
+            first.precision,
+            first.extremum_precision,
+            _EXTREMUM_TOLERANCE,
+            [p for p, _ in problems],
+            [i for _, i in problems],
+            [search.orbit.get("shadow", []) for search, _ in together],
+            [search.orbit.get("umbra", []) for search, _ in together],
+        )
+        for (search, run), result in zip(together, results, strict=True):
+            search.take_free(run, result)
+    return [search.result() for search in searches]
+
+
+def _free_plans(
+    trajectories: list[Trajectory],
+    spec: PointingSpec,
+    spans: list[tuple[float, float]],
+    surroundings: SharedSurroundings | None,
+) -> list[dict[int, FreePlan | None] | None]:
+    """The free plans of every torque-free segment of the trajectories of one scenario
+    over their spans, found together (:func:`attitude.pointing.free_search.free_plans`)
+    as :func:`search_grid` finds each (by segment index); None for a trajectory whose
+    plans :func:`search_grid` finds itself (other scenarios, surroundings that do not
+    cover its span)."""
+    out: list[dict[int, FreePlan | None] | None] = [None] * len(trajectories)
+    if not trajectories or surroundings is None or not spec.body_vectors:
+        return out
+    scenario = trajectories[0].scenario
+    spec = for_scenario(spec, scenario)
+    where, solvers, parts = [], [], []
+    for i, (trajectory, (start_s, stop_s)) in enumerate(zip(trajectories, spans, strict=True)):
+        if trajectory.scenario is not scenario or not surroundings.covers(start_s, stop_s):
+            continue
+        out[i] = {}
+        for k, segment in _in_span(trajectory, start_s, stop_s):
+            if isinstance(segment.solver, EulerSolver):
+                where.append((i, k))
+                solvers.append(segment.solver)
+                parts.append((max(segment.start_s, start_s), min(segment.end_s, stop_s)))
+    for (i, k), plan in zip(where, free_plans(solvers, spec, surroundings, parts), strict=True):
+        out[i][k] = plan  # type: ignore[index]
+    return out
+
+
+def _batch_key(search: _Search) -> tuple:
+    return (search.shared, search.spec, search.precision, search.extremum_precision)
+
+
+def _searched(search: _Search) -> None:
+    """Run the search of :func:`pointing_analysis` over its span."""
+    trajectory, spec, grid = search.trajectory, search.spec, search.grid
     if spec.body_vectors:
         # Consecutive torque-free segments are searched together, and so are
         # consecutive other ones, on the grid.
@@ -1022,7 +1166,6 @@ def pointing_analysis(
             search.free(run)
         if gridded:
             search.gridded(gridded[0], gridded[-1])
-    return search.result()
 
 
 def _first_dark(item: VectorAnalysis, grid: SearchGrid) -> Extremum | None:
