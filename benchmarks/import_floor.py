@@ -93,12 +93,17 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--peer-python", required=True, help="the peer venv's python")
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args(argv)
-    environment = dict(os.environ, PYTHONPATH=str(ROOT))
     started = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
     loads = [os.getloadavg()[0]]
     report: dict = {"cases": {}}
     with tempfile.TemporaryDirectory() as folder:
         folder = Path(folder)
+        # The .pyc files of either side kept outside both trees, as runs_side_by_side does.
+        environment = dict(
+            os.environ, PYTHONPATH=str(ROOT), PYTHONPYCACHEPREFIX=str(folder / "pyc-this")
+        )
+        environment.pop("PYTHONDONTWRITEBYTECODE", None)
+        peer_pycache = folder / "pyc-peer"
         for name, scenario in cases(False, folder, args.peer_tree).items():
             record = folder / f"{name}.json"
             out = folder / f"record-{name}"
@@ -106,7 +111,9 @@ def main(argv: list[str] | None = None) -> dict:
             _cpu([*command, "--out", str(out)], environment)
             floor_command = [sys.executable, "-c", _IMPORT, str(record)]
             _cpu(floor_command, environment)  # warm: .pyc files, font cache
-            run_once(args.peer_python, args.peer_tree, scenario, folder / f"warm-{name}")
+            run_once(
+                args.peer_python, args.peer_tree, scenario, folder / f"warm-{name}", peer_pycache
+            )
             floors, peers = [], []
             for repeat in range(args.repeat):
                 order = ("floor", "peer") if repeat % 2 == 0 else ("peer", "floor")
@@ -115,9 +122,10 @@ def main(argv: list[str] | None = None) -> dict:
                         floors.append(_cpu(floor_command, environment))
                     else:
                         peer_out = folder / f"peer-{name}-{repeat}"
-                        peers.append(
-                            run_once(args.peer_python, args.peer_tree, scenario, peer_out)["cpu_s"]
+                        run = run_once(
+                            args.peer_python, args.peer_tree, scenario, peer_out, peer_pycache
                         )
+                        peers.append(run["cpu_s"])
                 loads.append(os.getloadavg()[0])
             floor, peer = statistics.median(floors), statistics.median(peers)
             modules = json.loads(record.read_text())

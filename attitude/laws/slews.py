@@ -71,7 +71,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import brentq
 from scipy.spatial.transform import Rotation
 
 from attitude.base.errors import InputError
@@ -300,6 +299,8 @@ class Slew:
         if θ == 0.0 or excess(low) >= 0.0:
             T = low
         else:
+            from scipy.optimize import brentq  # here: a run without a slew never needs it
+
             T = brentq(excess, low, high, xtol=1e-12 * high, rtol=1e-14)
             while excess(T) < 0.0:  # the root from above: the profile must fit in T
                 T = math.nextafter(T, math.inf) * (1.0 + 1e-15)

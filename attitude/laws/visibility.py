@@ -20,7 +20,6 @@ from itertools import pairwise
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import brentq
 
 from attitude.base.errors import InputError
 from attitude.base.quantities import as_si_scalar
@@ -64,6 +63,7 @@ def visible_intervals(
     count = max(int(np.ceil((stop - start) / step)), 1) + 1
     grid = np.linspace(start, stop, count)
     _, rate = site.elevation(bound.at(grid))
+    from scipy.optimize import brentq  # here: a run without a ground site never needs it
 
     def rate_at(t: float) -> float:
         return float(site.elevation(bound.at([t]))[1][0])

@@ -177,6 +177,14 @@ def _panels(rows: int, height_in: float) -> tuple[Figure, list]:
     return figure, list(figure.subplots(rows, 1, squeeze=False)[:, 0])
 
 
+def _title(axes, text: str) -> None:
+    """An axes' title at its usual place, just above the axes: placed there, not found
+    there by matplotlib, which measures every tick label of the y axis (for an offset
+    text that could reach the title) at each drawing, a tenth of a figure's time.  No
+    axis of these figures has tick labels or an offset text under the title's middle."""
+    axes.set_title(text, y=1.0)
+
+
 def _save(figure: Figure, path: Path) -> str:
     """The figure as an opaque RGB PNG: its background is white, so the alpha channel
     that matplotlib's own PNG carries says nothing, and without it there is a quarter
@@ -261,7 +269,7 @@ def _zoom_panel(axes, zoom: Zoom, colors: dict[str, str], ylabel: str, scale=Non
     axes.set_xlim(zoom.seconds[0] / unit_s, zoom.seconds[-1] / unit_s)
     axes.set_xlabel(label)
     axes.set_ylabel(ylabel)
-    axes.set_title(zoom.title)
+    _title(axes, zoom.title)
     axes.grid(alpha=0.3)
     return unit_s
 
@@ -287,7 +295,7 @@ def plot_angular_velocity(
     axes.set_xlim(envelope.start_s / unit_s, envelope.stop_s / unit_s)
     axes.set_xlabel(label)
     axes.set_ylabel("body angular velocity (deg/s)")
-    axes.set_title(title or "Angular velocity in body axes (band: range in each pixel column)")
+    _title(axes, title or "Angular velocity in body axes (band: range in each pixel column)")
     axes.grid(alpha=0.3)
     axes.legend(loc="upper right", fontsize="small", ncols=3)
     if zoom is not None:
@@ -338,7 +346,7 @@ def plot_sun_angles(
     top.set_xlim(envelope.start_s / unit_s, envelope.stop_s / unit_s)
     top.set_xlabel(label)
     top.set_ylabel("angle from the Sun (deg)")
-    top.set_title(title or "Sun angle on the body vectors (band: range in each pixel column)")
+    _title(top, title or "Sun angle on the body vectors (band: range in each pixel column)")
     top.legend(loc="upper right", fontsize="small", ncols=2)
     if zoom is not None:
         zoom_unit_s = _zoom_panel(panels[1], zoom, colors, "angle from the Sun (deg)")
@@ -365,7 +373,7 @@ def plot_eclipse(
         _draw_envelope(axes, envelope, unit_s, {"sunlit": "tab:orange"})
         axes.set_ylim(-0.05, 1.05)
         axes.set_ylabel("Sun disc visible")
-        axes.set_title(title or "Eclipses (conical shadow: umbra and penumbra)")
+        _title(axes, title or "Eclipses (conical shadow: umbra and penumbra)")
     else:
         starts = np.array([p[0] for p in passes]) / unit_s
         axes.plot(
@@ -389,7 +397,7 @@ def plot_eclipse(
         axes.set_ylabel("eclipse duration (min)")
         axes.set_ylim(0.0, 1.15 * max((p[1] / 60.0 for p in passes), default=1.0))
         axes.legend(loc="best", fontsize="small")
-        axes.set_title(title or f"Eclipses: the duration of each of the {len(passes)} passes")
+        _title(axes, title or f"Eclipses: the duration of each of the {len(passes)} passes")
     axes.set_xlim(span_s[0] / unit_s, span_s[1] / unit_s)
     axes.set_xlabel(label)
     axes.grid(alpha=0.3)
@@ -461,7 +469,7 @@ def _draw_on_sphere(sphere, directions: list[tuple[int, NDArray[np.float64]]]) -
         sphere.text(*tip, f"body {name}")
     sphere.set_box_aspect((1, 1, 1))
     sphere.set_axis_off()
-    sphere.set_title("on the unit sphere")
+    sphere.set_title("on the unit sphere")  # a 3D axes places its own
 
 
 def _draw_from_mean(flat, directions: list[tuple[int, NDArray[np.float64]]]) -> None:
@@ -484,7 +492,7 @@ def _draw_from_mean(flat, directions: list[tuple[int, NDArray[np.float64]]]) -> 
     flat.set_xlabel("angle from the mean direction (deg)")
     flat.set_ylabel("angle from the mean direction (deg)")
     flat.grid(alpha=0.3)
-    flat.set_title("seen from the mean direction")
+    _title(flat, "seen from the mean direction")
     if len(directions) > 1:
         flat.legend(loc="best", fontsize="small")
 

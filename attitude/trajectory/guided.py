@@ -43,7 +43,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
-from scipy.optimize import minimize_scalar
 from scipy.spatial.transform import Rotation
 
 from attitude.base.errors import InputError
@@ -158,6 +157,8 @@ class GuidedMotion:
             (values <= left) & (values <= right) & ((values < left) | (values < right))
         )
         found = []
+        from scipy.optimize import minimize_scalar  # here: only a run with a guided law
+
         for k in minima[values[minima] < _NEAR_RAD]:
             low, high = grid[max(k - 1, 0)], grid[min(k + 1, count - 1)]
             result = minimize_scalar(
@@ -295,6 +296,8 @@ class GuidedMotion:
         best = (float(rates[k]), float(grid[k]))
         low, high = grid[max(k - 1, 0)], grid[min(k + 1, grid.size - 1)]
         if high > low:
+            from scipy.optimize import minimize_scalar  # here: only a run with a guided law
+
             found = minimize_scalar(
                 lambda s: -float(np.linalg.norm(self.angular_velocity(np.array([s, s]))[0])),
                 bounds=(low, high),
