@@ -4,6 +4,8 @@ segment's motion is.
 
 Modules:
 
+- ``averaged_kicks``: Gravity gradient as averaged kicks along the exact free flow: the
+  validity horizon's long steps.
 - ``guided``: A stretch of a scenario's motion under an attitude law or a slew, seen
   as the layers above see a segment.
 - ``handoff``: The exact hand-off: from a law's state at a control loss to the free

@@ -4,37 +4,56 @@ A scenario with an orbit whose ``[torques]`` leave out the gravity gradient (a
 torque-free one, or one with burns alone) neglects the gravity-gradient torque of the
 Earth.  Its validity horizon is the time until that neglected torque would have moved
 the attitude by a threshold (1° by default, ``[torques] horizon_threshold``): the same
-scenario (the same events, the same burns) is propagated under gravity gradient too
-(``attitude.trajectory.torqued``) alongside the scenario's own trajectory, their
-attitudes are compared at every step of that run, over the whole span, a block of
-steps at a time, and the first crossing is refined by bisection to a millisecond
-(:func:`attitude.torques.solver.first_crossing`, which ``departure_time`` uses for one
-solver); the run goes no further than the block of the crossing.  An attitude reset
-puts both on the same attitude again; the horizon is the first crossing.  With burns,
-both runs are splittings at the scenario's step (or accuracy): the comparison also
-holds their difference in splitting error, at most the sum of their errors, which the
-summary states beside it.
+scenario (the same events, the same burns) is propagated under gravity gradient too,
+alongside the scenario's own trajectory, their attitudes are compared over the whole
+span, and the first crossing is refined by bisection to a millisecond; the run
+alongside goes no further than the crossing.  An attitude reset puts both on the same
+attitude again; the horizon is the first crossing.
 
 The accuracy is that of an estimate, stated with it: :data:`HORIZON_RELATIVE_ACCURACY`
 (1 %) of the horizon.  The horizon says when the torque-free answer has expired by a
 threshold that is itself a choice (1°): 1 % of a day is 14 minutes, far finer than a
-user reads "valid until then", and it lets the run alongside take a third fewer
-steps.  That run uses the scenario's ``[torques]`` step or accuracy and order when it
-states one; otherwise order 4 at a step of three tenths of the body's fastest turn (at
-the bound √(2T/I_min) of its rate), at most a fortieth of the orbit period.  What
-limits the estimate is the sampling: the angle between the runs wobbles within a turn,
-and a peak between two steps can cross first.  Against DOP853
-(``tests/test_validity_horizon_against_dop853.py``), the spinner's crossing after
-31 550 s comes out 4.6e-4 of the horizon late at this step (6e-4 at a fifth of a turn,
-1.2e-3 at half a turn); the tumbler's is the same to 1e-7 of it.  Half a turn is not
-enough everywhere: the tumbler of
+user reads "valid until then".
+
+**Torque-free scenarios** (no burn, no law, no ``[torques]`` step or accuracy), the
+default, are first **screened** by :mod:`attitude.trajectory.averaged_kicks`: long
+steps set by the size of the perturbation's kick (up to half an orbit), each kick the
+torque and the gradient of the potential averaged along the exact free flow, the
+events applied to its state as to the scenario's, its attitude compared with the
+scenario's at its quadrature nodes (four a turn).  When that run stays below
+:data:`SCREEN_FRACTION` (a half) of the threshold over the whole span, the horizon is
+beyond the span; that is the answer, without numba, in about 0.1 s of CPU for a day of
+a 5 rpm spinner.  Otherwise the horizon is computed as below, by the splitting: every
+crossing the summary states comes from it.  The averaged kicks are an estimate whose
+error grows with the run (the module's docstring): against DOP853
+(``tests/test_validity_horizon_hostile_cases_against_dop853.py``) their crossings
+come within 1.3e-3 of themselves on hostile cases of minutes, but the nutating 5 rpm
+spinner of ``benchmarks.horizon_share`` crosses 1° 10.6 % late about 2.7 days in.
+Hence the factor two: on that spinner over eight days, the averaged run crosses half
+of a threshold from 0.25° to 4° at 0.51 to 0.64 of the time the splitting crosses the
+threshold (``tests/test_validity_horizon_screen_against_the_splitting.py``), so a span
+that it finds below half the threshold is below the threshold with room to spare.
+
+**The splitting** (burns, laws, a stated step, or a torque-free scenario whose screen
+finds half the threshold crossed): the run alongside is the splitting
+(``attitude.trajectory.torqued``) at the scenario's ``[torques]`` step or accuracy and
+order when it states one; otherwise order 4 at a step of three tenths of the body's
+fastest turn (at the bound √(2T/I_min) of its rate), at most a fortieth of the orbit
+period; the attitudes are compared at every step, a block of steps at a time
+(:func:`attitude.torques.solver.first_crossing` refines).  A segment under a law has
+the law's attitude in both runs.  With burns, both runs are splittings at the
+scenario's step (or accuracy): the comparison also holds their difference in
+splitting error, at most the sum of their errors, which the summary states beside
+it.  What limits that estimate is the sampling: the angle between the runs wobbles
+within a turn, and a peak between two steps can cross first (the tumbler of
 ``tests/test_scenario_torques_against_torque_free_and_momentum_laws.py`` with a 5°
-threshold comes out 6.8 % late at that step, within 0.01 s at this one.  The orbit's position is
-interpolated (cubic Hermite, checked against the orbit within
-:data:`ORBIT_TOLERANCE_M`), and with gravity gradient as its only torque the run
-takes the compiled splitting loop (:mod:`attitude.torques.compiled_steps`) past its
-first :data:`attitude.torques.solver.PYTHON_LOOP_STEPS` steps: the whole day of a
-5 rpm spinner (28 500 steps) costs about 0.8 s of CPU, numba's start included.
+threshold comes out 6.8 % late at half a turn, within 0.01 s at three tenths).  With
+gravity gradient as its only torque that run takes the compiled splitting loop
+(:mod:`attitude.torques.compiled_steps`) past its first
+:data:`attitude.torques.solver.PYTHON_LOOP_STEPS` steps.
+
+Both runs read the orbit's position interpolated (cubic Hermite, checked against the
+orbit within :data:`ORBIT_TOLERANCE_M`).
 """
 
 from __future__ import annotations
@@ -48,18 +67,33 @@ import numpy as np
 from numpy.typing import NDArray
 
 from attitude.environment.timescales import offline_time
+from attitude.scenario.events import State
+from attitude.scenario.modes import ModeEvent
 from attitude.scenario.scenario import Scenario
 from attitude.scenario.torques import ScenarioTorques
+from attitude.solver.euler_solver import EulerSolver
 from attitude.torques.models import MU_EARTH_M3_S2, GravityGradient
 from attitude.torques.solver import angles_between, first_crossing
+from attitude.trajectory.averaged_kicks import departure
+from attitude.trajectory.modes import uses_laws
 from attitude.trajectory.segments import Segment, segments
 from attitude.trajectory.torqued import TorquedMotion, scenario_torque_models
 from attitude.trajectory.trajectory import Trajectory, propagate
 
-__all__ = ["HORIZON_RELATIVE_ACCURACY", "ORBIT_TOLERANCE_M", "ValidityHorizon", "validity_horizon"]
+__all__ = [
+    "HORIZON_RELATIVE_ACCURACY",
+    "ORBIT_TOLERANCE_M",
+    "SCREEN_FRACTION",
+    "ValidityHorizon",
+    "averaged_horizon",
+    "validity_horizon",
+]
 
 # The horizon is an estimate to this fraction of itself (module docstring).
 HORIZON_RELATIVE_ACCURACY = 1e-2
+# A torque-free span whose averaged kicks stay below this fraction of the threshold is
+# beyond the horizon (module docstring: the averaged run's error stays well within it).
+SCREEN_FRACTION = 0.5
 
 _TURN_FRACTION = 0.3
 _ORBIT_FRACTION = 1.0 / 40.0
@@ -90,6 +124,7 @@ class ValidityHorizon:
     span_s: float
     step_s: float
     order: int
+    method: str = "splitting"
 
     @property
     def within_span(self) -> bool:
@@ -120,6 +155,7 @@ class ValidityHorizon:
             "searched_s": self.searched_s,
             "torqued_run": {
                 "model": "gravity gradient (point-mass Earth)",
+                "method": self.method,
                 "order": self.order,
                 "step_s": self.step_s,
             },
@@ -156,6 +192,18 @@ def validity_horizon(trajectory: Trajectory, orbit: Any) -> ValidityHorizon:
     settings = scenario.torques
     threshold = settings.horizon_threshold
     given = settings.step is not None or settings.accuracy is not None
+    if not given and _free_only(trajectory):
+        screen = averaged_horizon(trajectory, orbit, SCREEN_FRACTION * threshold)
+        if not screen.within_span:
+            return ValidityHorizon(
+                threshold,
+                math.inf,
+                screen.searched_s,
+                screen.span_s,
+                screen.step_s,
+                screen.order,
+                screen.method,
+            )
     step = settings.step if settings.step is not None else _step(trajectory, orbit)
     torques = ScenarioTorques(
         gravity_gradient=_interpolated(orbit, scenario),
@@ -177,6 +225,62 @@ def validity_horizon(trajectory: Trajectory, orbit: Any) -> ValidityHorizon:
     searched = min(crossing, scenario.stop_s)
     return ValidityHorizon(
         threshold, crossing, searched, scenario.stop_s, max(steps, default=step), torques.order
+    )
+
+
+def _free_only(trajectory: Trajectory) -> bool:
+    """Whether every segment of ``trajectory`` is torque-free (no burn, no law): the
+    gravity gradient is then the run alongside's only torque."""
+    scenario = trajectory.scenario
+    return (
+        not scenario.torques.burns
+        and not uses_laws(scenario)
+        and all(isinstance(segment.solver, EulerSolver) for segment in trajectory.segments)
+    )
+
+
+def _gradient(trajectory: Trajectory, orbit: Any) -> tuple[GravityGradient, float]:
+    """The gravity gradient on ``orbit`` (interpolated) and the orbit period (s) at the
+    epoch (two-body, from the radius there)."""
+    scenario = trajectory.scenario
+    with_orbit = scenario.with_torques(
+        ScenarioTorques(gravity_gradient=_interpolated(orbit, scenario))
+    )
+    gradient = scenario_torque_models(with_orbit)[0][2]
+    if not isinstance(gradient, GravityGradient):
+        raise TypeError(f"the first torque model is the gravity gradient, got {gradient!r}")
+    radius = float(np.linalg.norm(gradient.position(np.array([0.0]))[0]))
+    return gradient, 2.0 * math.pi * math.sqrt(radius**3 / gradient.mu)
+
+
+def averaged_horizon(trajectory: Trajectory, orbit: Any, threshold: float) -> ValidityHorizon:
+    """The first time the averaged kicks (:mod:`attitude.trajectory.averaged_kicks`) part
+    from a torque-free ``trajectory`` by ``threshold`` rad, segment by segment through
+    its events: the screen of :func:`validity_horizon` (at :data:`SCREEN_FRACTION` of
+    its threshold), an estimate whose accuracy the module docstring states."""
+    scenario = trajectory.scenario
+    gradient, period = _gradient(trajectory, orbit)
+    largest, crossing = 0.0, math.inf
+    state: State | None = None
+    for segment in trajectory.segments:
+        if segment.event is not None:  # the event, applied to the torqued state before it
+            assert state is not None and not isinstance(segment.event, ModeEvent)
+            state = segment.event.apply(state)
+        else:
+            state = segment.state
+        assert isinstance(segment.solver, EulerSolver)
+        found = departure(
+            state, segment.start_s, segment.end_s, segment.solver, gradient, period, threshold
+        )
+        largest = max(largest, found.largest_step_s)
+        if math.isfinite(found.crossing_s):
+            crossing = found.crossing_s
+            break
+        assert found.end_state is not None
+        state = found.end_state
+    searched = min(crossing, scenario.stop_s)
+    return ValidityHorizon(
+        threshold, crossing, searched, scenario.stop_s, largest, 2, "averaged kicks"
     )
 
 
