@@ -5,7 +5,9 @@ and the same exception; a child still running when the block is left (an error, 
 signal) is killed and reaped.  Through the real command line: SIGINT and SIGTERM
 while the horizon's process runs give one line and exit codes 130 and 143, leave the
 output folder as it was, and leave no process behind; `run` writes the same
-summary.json as the horizon computed in the run's own process.
+summary.json as the horizon computed in the run's own process.  A span the averaged
+kicks' screen finds clear is answered without a process; a horizon within the span is
+the splitting's, computed beside.
 """
 
 import json
@@ -23,7 +25,7 @@ import attitude.report.beside
 from attitude.files.scenario_reader import load_scenario
 from attitude.outputs.formats import OutputChoice
 from attitude.report.beside import Beside
-from attitude.report.plan import plan_run
+from attitude.report.plan import horizon_beside, plan_run
 from attitude.report.run import write_report
 from attitude.trajectory.horizon import validity_horizon
 
@@ -31,11 +33,14 @@ ROOT = Path(__file__).parents[1]
 linux_only = pytest.mark.skipif(not Path("/proc/self/task").is_dir(), reason="needs /proc")
 
 
-def _spinner(folder: Path, duration: float, step: float) -> Path:
+def _spinner(folder: Path, duration: float, step: float, threshold_deg: float = 1.0) -> Path:
+    """The spinner example over ``duration`` at ``step``; below a threshold of about
+    0.1° its horizon falls within a day and needs the splitting beside the run."""
     text = (ROOT / "scenarios" / "spinner_thruster_pulse.toml").read_text()
     text = text.replace("duration = 3600.0", f"duration = {duration!r}")
     text = text.replace("step = 0.5", f"step = {step!r}")
     assert f"duration = {duration!r}" in text and f"step = {step!r}" in text
+    text += f'\n[torques]\nhorizon_threshold = {{ value = {threshold_deg!r}, unit = "deg" }}\n'
     path = folder / "spinner.toml"
     path.write_text(text)
     return path
@@ -62,6 +67,27 @@ def test_the_value_is_the_one_computed_here(tmp_path):
     with Beside(validity_horizon, plan.trajectory, loaded.pointing.orbit) as beside:
         assert beside.result() == here
         assert beside.result() == here  # asked twice: the same, the child reaped once
+
+
+def test_a_span_the_screen_finds_clear_is_answered_without_a_process(tmp_path):
+    """The hour of the spinner: its averaged kicks stay below half of 1°, so the run's
+    horizon is the screen's, computed in the run's own process (no fork: cheaper)."""
+    loaded = load_scenario(_spinner(tmp_path, 3600.0, 10.0))
+    plan = plan_run(loaded.scenario, loaded.pointing, horizon=False)
+    with horizon_beside(plan) as beside:
+        assert _children(os.getpid()) == []
+        found = beside.result()
+    assert found == validity_horizon(plan.trajectory, loaded.pointing.orbit)
+    assert found.method == "averaged kicks" and not found.within_span
+
+
+def test_a_horizon_within_the_span_is_the_splittings_beside(tmp_path):
+    loaded = load_scenario(_spinner(tmp_path, 3600.0, 10.0, threshold_deg=0.01))
+    plan = plan_run(loaded.scenario, loaded.pointing, horizon=False)
+    with horizon_beside(plan) as beside:
+        found = beside.result()
+    assert found == validity_horizon(plan.trajectory, loaded.pointing.orbit)
+    assert found.method == "splitting" and found.within_span
 
 
 def test_an_exception_is_raised_in_the_parent():
@@ -109,7 +135,9 @@ def _children(pid: int) -> list[int]:
 def test_a_signal_while_the_horizon_runs_leaves_one_line_and_no_process(
     tmp_path, number, code, group
 ):
-    scenario = _spinner(tmp_path, 30000.0, 10.0)  # a horizon of 15 000 steps: seconds
+    # At 0.1° the averaged kicks' screen finds half of it crossed: the splitting runs
+    # beside, thousands of steps (seconds).
+    scenario = _spinner(tmp_path, 30000.0, 10.0, threshold_deg=0.1)
     out = tmp_path / "out"
     process = subprocess.Popen(
         [sys.executable, "-m", "attitude", "run", str(scenario), "--out", str(out)],

@@ -9,6 +9,8 @@ Modules:
 - ``errors``: Exception classes of the package.
 - ``float_math``: numpy's elementwise functions, on Python floats: the namespace of a
   single state's path.
+- ``hermite``: Cubic Hermite interpolation on equally spaced nodes, without
+  scipy.interpolate.
 - ``jets``: Taylor jets: a quantity with its first time derivatives, carried through
   arithmetic.
 - ``jit``: How the package compiles its kernels: ``jit``, numba's ``njit`` with one

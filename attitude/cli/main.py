@@ -358,7 +358,8 @@ def _checked_run(args, state: dict) -> int:
         claim(args.out, OUTPUT_NAMES, dry_run=True)  # a folder that is not ours: say so first
         for note in plan.notes:
             print(f"attitude: note: {loaded.path.name}: {note}", file=sys.stderr, flush=True)
-        # The horizon starts beside the run before the writers and plots are imported.
+        # The horizon's screen, and the splitting beside the run if the screen cannot
+        # answer, before the writers and plots are imported.
         with horizon_beside(plan) or contextlib.nullcontext() as horizon:
             from attitude.report.run import write_report
 

@@ -1,12 +1,15 @@
 """One computation in a forked process beside the run, on the machine's other core.
 
-A report's validity horizon (:func:`attitude.trajectory.horizon.validity_horizon`: the scenario
-propagated again under gravity gradient over the span, splitting steps of exact free
-flows) is a part of a run's CPU that needs none of the rest; it is a few
-numbers to the summary at the end.  :class:`Beside` computes such a function in a child
-process made by ``fork`` (nothing to import again, nothing to send but the result)
-while the parent streams the outputs, and hands the result, or the exception the
-function raised, back through a pipe (pickled) when it is asked for.
+A report's validity horizon by the splitting
+(:func:`attitude.trajectory.horizon.splitting_horizon`: the scenario propagated again
+under gravity gradient up to the crossing, splitting steps of exact free flows) is a
+part of a run's CPU that needs none of the rest; it is a few numbers to the summary at
+the end.  (When the averaged kicks' screen answers, in a tenth of a second for a day,
+the run computes it itself: :meth:`Beside.known` holds that value, no process.)
+:class:`Beside` computes such a function in a child process made by ``fork``
+(nothing to import again, nothing to send but the result) while the parent streams
+the outputs, and hands the result, or the exception the function raised, back
+through a pipe (pickled) when it is asked for.
 
 The child leaves nothing behind: it handles no signal itself (SIGINT, SIGTERM and
 SIGHUP are back to their default action, so a Ctrl-C to the terminal's process group
@@ -89,6 +92,15 @@ class Beside(Generic[T]):
         signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
         os.close(write)
         self._pid, self._read = pid, read
+
+    @classmethod
+    def known(cls, value: T) -> Beside[T]:
+        """A value already computed, behind the same interface (no process)."""
+        done: Beside[T] = cls.__new__(cls)
+        done._function, done._args = (lambda: value), ()
+        done._pid, done._read, done._done = None, None, True
+        done._value = (True, value)
+        return done
 
     def result(self) -> T:
         """The function's value (or its exception, raised here)."""

@@ -36,7 +36,12 @@ from attitude.pointing.spec import PointingSpec, for_scenario
 from attitude.report.beside import Beside
 from attitude.scenario.scenario import Scenario
 from attitude.trajectory.guided import GUIDED
-from attitude.trajectory.horizon import ValidityHorizon, validity_horizon
+from attitude.trajectory.horizon import (
+    ValidityHorizon,
+    screened_horizon,
+    splitting_horizon,
+    validity_horizon,
+)
 from attitude.trajectory.modes import uses_laws
 from attitude.trajectory.motion import SegmentMotion, analyze, undersampling_note
 from attitude.trajectory.steps import CHECK_BUDGET_S
@@ -222,11 +227,17 @@ def _check_gravity_gradient_orbit(scenario: Scenario) -> None:
 
 
 def horizon_beside(plan: RunPlan) -> Beside[ValidityHorizon] | None:
-    """The validity horizon ``plan`` left to the run, started now in a process beside
-    this one (:class:`attitude.report.beside.Beside`; use it as a context manager), or None
-    when the plan has none to compute.  The command line starts it before it imports
-    the writers and the plots, so that the horizon, the longest single job of a
-    one-day report, starts as early as it can."""
+    """The validity horizon ``plan`` left to the run, or None when the plan has none to
+    compute.  A torque-free span the averaged kicks find clear is answered here, in
+    this process (:func:`attitude.trajectory.horizon.screened_horizon`: a tenth of a
+    second for a day, less than forking would cost); otherwise the splitting is
+    started now in a process beside this one (:class:`attitude.report.beside.Beside`;
+    use it as a context manager).  The command line calls this before it imports the
+    writers and the plots, so that the splitting, the longest single job of a report
+    that needs it, starts as early as it can."""
     if not plan.horizon_deferred:
         return None
-    return Beside(validity_horizon, plan.trajectory, plan.pointing.orbit)
+    screened = screened_horizon(plan.trajectory, plan.pointing.orbit)
+    if screened is not None:
+        return Beside.known(screened)
+    return Beside(splitting_horizon, plan.trajectory, plan.pointing.orbit)

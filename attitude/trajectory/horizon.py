@@ -66,6 +66,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from attitude.base.hermite import UniformCubicHermite
 from attitude.environment.timescales import offline_time
 from attitude.scenario.events import State
 from attitude.scenario.modes import ModeEvent
@@ -86,6 +87,8 @@ __all__ = [
     "SCREEN_FRACTION",
     "ValidityHorizon",
     "averaged_horizon",
+    "screened_horizon",
+    "splitting_horizon",
     "validity_horizon",
 ]
 
@@ -187,23 +190,44 @@ def _step(trajectory: Trajectory, orbit: Any) -> float:
 def validity_horizon(trajectory: Trajectory, orbit: Any) -> ValidityHorizon:
     """The validity horizon of ``trajectory`` (torque-free, or under burns alone) on
     ``orbit`` (module docstring); its threshold is the scenario's
-    ``torques.horizon_threshold``."""
+    ``torques.horizon_threshold``: the screen's answer when it finds the span clear
+    (:func:`screened_horizon`), else the splitting's (:func:`splitting_horizon`)."""
+    screened = screened_horizon(trajectory, orbit)
+    return screened if screened is not None else splitting_horizon(trajectory, orbit)
+
+
+def screened_horizon(trajectory: Trajectory, orbit: Any) -> ValidityHorizon | None:
+    """The horizon beyond the span, when ``trajectory`` is torque-free (no burn, no law,
+    no ``[torques]`` step or accuracy) and its averaged kicks stay below
+    :data:`SCREEN_FRACTION` of the threshold over the whole span; else None (the
+    splitting is then needed: :func:`splitting_horizon`)."""
+    settings = trajectory.scenario.torques
+    if settings.step is not None or settings.accuracy is not None:
+        return None
+    if not _free_only(trajectory):
+        return None
+    threshold = settings.horizon_threshold
+    screen = averaged_horizon(trajectory, orbit, SCREEN_FRACTION * threshold)
+    if screen.within_span:
+        return None
+    return ValidityHorizon(
+        threshold,
+        math.inf,
+        screen.searched_s,
+        screen.span_s,
+        screen.step_s,
+        screen.order,
+        screen.method,
+    )
+
+
+def splitting_horizon(trajectory: Trajectory, orbit: Any) -> ValidityHorizon:
+    """The validity horizon of ``trajectory`` by the splitting alongside it, stopped at
+    the crossing (module docstring, "The splitting")."""
     scenario = trajectory.scenario
     settings = scenario.torques
     threshold = settings.horizon_threshold
     given = settings.step is not None or settings.accuracy is not None
-    if not given and _free_only(trajectory):
-        screen = averaged_horizon(trajectory, orbit, SCREEN_FRACTION * threshold)
-        if not screen.within_span:
-            return ValidityHorizon(
-                threshold,
-                math.inf,
-                screen.searched_s,
-                screen.span_s,
-                screen.step_s,
-                screen.order,
-                screen.method,
-            )
     step = settings.step if settings.step is not None else _step(trajectory, orbit)
     torques = ScenarioTorques(
         gravity_gradient=_interpolated(orbit, scenario),
@@ -329,7 +353,6 @@ def _interpolated(orbit: Any, scenario: Scenario) -> Any:
     ``state_tt``); any other orbit as it is."""
     if not hasattr(orbit, "state_tt"):
         return orbit
-    from scipy.interpolate import CubicHermiteSpline
 
     with offline_time():
         tt = scenario.epoch.tt
@@ -344,9 +367,10 @@ def _interpolated(orbit: Any, scenario: Scenario) -> Any:
     def fit(spacing: float, end: float) -> tuple[Any, float]:
         """The interpolant on nodes ``spacing`` apart from ``low`` to ``end``, and its
         largest error at the middle of every interval (of every 8th past the first 64)."""
-        nodes = np.linspace(low, end, max(2, math.ceil((end - low) / spacing)) + 1)
+        count = max(2, math.ceil((end - low) / spacing))
+        nodes = np.linspace(low, end, count + 1)
         r, v = exact(nodes)
-        spline = CubicHermiteSpline(nodes, r, v, axis=0)
+        spline = UniformCubicHermite(low, (end - low) / count, r, v)
         middles = 0.5 * (nodes[1:] + nodes[:-1])
         middles = np.concatenate([middles[:64], middles[64::8]])
         error = float(np.max(np.linalg.norm(spline(middles) - exact(middles)[0], axis=-1)))
