@@ -198,7 +198,7 @@ def sample_metrics(plan: RunPlan) -> tuple[dict[str, Any], NDArray[np.float64]]:
     """
     scenario = plan.scenario
     seconds = scenario.output_seconds()
-    motion = motion_summary(plan.trajectory, plan.motion)
+    motion = motion_summary(plan.trajectory, plan.motion, epochs=False)
     largest = largest_rate_of(plan.motion)
     metrics: dict[str, Any] = {
         "flip_count": _count(motion["flips"]["count"]),

@@ -116,10 +116,12 @@ _MOTION_TEXT = {
 }
 
 
-def _flips_summary(scenario, motion: list[SegmentMotion]) -> dict[str, Any]:
+def _flips_summary(scenario, motion: list[SegmentMotion], epochs: bool) -> dict[str, Any]:
     """All flips: their count, and their times up to LISTED_FLIPS (an event's epoch can
-    end one segment and start the next with the same flip: it counts once).  When a
-    segment's flips were not located, the count is None and the note says why."""
+    end one segment and start the next with the same flip: it counts once; ``epochs``:
+    also as dates).  When a segment's flips were not located, the count is None and
+    the note says why."""
+    format_epoch = scenario.format_epoch if epochs else None
     missing = [item.flips_note for item in motion if item.flip_count is None]
     listed = np.concatenate([item.flip_times_s for item in motion]) if motion else np.empty(0)
     listed, repeated = np.unique(listed, return_counts=True)
@@ -128,7 +130,7 @@ def _flips_summary(scenario, motion: list[SegmentMotion]) -> dict[str, Any]:
         return {
             "count": None,
             "times_s": listed,
-            "times": [scenario.format_epoch(t) for t in listed[:1000]],
+            "times": _dates(format_epoch, listed[:1000]),
             "note": f"flips of segments under torques {missing[0]}",
         }
     count = sum(int(item.flip_count or 0) for item in motion) - int(np.sum(repeated - 1))
@@ -136,13 +138,21 @@ def _flips_summary(scenario, motion: list[SegmentMotion]) -> dict[str, Any]:
     return {
         "count": count,
         "times_s": listed,
-        "times": [scenario.format_epoch(t) for t in listed[:1000]],
+        "times": _dates(format_epoch, listed[:1000]),
         "note": None if complete else f"times_s lists the first {listed.size} of {count} flips",
     }
 
 
-def motion_summary(trajectory: Trajectory, motion: list[SegmentMotion]) -> dict[str, Any]:
-    """The JSON summary of the motion: segments, events, flips, precession, nutation."""
+def _dates(format_epoch, seconds) -> list[str] | None:
+    return None if format_epoch is None else [format_epoch(t) for t in seconds]
+
+
+def motion_summary(
+    trajectory: Trajectory, motion: list[SegmentMotion], epochs: bool = True
+) -> dict[str, Any]:
+    """The JSON summary of the motion: segments, events, flips, precession, nutation.
+    ``epochs=False``: the numbers alone, the dates (``start``, the flips' ``times``)
+    None (a Monte Carlo sample's metrics: an astropy formatting each)."""
     scenario = trajectory.scenario
     segments = []
     for k, (segment, item) in enumerate(zip(trajectory.segments, motion, strict=True)):
@@ -150,7 +160,7 @@ def motion_summary(trajectory: Trajectory, motion: list[SegmentMotion]) -> dict[
         segments.append(
             {
                 "index": k,
-                "start": scenario.format_epoch(item.start_s),
+                "start": scenario.format_epoch(item.start_s) if epochs else None,
                 "start_s": item.start_s,
                 "end_s": item.end_s,
                 "started_by": None
@@ -178,7 +188,7 @@ def motion_summary(trajectory: Trajectory, motion: list[SegmentMotion]) -> dict[
                 "angular_momentum_norm_N_m_s": item.angular_momentum_norm_N_m_s,
             }
         )
-    return {"segments": segments, "flips": _flips_summary(scenario, motion)}
+    return {"segments": segments, "flips": _flips_summary(scenario, motion, epochs)}
 
 
 def _interval_totals(intervals: list[Interval], format_epoch=None) -> dict[str, Any]:

@@ -294,14 +294,17 @@ class Scenario:
         for index, event in enumerate(events):
             key = f"events[{index}].{_epoch_key(event.epoch)}"
             offset = self._offset_in_span(event.epoch, key)
-            what = f"the {event.kind} at {self.format_epoch(offset)}"
+            # Formatted only for an error: a Monte Carlo sample places its events
+            # thousands of times.
             if offset < 0.0:
+                what = f"the {event.kind} at {self.format_epoch(offset)}"
                 raise InputError(
                     f"{what} is before the scenario epoch {self.format_epoch(0.0)}",
                     key=key,
                     value=event.epoch,
                 )
             if offset > self.stop_s:
+                what = f"the {event.kind} at {self.format_epoch(offset)}"
                 end = self.format_epoch(self.stop_s)
                 raise InputError(
                     f"{what} is after the end of the propagation span {end}",

@@ -27,8 +27,9 @@ rate that the outputs raise (the AEM's time tags).
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -62,13 +63,17 @@ class Breakpoint:
 class Where:
     """The state a segment starts from, as errors name it: ``key``, the scenario key
     that gave its rate (``initial_state.angular_velocity``, ``events[2].impulse``), and
-    ``text``, the state in words for the reason (empty for the initial state)."""
+    ``text``, the state in words for the reason (empty for the initial state), or a
+    function that gives it (worded only for an error: an event's epoch costs an
+    astropy formatting, and a Monte Carlo sample builds its segments thousands of
+    times)."""
 
     key: str
-    text: str = ""
+    text: str | Callable[[], str] = ""
 
     def error(self, reason: str) -> InputError:
-        return InputError(f"{self.text}: {reason}" if self.text else reason, key=self.key)
+        text = self.text() if callable(self.text) else self.text
+        return InputError(f"{text}: {reason}" if text else reason, key=self.key)
 
 
 def _initial_where(scenario: Scenario) -> Where:
@@ -86,7 +91,11 @@ def _event_where(scenario: Scenario, index: int, offset: float, event: Event) ->
         for name in ("angular_velocity", "angular_momentum"):
             if getattr(event, name, None) is not None:
                 key += f".{name}"
-    return Where(key, f"the state after the {event.kind} at {scenario.format_epoch(offset)}")
+    return Where(key, partial(_event_text, event.kind, scenario, offset))
+
+
+def _event_text(kind: str, scenario: Scenario, offset: float) -> str:
+    return f"the state after the {kind} at {scenario.format_epoch(offset)}"
 
 
 @dataclass(frozen=True)
