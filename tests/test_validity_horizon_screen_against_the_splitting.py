@@ -9,7 +9,9 @@ case), whose 1° crossing about 2.7 days in the averaged kicks find 10 % late.  
 that spinner stretched to days, the averaged run must cross half of each threshold
 before the splitting (order 4 at three tenths of a turn: within 1 % of DOP853 in
 ``tests/test_validity_horizon_against_dop853.py``) crosses the threshold; measured:
-at 0.51 to 0.64 of its time, for thresholds from 0.25° to 4° (the last 8 days in).
+at 0.51 to 0.64 of its time, for thresholds from 0.25° to 30° (the last 29 days in).
+The same for the Envisat-like tumbler of ``scenarios/tumbling_defunct_satellite.toml``
+over three days (0.23 to 0.49 of its time, 1° to 20°).
 """
 
 import dataclasses
@@ -23,18 +25,20 @@ from attitude.files.scenario_reader import load_scenario
 from attitude.trajectory.horizon import SCREEN_FRACTION, averaged_horizon, validity_horizon
 from attitude.trajectory.trajectory import propagate
 
-SPINNER = Path(__file__).parents[1] / "scenarios" / "spinner_thruster_pulse.toml"
+SCENARIOS = Path(__file__).parents[1] / "scenarios"
+SPINNER = SCENARIOS / "spinner_thruster_pulse.toml"
+TUMBLER = SCENARIOS / "tumbling_defunct_satellite.toml"
 
 
-def _spinner(tmp_path: Path, days: float):
-    text = re.sub(r"(?m)^duration = .*$", f"duration = {days * 86400.0!r}", SPINNER.read_text())
-    path = tmp_path / "spinner.toml"
+def _spinner(tmp_path: Path, days: float, source: Path = SPINNER):
+    text = re.sub(r"(?m)^duration = .*$", f"duration = {days * 86400.0!r}", source.read_text())
+    path = tmp_path / "scenario.toml"
     path.write_text(text)
     return load_scenario(path)
 
 
-def _check(tmp_path: Path, days: float, threshold_deg: float) -> None:
-    loaded = _spinner(tmp_path, days)
+def _check(tmp_path: Path, days: float, threshold_deg: float, source: Path = SPINNER) -> None:
+    loaded = _spinner(tmp_path, days, source)
     threshold = math.radians(threshold_deg)
     settings = dataclasses.replace(loaded.scenario.torques, horizon_threshold=threshold)
     trajectory = propagate(loaded.scenario.with_torques(settings))
@@ -55,6 +59,20 @@ def test_the_screen_crosses_half_of_one_degree_before_the_splitting_crosses_it(t
 @pytest.mark.parametrize("threshold_deg", [0.25, 2.0, 4.0])
 def test_the_screen_over_eight_days(tmp_path, threshold_deg):
     _check(tmp_path, 9.0, threshold_deg)
+
+
+@pytest.mark.slow
+def test_the_screen_over_a_month(tmp_path):
+    _check(tmp_path, 30.0, 8.0)  # the splitting crosses after 13 days
+
+
+def test_the_screen_of_a_tumbler_over_days(tmp_path):
+    _check(tmp_path, 3.0, 5.0, TUMBLER)
+
+
+@pytest.mark.slow
+def test_the_screen_of_a_tumbler_at_twenty_degrees(tmp_path):
+    _check(tmp_path, 3.0, 20.0, TUMBLER)
 
 
 def test_a_span_below_the_screen_is_beyond_the_horizon(tmp_path):
