@@ -23,18 +23,16 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import statistics
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 from benchmarks.report_one_day import scenario_text
+from benchmarks.run_record import machine_line, short_commit, started_utc, write_results
 
 ROOT = Path(__file__).parents[1]
-RESULTS = Path(__file__).parent / "results"
 
 # Run in a fresh interpreter: the run, then its own CPU and its children's, and the
 # CPU its own process spent in the horizon (the screen by averaged kicks, computed in
@@ -96,14 +94,9 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--days", type=float, default=1.0)
     args = parser.parse_args(argv)
-    commit = subprocess.run(
-        ["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"],
-        capture_output=True,
-        text=True,
-        check=True,
-    ).stdout.strip()
+    commit = short_commit(ROOT)
     loads = [os.getloadavg()[0]]
-    started = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+    started = started_utc()
     runs = []
     with tempfile.TemporaryDirectory() as folder:
         folder = Path(folder)
@@ -127,14 +120,11 @@ def main(argv: list[str] | None = None) -> dict:
         "median_run_cpu_s": statistics.median(r["run_cpu_s"] for r in runs),
         "case": f"spinner_thruster_pulse.toml over {args.days:g} day(s) at a 1 s step",
         "commit": commit,
-        "machine": f"{platform.machine()}, {os.cpu_count()} cores, {platform.system()} "
-        f"{platform.release()}, Python {platform.python_version()}",
+        "machine": machine_line(),
         "started": started,
         "load_1min": {"min": min(loads), "max": max(loads), "samples": loads},
     }
-    RESULTS.mkdir(exist_ok=True)
-    path = RESULTS / "horizon_share.json"
-    path.write_text(json.dumps(report, indent=2) + "\n")
+    path = write_results("horizon_share", report)
     print(
         f"{commit}: the horizon {100.0 * report['median_share']:.1f} % of the run's CPU "
         f"(median; {report['median_horizon_cpu_s']:.2f} s of "

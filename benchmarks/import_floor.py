@@ -31,17 +31,14 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import statistics
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
+from benchmarks.run_record import machine_line, started_utc, write_results
 from benchmarks.runs_side_by_side import ROOT, cases, run_once
-
-RESULTS = Path(__file__).parent / "results"
 
 # Run in the child: the example's run, then the third-party modules it imported.
 _RECORD = """
@@ -93,7 +90,7 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--peer-python", required=True, help="the peer venv's python")
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args(argv)
-    started = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+    started = started_utc()
     loads = [os.getloadavg()[0]]
     report: dict = {"cases": {}}
     with tempfile.TemporaryDirectory() as folder:
@@ -146,16 +143,13 @@ def main(argv: list[str] | None = None) -> dict:
             )
     report.update(
         {
-            "machine": f"{platform.machine()}, {os.cpu_count()} cores, {platform.system()} "
-            f"{platform.release()}, Python {platform.python_version()}",
+            "machine": machine_line(),
             "started": started,
             "load_1min": {"min": min(loads), "max": max(loads), "samples": loads},
             "repeat": args.repeat,
         }
     )
-    RESULTS.mkdir(exist_ok=True)
-    path = RESULTS / "import_floor.json"
-    path.write_text(json.dumps(report, indent=2) + "\n")
+    path = write_results("import_floor", report)
     print(
         f"{report['machine']}; started {started}; load (1 min) {min(loads):.1f} to "
         f"{max(loads):.1f}; written: {path}"

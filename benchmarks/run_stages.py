@@ -23,18 +23,16 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import statistics
 import subprocess
 import sys
 import tempfile
-import time
 from pathlib import Path
 
 from benchmarks.report_one_day import scenario_text
+from benchmarks.run_record import machine_line, short_commit, started_utc, write_results
 
 ROOT = Path(__file__).parents[1]
-RESULTS = Path(__file__).parent / "results"
 
 # Run in the child: the stages wrapped, then the command; the CPU of each stage (s)
 # written as JSON to the path in argv[1].
@@ -105,13 +103,8 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--one-day", action="store_true", help="the spinner over a day at 1 s")
     parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args(argv)
-    commit = subprocess.run(
-        ["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"],
-        capture_output=True,
-        text=True,
-        check=True,
-    ).stdout.strip()
-    started = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+    commit = short_commit(ROOT)
+    started = started_utc()
     loads = [os.getloadavg()[0]]
     with tempfile.TemporaryDirectory() as folder:
         folder = Path(folder)
@@ -133,15 +126,12 @@ def main(argv: list[str] | None = None) -> dict:
         "commit": commit,
         "median_cpu_s": medians,
         "runs": runs,
-        "machine": f"{platform.machine()}, {os.cpu_count()} cores, {platform.system()} "
-        f"{platform.release()}, Python {platform.python_version()}",
+        "machine": machine_line(),
         "started": started,
         "load_1min": {"min": min(loads), "max": max(loads), "samples": loads},
         "repeat": args.repeat,
     }
-    RESULTS.mkdir(exist_ok=True)
-    path = RESULTS / f"run_stages{'_one_day' if args.one_day else ''}.json"
-    path.write_text(json.dumps(report, indent=2) + "\n")
+    path = write_results(f"run_stages{'_one_day' if args.one_day else ''}", report)
     print(
         f"{report['scenario']} at {commit}; started {started}; load (1 min) "
         f"{min(loads):.1f} to {max(loads):.1f}; written: {path}"

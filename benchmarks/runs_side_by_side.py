@@ -28,9 +28,7 @@ Results: stdout and ``benchmarks/results/runs_side_by_side[_one_day].json``.
 from __future__ import annotations
 
 import argparse
-import json
 import os
-import platform
 import statistics
 import subprocess
 import sys
@@ -39,9 +37,9 @@ import time
 from pathlib import Path
 
 from benchmarks.report_one_day import scenario_text
+from benchmarks.run_record import machine_line, short_commit, started_utc, write_results
 
 ROOT = Path(__file__).parents[1]
-RESULTS = Path(__file__).parent / "results"
 # Scenarios that `attitude run` does not run as they are.
 _NOT_RUN = {"spinner_dispersions.toml"}
 
@@ -93,21 +91,11 @@ def main(argv: list[str] | None = None) -> dict:
     parser.add_argument("--one-day", action="store_true")
     parser.add_argument("--only", nargs="*", help="case names (the examples' file stems)")
     args = parser.parse_args(argv)
-    peer_commit = subprocess.run(
-        ["git", "-C", str(args.peer_tree), "rev-parse", "--short", "HEAD"],
-        capture_output=True,
-        text=True,
-        check=True,
-    ).stdout.strip()
-    this_commit = subprocess.run(
-        ["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"],
-        capture_output=True,
-        text=True,
-        check=True,
-    ).stdout.strip()
+    peer_commit = short_commit(args.peer_tree)
+    this_commit = short_commit(ROOT)
     sides = {"this": (sys.executable, ROOT), "peer": (args.peer_python, args.peer_tree)}
     loads = [os.getloadavg()[0]]
-    started = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+    started = started_utc()
     report: dict = {"cases": {}}
     with tempfile.TemporaryDirectory() as folder:
         folder = Path(folder)
@@ -141,16 +129,13 @@ def main(argv: list[str] | None = None) -> dict:
         {
             "this_commit": this_commit,
             "peer_commit": peer_commit,
-            "machine": f"{platform.machine()}, {os.cpu_count()} cores, {platform.system()} "
-            f"{platform.release()}, Python {platform.python_version()}",
+            "machine": machine_line(),
             "started": started,
             "load_1min": {"min": min(loads), "max": max(loads), "samples": loads},
             "repeat": args.repeat,
         }
     )
-    RESULTS.mkdir(exist_ok=True)
-    path = RESULTS / f"runs_side_by_side{'_one_day' if args.one_day else ''}.json"
-    path.write_text(json.dumps(report, indent=2) + "\n")
+    path = write_results(f"runs_side_by_side{'_one_day' if args.one_day else ''}", report)
     print(
         f"this {this_commit} against {peer_commit}; {report['machine']}; started {started}; "
         f"load (1 min) {min(loads):.1f} to {max(loads):.1f}; written: {path}"

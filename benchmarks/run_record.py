@@ -1,0 +1,43 @@
+"""What every whole-run benchmark records beside its figures: the commit, the machine,
+when it started, and where its results go (``benchmarks/results/NAME.json``)."""
+
+from __future__ import annotations
+
+import json
+import os
+import platform
+import subprocess
+import time
+from pathlib import Path
+
+RESULTS = Path(__file__).parent / "results"
+
+
+def short_commit(tree: Path) -> str:
+    """The short hash of ``tree``'s checked-out commit."""
+    return subprocess.run(
+        ["git", "-C", str(tree), "rev-parse", "--short", "HEAD"],
+        capture_output=True,
+        text=True,
+        check=True,
+    ).stdout.strip()
+
+
+def machine_line() -> str:
+    """The machine, its cores, the kernel and the Python that ran the benchmark."""
+    return (
+        f"{platform.machine()}, {os.cpu_count()} cores, {platform.system()} "
+        f"{platform.release()}, Python {platform.python_version()}"
+    )
+
+
+def started_utc() -> str:
+    return time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+
+
+def write_results(name: str, report: dict) -> Path:
+    """``report`` as ``benchmarks/results/{name}.json``; its path."""
+    RESULTS.mkdir(exist_ok=True)
+    path = RESULTS / f"{name}.json"
+    path.write_text(json.dumps(report, indent=2) + "\n")
+    return path
