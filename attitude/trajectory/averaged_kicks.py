@@ -132,6 +132,7 @@ from scipy.spatial.transform import Rotation
 from attitude.base.quaternions import right_matrix, rotation_rows
 from attitude.scenario.events import State
 from attitude.solver.backends import TABLE_MIN_SAMPLES
+from attitude.solver.closed_form import hamilton
 from attitude.solver.euler_solver import EulerSolver
 from attitude.torques.models import GravityGradient
 from attitude.torques.solver import angles_between
@@ -185,13 +186,12 @@ Angles = Callable[[NDArray[np.float64], NDArray[np.float64]], NDArray[np.float64
 @dataclass(frozen=True)
 class Departure:
     """What :func:`departure` found on one segment: ``crossing_s`` (TT s, or inf), the
-    torqued state at the segment's end (None after a crossing), the largest step (s)
-    and the number of steps taken."""
+    torqued state at the segment's end (None after a crossing) and the largest step
+    (s)."""
 
     crossing_s: float
     end_state: State | None
     largest_step_s: float
-    steps: int
 
 
 @dataclass(frozen=True)
@@ -236,17 +236,7 @@ class _Body:
 
 def _hamilton(p: NDArray[np.float64], q: NDArray[np.float64]) -> NDArray[np.float64]:
     """Hamilton products p ⊗ q of quaternion stacks (n, 4), scalar first."""
-    pw, px, py, pz = p[:, 0], p[:, 1], p[:, 2], p[:, 3]
-    qw, qx, qy, qz = q[:, 0], q[:, 1], q[:, 2], q[:, 3]
-    return np.stack(
-        [
-            pw * qw - px * qx - py * qy - pz * qz,
-            pw * qx + px * qw + py * qz - pz * qy,
-            pw * qy - px * qz + py * qw + pz * qx,
-            pw * qz + px * qy - py * qx + pz * qw,
-        ],
-        axis=-1,
-    )
+    return np.stack(hamilton(tuple(p.T), tuple(q.T)), axis=-1)
 
 
 def _sinc_half(angle: float) -> float:
@@ -291,7 +281,7 @@ class _Run:
     ) -> None:
         self.body, self.gradient, self.period = body, gradient, period
         self.free, self.threshold = free, threshold
-        self.largest, self.steps = 0.0, 0
+        self.largest = 0.0
         self.compared = 0  # nodes compared so far
         self.sub = 1.0  # the last step's sub-interval (s)
 
@@ -369,7 +359,7 @@ class _Run:
         size = float(np.linalg.norm(a)) + float(
             np.sqrt(np.max(np.einsum("ij,ij->i", moved_by, moved_by)))
         )
-        self.largest, self.steps = max(self.largest, h), self.steps + 1
+        self.largest = max(self.largest, h)
         return t, qs, after, size
 
     def run(
@@ -508,4 +498,4 @@ def departure(
     end_state = None
     if after is not None:
         end_state = body.body(after.angular_momentum(end_s), after.attitude(end_s), state.inertia)
-    return Departure(crossing, end_state, run.largest, run.steps)
+    return Departure(crossing, end_state, run.largest)

@@ -62,7 +62,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -75,7 +75,7 @@ from attitude.scenario.modes import ModeEvent
 from attitude.scenario.scenario import Scenario
 from attitude.scenario.torques import ScenarioTorques
 from attitude.solver.euler_solver import EulerSolver
-from attitude.torques.models import MU_EARTH_M3_S2, GravityGradient
+from attitude.torques.models import GravityGradient
 from attitude.torques.solver import angles_between, first_crossing
 from attitude.trajectory.averaged_kicks import departure
 from attitude.trajectory.modes import uses_laws
@@ -179,13 +179,7 @@ def _step(trajectory: Trajectory, orbit: Any) -> float:
         for segment in trajectory.segments
     ]
     candidates = [2.0 * math.pi / max(rates) * _TURN_FRACTION] if max(rates) > 0.0 else []
-    scenario = trajectory.scenario
-    with_orbit = scenario.with_torques(ScenarioTorques(gravity_gradient=orbit))
-    gradient = scenario_torque_models(with_orbit)[0][2]
-    if not isinstance(gradient, GravityGradient):
-        raise TypeError(f"the first torque model is the gravity gradient, got {gradient!r}")
-    radius = float(np.linalg.norm(gradient.position(np.array([0.0]))[0]))
-    candidates.append(2.0 * math.pi * math.sqrt(radius**3 / MU_EARTH_M3_S2) * _ORBIT_FRACTION)
+    candidates.append(_gradient(trajectory.scenario, orbit)[1] * _ORBIT_FRACTION)
     return min(candidates)
 
 
@@ -210,17 +204,7 @@ def screened_horizon(trajectory: Trajectory, orbit: Any) -> ValidityHorizon | No
         return None
     threshold = settings.horizon_threshold
     screen = averaged_horizon(trajectory, orbit, SCREEN_FRACTION * threshold)
-    if screen.within_span:
-        return None
-    return ValidityHorizon(
-        threshold,
-        math.inf,
-        screen.searched_s,
-        screen.span_s,
-        screen.step_s,
-        screen.order,
-        screen.method,
-    )
+    return None if screen.within_span else replace(screen, threshold_rad=threshold)
 
 
 def splitting_horizon(trajectory: Trajectory, orbit: Any) -> ValidityHorizon:
@@ -265,13 +249,10 @@ def _free_only(trajectory: Trajectory) -> bool:
     )
 
 
-def _gradient(trajectory: Trajectory, orbit: Any) -> tuple[GravityGradient, float]:
-    """The gravity gradient on ``orbit`` (interpolated) and the orbit period (s) at the
+def _gradient(scenario: Scenario, orbit: Any) -> tuple[GravityGradient, float]:
+    """The gravity gradient of ``scenario`` on ``orbit`` and the orbit period (s) at the
     epoch (two-body, from the radius there)."""
-    scenario = trajectory.scenario
-    with_orbit = scenario.with_torques(
-        ScenarioTorques(gravity_gradient=_interpolated(orbit, scenario))
-    )
+    with_orbit = scenario.with_torques(ScenarioTorques(gravity_gradient=orbit))
     gradient = scenario_torque_models(with_orbit)[0][2]
     if not isinstance(gradient, GravityGradient):
         raise TypeError(f"the first torque model is the gravity gradient, got {gradient!r}")
@@ -285,7 +266,7 @@ def averaged_horizon(trajectory: Trajectory, orbit: Any, threshold: float) -> Va
     its events: the screen of :func:`validity_horizon` (at :data:`SCREEN_FRACTION` of
     its threshold), an estimate whose accuracy the module docstring states."""
     scenario = trajectory.scenario
-    gradient, period = _gradient(trajectory, orbit)
+    gradient, period = _gradient(scenario, _interpolated(orbit, scenario))
     largest, crossing = 0.0, math.inf
     state: State | None = None
     for segment in trajectory.segments:
