@@ -30,7 +30,7 @@ import tempfile
 from pathlib import Path
 
 from benchmarks.report_one_day import scenario_text
-from benchmarks.run_record import machine_line, short_commit, started_utc, write_results
+from benchmarks.run_record import conditions, short_commit, started_utc, write_results
 
 ROOT = Path(__file__).parents[1]
 
@@ -120,9 +120,7 @@ def main(argv: list[str] | None = None) -> dict:
         "median_run_cpu_s": statistics.median(r["run_cpu_s"] for r in runs),
         "case": f"spinner_thruster_pulse.toml over {args.days:g} day(s) at a 1 s step",
         "commit": commit,
-        "machine": machine_line(),
-        "started": started,
-        "load_1min": {"min": min(loads), "max": max(loads), "samples": loads},
+        **conditions(started, loads),
     }
     path = write_results("horizon_share", report)
     print(

@@ -37,7 +37,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from benchmarks.run_record import machine_line, started_utc, write_results
+from benchmarks.run_record import conditions, started_utc, write_results
 from benchmarks.runs_side_by_side import ROOT, cases, run_once
 
 # Run in the child: the example's run, then the third-party modules it imported.
@@ -143,9 +143,7 @@ def main(argv: list[str] | None = None) -> dict:
             )
     report.update(
         {
-            "machine": machine_line(),
-            "started": started,
-            "load_1min": {"min": min(loads), "max": max(loads), "samples": loads},
+            **conditions(started, loads),
             "repeat": args.repeat,
         }
     )

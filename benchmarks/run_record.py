@@ -35,6 +35,16 @@ def started_utc() -> str:
     return time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
 
 
+def conditions(started: str, loads: list[float]) -> dict:
+    """The keys every result file holds on how it was measured: the machine, the start,
+    the 1-minute load average sampled during the run."""
+    return {
+        "machine": machine_line(),
+        "started": started,
+        "load_1min": {"min": min(loads), "max": max(loads), "samples": loads},
+    }
+
+
 def write_results(name: str, report: dict) -> Path:
     """``report`` as ``benchmarks/results/{name}.json``; its path."""
     RESULTS.mkdir(exist_ok=True)

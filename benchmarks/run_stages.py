@@ -30,7 +30,7 @@ import tempfile
 from pathlib import Path
 
 from benchmarks.report_one_day import scenario_text
-from benchmarks.run_record import machine_line, short_commit, started_utc, write_results
+from benchmarks.run_record import conditions, short_commit, started_utc, write_results
 
 ROOT = Path(__file__).parents[1]
 
@@ -126,9 +126,7 @@ def main(argv: list[str] | None = None) -> dict:
         "commit": commit,
         "median_cpu_s": medians,
         "runs": runs,
-        "machine": machine_line(),
-        "started": started,
-        "load_1min": {"min": min(loads), "max": max(loads), "samples": loads},
+        **conditions(started, loads),
         "repeat": args.repeat,
     }
     path = write_results(f"run_stages{'_one_day' if args.one_day else ''}", report)

@@ -37,7 +37,7 @@ import time
 from pathlib import Path
 
 from benchmarks.report_one_day import scenario_text
-from benchmarks.run_record import machine_line, short_commit, started_utc, write_results
+from benchmarks.run_record import conditions, short_commit, started_utc, write_results
 
 ROOT = Path(__file__).parents[1]
 # Scenarios that `attitude run` does not run as they are.
@@ -129,9 +129,7 @@ def main(argv: list[str] | None = None) -> dict:
         {
             "this_commit": this_commit,
             "peer_commit": peer_commit,
-            "machine": machine_line(),
-            "started": started,
-            "load_1min": {"min": min(loads), "max": max(loads), "samples": loads},
+            **conditions(started, loads),
             "repeat": args.repeat,
         }
     )

@@ -121,10 +121,7 @@ def _montecarlo_parser(commands) -> None:
     mc.add_argument("--out", type=Path, help="output folder (the rules of run --out)")
     mc.add_argument("--samples", type=int, help="sample count (replaces the file's)")
     mc.add_argument("--seed", type=int, help="seed (replaces the file's)")
-    where = mc.add_mutually_exclusive_group()
-    where.add_argument("--scheduler", help="address of a Dask scheduler (default: local)")
-    where.add_argument("--workers", type=int, help="local worker processes (default: all cores)")
-    mc.add_argument("--batch-size", type=int, help="samples per task (default: from costs)")
+    _dask_arguments(mc, "samples")
     mc.add_argument(
         "--sample", type=int, action="append", help="with --emit-scenario: sample K (repeatable)"
     )
@@ -145,11 +142,16 @@ def _envelope_parser(commands) -> None:
     )
     envelope.add_argument("scenario", type=Path, help="scenario file (TOML) with [envelope]")
     envelope.add_argument("--out", type=Path, help="output folder (the rules of run --out)")
-    where = envelope.add_mutually_exclusive_group()
+    _dask_arguments(envelope, "failures")
+    envelope.add_argument("--quiet", action="store_true", help="no progress bar or messages")
+
+
+def _dask_arguments(parser, items: str) -> None:
+    """Where a Dask job runs, and how many of its ``items`` a task takes."""
+    where = parser.add_mutually_exclusive_group()
     where.add_argument("--scheduler", help="address of a Dask scheduler (default: local)")
     where.add_argument("--workers", type=int, help="local worker processes (default: all cores)")
-    envelope.add_argument("--batch-size", type=int, help="failures per task (default: from costs)")
-    envelope.add_argument("--quiet", action="store_true", help="no progress bar or messages")
+    parser.add_argument("--batch-size", type=int, help=f"{items} per task (default: from costs)")
 
 
 def _outputs(args, outputs):

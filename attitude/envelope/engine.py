@@ -15,12 +15,12 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from attitude.base.errors import InputError
 from attitude.envelope.failure import BatchResult, EnvelopeJob, evaluate_batch
 from attitude.envelope.plan import EnvelopePlan, make_job
 from attitude.montecarlo.cluster import (
     batch_ranges,
     batches_as_they_finish,
+    check_batch_size,
     check_where,
     check_workers,
     connect,
@@ -60,10 +60,7 @@ def simulate(
     import pandas
 
     stage = stage or (lambda text: None)
-    if batch_size is not None and not 1 <= batch_size <= plan.count:
-        raise InputError(
-            f"expected 1 to {plan.count}, got {batch_size}", key="--batch-size", value=batch_size
-        )
+    check_batch_size(batch_size, plan.count)
     count = check_where(scheduler, workers, probe=not probed)
     started = time.perf_counter()
     stage("the nominal timeline and the hand-off states")

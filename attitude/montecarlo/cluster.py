@@ -31,6 +31,7 @@ from attitude.outputs.folder import held_signals
 __all__ = [
     "batch_ranges",
     "batches_as_they_finish",
+    "check_batch_size",
     "check_where",
     "check_workers",
     "connect",
@@ -375,6 +376,14 @@ def check_workers(client) -> int:
                 key="--scheduler",
             )
     return sum(w["nthreads"] for w in client.scheduler_info()["workers"].values())
+
+
+def check_batch_size(batch_size: int | None, count: int) -> None:
+    """A ``--batch-size`` given for a job of ``count`` items: 1 to ``count``."""
+    if batch_size is not None and not 1 <= batch_size <= count:
+        raise InputError(
+            f"expected 1 to {count}, got {batch_size}", key="--batch-size", value=batch_size
+        )
 
 
 def batch_ranges(count: int, size: int) -> list[tuple[int, int]]:

@@ -45,11 +45,11 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from attitude.base.errors import InputError
 from attitude.montecarlo.cluster import (
     WORKER_MODULES,
     batch_ranges,
     batches_as_they_finish,
+    check_batch_size,
     check_where,
     check_workers,
     connect,
@@ -177,10 +177,7 @@ def simulate(
     import pandas
 
     stage = stage or (lambda text: None)
-    if batch_size is not None and not 1 <= batch_size <= mc.samples:
-        raise InputError(
-            f"expected 1 to {mc.samples}, got {batch_size}", key="--batch-size", value=batch_size
-        )
+    check_batch_size(batch_size, mc.samples)
     if scheduler is not None and not probed:
         stage(f"trying the Dask scheduler at {scheduler}")
     count = check_where(scheduler, workers, probe=not probed)
