@@ -50,6 +50,11 @@ def process_started_at() -> float:
         return _IMPORTED
     now = time.perf_counter()
     since_import = now - _IMPORTED
-    # The process began before this import, and not a minute before it: otherwise the
-    # clocks disagree (a container's /proc/uptime, say), and the import is close.
-    return now - age if since_import - 0.1 <= age <= since_import + 60.0 else _IMPORTED
+    # The process began before this import, and not much before it: /proc counts from
+    # the fork, and a shell that runs its last command by exec (``sh -c "pip install .
+    # && attitude run ..."``) forked this process before everything it ran first.  What
+    # came before the import here is Python's start, which computes: a few times the
+    # CPU this process has used, at most.  Otherwise (that, or clocks that disagree: a
+    # container's /proc/uptime, say) the import is close.
+    plausible = since_import + 5.0 * time.process_time() + 0.5
+    return now - age if since_import - 0.1 <= age <= plausible else _IMPORTED
