@@ -132,3 +132,35 @@ def test_a_span_not_covered_builds_another(spinner):
     full = shared_surroundings(trajectory, spec)
     assert full is not short and full.covers(0.0, trajectory.scenario.stop_s)
     assert math.isfinite(full.position_error_m)
+
+
+def test_pieces_left_exact_bound_nothing_and_the_search_still_runs(spinner, monkeypatch):
+    """Pieces no series fits (a TLE propagated months from its epoch: from 196 days on,
+    the spinner's orbit) are evaluated exactly; their rate bounds are infinite, and the
+    least distance comes from the fitted pieces, not from the exact pieces' empty
+    series (which read as a position at the Earth's centre, and divided by zero).  Here
+    every piece is left exact (tolerances no fit meets), and the search on those
+    surroundings finds the eclipses the exact path has (within twice the interval
+    precision, 1 ms)."""
+    import attitude.pointing.shared_surroundings as module
+    from attitude.pointing.search import pointing_analysis
+
+    trajectory, spec = spinner
+    monkeypatch.setattr(module, "_POSITION_TOLERANCE_M", 0.0)
+    monkeypatch.setattr(module, "_HALVINGS", 0)
+    stop = trajectory.scenario.stop_s
+    epoch = trajectory.scenario.epoch.tt
+    shared = SharedSurroundings(
+        (epoch.jd1, epoch.jd2), spec.orbit, spec.earth_limb_atmosphere_height_m, 0.0, stop
+    )
+    bounds = shared.rate_bounds()
+    assert all(math.isinf(bounds[name]) for name in ("nadir_1", "nadir_2", "limb_1", "sun_1"))
+    exact = pointing_analysis(trajectory, spec)
+    found = pointing_analysis(trajectory, spec, surroundings=shared)
+    assert exact.shadow
+    for name in ("shadow", "umbra"):
+        ends = [(i.start_s, i.end_s) for i in getattr(exact, name)]
+        assert len(getattr(found, name)) == len(ends)
+        np.testing.assert_allclose(
+            [(i.start_s, i.end_s) for i in getattr(found, name)], ends, rtol=0.0, atol=2e-3
+        )

@@ -282,7 +282,9 @@ class SharedSurroundings:
                 exact[k] = True
             else:
                 cheb_all[k] = cheb_k
-        degree = self._least_degree(cheb_all)
+        # The degree from the fitted pieces alone: a piece left exact has no series (its
+        # zeros would read as a position at the Earth's centre).
+        degree = self._least_degree(cheb_all[~exact])
         # Powers of t of the truncated series: |T_k| ≤ 1 on [−1, 1], so the dropped
         # coefficients bound what the truncation adds (``_least_degree``).
         to_power = _TO_POWER[: degree + 1, : degree + 1]
@@ -350,7 +352,8 @@ class SharedSurroundings:
         :mod:`attitude.pointing.free_search`): ``<field>_1`` ≥ |p'| and ``<field>_2`` ≥
         |p''| of each interpolated field p (a polynomial of t ∈ [−1, 1] on each piece is
         at most the sum of its coefficients' magnitudes there), and the least distance
-        ``r_least`` (m) on an orbit.  The exact pieces use the check's samples."""
+        ``r_least`` (m) on an orbit, over the fitted pieces (a piece left exact has no
+        series; where there is one, every rate bound is infinite)."""
         k = np.arange(self._coefficients.shape[1], dtype=np.float64)
         scale = (2.0 / widths)[:, None]
         first = np.einsum("k,pkc->pc", k, np.abs(self._coefficients)) * scale
@@ -361,9 +364,10 @@ class SharedSurroundings:
             bounds[f"{name}_2"] = float(np.max(norm(second[:, columns]), initial=0.0))
         if "r" in self._slices:
             # The least |r|: every coefficient but the constant bounds the variation.
-            constant = self._coefficients[:, 0, self._slices["r"]]
-            rest = np.sum(np.abs(self._coefficients[:, 1:, self._slices["r"]]), axis=1)
-            bounds["r_least"] = float(np.min(norm(constant) - norm(rest)))
+            fitted = self._coefficients[~self._exact_pieces]
+            constant = fitted[:, 0, self._slices["r"]]
+            rest = np.sum(np.abs(fitted[:, 1:, self._slices["r"]]), axis=1)
+            bounds["r_least"] = float(np.min(norm(constant) - norm(rest), initial=math.inf))
         if np.any(self._exact_pieces):
             bounds = {name: math.inf for name in bounds} | (
                 {"r_least": bounds["r_least"]} if "r_least" in bounds else {}
@@ -505,6 +509,14 @@ class SharedSurroundings:
             # attitude.pointing.free_search derive both).
             least = b["r_least"]
             r1, r2 = b["r_1"], b["r_2"]
+            if not (0.0 < least < math.inf and math.isfinite(r1)):
+                # A piece left exact (or none fitted): nothing of the orbit is bounded.
+                out.update(
+                    dict.fromkeys(
+                        ("nadir_1", "nadir_2", "fraction_1", "limb_1", "limb_2"), math.inf
+                    )
+                )
+                return out
             out["nadir_1"] = r1 / least
             out["nadir_2"] = 2.0 * r2 / least + 5.0 * (r1 / least) ** 2
             # The lit fraction changes at most at (2/π a) per radian of the discs'
