@@ -38,6 +38,7 @@ shape ``times.shape + (3,)``.  Epochs are ``astropy.time.Time`` or ISO strings.
 
 from __future__ import annotations
 
+import math
 import re
 from abc import ABC, abstractmethod
 from typing import Any
@@ -51,7 +52,14 @@ from attitude.environment.earth import HILL_RADIUS_M
 from attitude.environment.ephemeris import timescale
 from attitude.environment.timescales import SECONDS_PER_DAY, as_time, offline_time
 
-__all__ = ["TLE_NOTED_AFTER_DAYS", "TLE_REFUSED_AFTER_DAYS", "Orbit", "TleOrbit", "tt_jd"]
+__all__ = [
+    "TLE_NOTED_AFTER_DAYS",
+    "TLE_REFUSED_AFTER_DAYS",
+    "Orbit",
+    "TleOrbit",
+    "coverage_seconds",
+    "tt_jd",
+]
 
 _LINE_LENGTH = 69
 # SGP4 elements are for days to weeks around their epoch: beyond the first limit a
@@ -71,6 +79,20 @@ def tt_jd(times: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     with offline_time():
         tt = times.tt
         return np.ravel(tt.jd1).astype(np.float64), np.ravel(tt.jd2).astype(np.float64)
+
+
+def coverage_seconds(orbit: Any, jd: tuple[float, float]) -> tuple[float, float]:
+    """The epochs ``orbit`` serves (:meth:`Orbit.coverage_tt`) as TT seconds since the
+    two-part TT Julian date ``jd``: (−inf, inf) for a source that serves every epoch,
+    or any object without ``coverage_tt``.  What samples an orbit with a margin about a
+    span keeps the margin within these (an orbit file may cover the span exactly)."""
+    coverage = getattr(orbit, "coverage_tt", None)
+    found = coverage() if coverage is not None else None
+    if found is None:
+        return -math.inf, math.inf
+    jd1, jd2 = jd
+    (a1, a2), (b1, b2) = found
+    return ((a1 - jd1) + (a2 - jd2)) * SECONDS_PER_DAY, ((b1 - jd1) + (b2 - jd2)) * SECONDS_PER_DAY
 
 
 class Orbit(ABC):
@@ -99,6 +121,14 @@ class Orbit(ABC):
         """Refuse (InputError) a span [start, stop] (``Time``) the source cannot cover;
         return notes.  By default every span is covered."""
         return []
+
+    def coverage_tt(self) -> tuple[tuple[float, float], tuple[float, float]] | None:
+        """The first and last epochs the source serves, as two-part TT Julian dates, or
+        None where it serves every epoch (a TLE or a Keplerian orbit: their limits are
+        refused by :meth:`check_span`, days from their epoch, not at an instant).  What
+        samples the orbit around a span (the shared surroundings' aligned pieces) keeps
+        within it."""
+        return None
 
     def position_velocity(self, times: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Position (m) and velocity (m/s) in the GCRS at ``times`` (``Time`` or ISO
