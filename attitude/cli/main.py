@@ -242,13 +242,7 @@ def _describe(loaded, plan, out: Path | None = None) -> str:
 
     lines += [f"  {line}" for line in describe_lines(loaded.pointing)]
     if plan.aem is not None:
-        steps = [item.step_s for item in plan.aem.segments]
-        lines.append(
-            f"  aem         {plan.aem.records} records (a record every "
-            f"{min(steps):.4g} to {max(steps):.4g} s), LAGRANGE interpolation within "
-            f"{plan.aem.tolerance_rad:g} rad of the "
-            f"{'exact' if is_exact(plan) else 'propagated'} attitude"
-        )
+        lines.append(f"  aem         {plan.aem.describe(is_exact(plan))}")
     from attitude.outputs.budget import free_disk_bytes, size_text
 
     if out is None:

@@ -101,7 +101,7 @@ def plan_run(
         check_span(scenario.start_s, scenario.stop_s, "--formats parquet")
     _check_gravity_gradient_orbit(scenario)
     say(_propagating(scenario, check))
-    trajectory = propagate(scenario, check=check)
+    trajectory = _propagated(scenario, outputs, check)
     # The size and memory checks come before the analysis and the pointing checks,
     # which do not depend on the output grid but can take a while on a long span.
     vectors, on_orbit = len(pointing.body_vectors), pointing.on_orbit
@@ -160,6 +160,7 @@ def plan_run(
             scenario.stop_s,
             outputs.aem_tolerance_rad,
             outputs.tolerance_key,
+            budget_s=CHECK_BUDGET_S if check else None,
         )
     budget = estimate(
         samples,
@@ -184,6 +185,33 @@ def plan_run(
         horizon_deferred=wanted and not horizon,
         check=check,
     )
+
+
+def _propagated(scenario: Scenario, outputs: OutputChoice, check: bool) -> Trajectory:
+    """The scenario propagated for the plan.  A run under torques first takes check's
+    path (:func:`propagate` with ``check``: the step search, or the estimate at a given
+    step, within check's CPU budget; its tries are the run's own): within the budget
+    that is the run itself, bit for bit, and is kept; past it, check's motion at a
+    longer step says what check refuses from it (the AEM's 1 ns time tags of a runaway
+    burn) before the run propagates for minutes, so that run refuses it at once with
+    check's line.  The full propagation follows."""
+    if check or not scenario.torques.any:
+        return propagate(scenario, check=check)
+    preview = propagate(scenario, check=True)
+    steps = preview.steps
+    found = None if steps is None else steps.measurement
+    if not preview.approximate and steps is not None and steps.settled:
+        if found is not None and found.complete:
+            return preview
+    if "aem" in outputs:
+        check_time_tags(
+            preview,
+            scenario.start_s,
+            scenario.stop_s,
+            outputs.aem_tolerance_rad,
+            outputs.tolerance_key,
+        )
+    return propagate(scenario)
 
 
 def _propagating(scenario: Scenario, check: bool) -> str:
