@@ -426,3 +426,42 @@ def test_every_run_error_names_the_file_and_the_key(tmp_path, capsys):
             r"(pointing\.tle|initial_state\.angular_velocity|output\.step|scenario\.epoch): ",
             line,
         )
+
+
+def test_run_refuses_a_runaway_burn_as_check_does_before_propagating_it(
+    tmp_path, capsys, monkeypatch
+):
+    """A burn that spins the body up to 1.5e5 rad/s, with an accuracy and the AEM: check
+    refuses it from its motion within its budget (1 ns time tags cannot hold that
+    rate); run searched the step over the whole span first (41 s of CPU on this 10 s
+    span, minutes over a longer one), then refused with the same line.  Run takes check's path as
+    far as check's budget goes, and refuses there: the full propagation never starts."""
+    import attitude.report.plan as plan_module
+    import attitude.trajectory.trajectory as trajectory_module
+
+    monkeypatch.setattr(trajectory_module, "CHECK_BUDGET_S", 0.5)  # check's, shorter: faster
+    text = BASE + (
+        '\n[torques]\naccuracy = { value = 1e-6, unit = "rad" }\n'
+        "\n[[torques.burns]]\noffset = 1.0\nduration = 5.0\ntorque = [0.0, 0.0, 1e5]\n"
+    )
+    path = tmp_path / "bad.toml"
+    path.write_text(text, encoding="utf-8")
+    asked = []
+    propagate = plan_module.propagate
+
+    def recorded(scenario, *args, check=False, **kwargs):
+        asked.append(check)
+        return propagate(scenario, *args, check=check, **kwargs)
+
+    monkeypatch.setattr(plan_module, "propagate", recorded)
+    lines = []
+    for command in ("check", "run"):
+        argv = [command, str(path), "--formats", "csv,aem"]
+        code = main(
+            argv + (["--out", str(tmp_path / "out"), "--quiet"] if command == "run" else [])
+        )
+        assert code == 2
+        lines.append(_lines(capsys))
+    assert lines[0] == lines[1] and len(lines[0]) == 1, lines
+    assert "1 ns time tag" in lines[0][0] and "torques.burns[0].torque" in lines[0][0]
+    assert asked == [True, True]  # check's path, twice; never the run's whole propagation

@@ -99,6 +99,7 @@ KEYS = {
     "separatrix": ACCEPTED,
     "separatrix_after_reset": ACCEPTED,
     "seven_tib": "output.step",
+    "slew_bare_rate": "events[0].slew.max_rate",
     "spacecraft_name_blank": "spacecraft.name",
     "span_across_2053": "output.duration",
     "sphere": ACCEPTED,

@@ -37,18 +37,19 @@ SUN_M = [1.496e11, 0.0, 0.0]
         (
             fix_checksum(LINE1.replace("14020.93", "14x20.93")),
             LINE2,
-            r"line1: not a TLE number \(could not convert string to float: 'x20.93268519'\)",
+            r"line1: columns 21-32 \(epoch day\) hold 'x20\.93268519', not a number as the TLE "
+            r"layout writes it",
         ),
         (
             LINE1,
             fix_checksum(LINE2.replace("0003572", "00035x2")),
-            r"line2: not a TLE number",
+            r"line2: columns 27-33 \(eccentricity\) hold '00035x2', not a number",
         ),
         (
             LINE1,
             fix_checksum(LINE2.replace("15.49815350", "00.00000000")),
-            r"line2: SGP4 cannot start from these elements \(float division by zero; mean "
-            r"motion 00.00000000 rev/day",
+            r"line2: SGP4 cannot start from these elements \(a division by zero in its "
+            r"initialisation; mean motion 00.00000000 rev/day",
         ),
         (
             LINE1,

@@ -262,7 +262,10 @@ def _horizon_through_the_cli(tmp_path, capsys, text, torques_line):
 
 def test_a_torque_free_file_with_an_orbit_states_its_validity_horizon(tmp_path, capsys):
     horizon = _horizon_through_the_cli(
-        tmp_path, capsys, SCENARIO, "torques     none: the exact torque-free solver"
+        tmp_path,
+        capsys,
+        SCENARIO,
+        "torques     none: exact torque-free motion (closed form, no integration)",
     )
     direct = departure_time(
         I_TUMBLER, I_TUMBLER * W_TUMBLER, R0, 0.0, [GravityGradient(circle)], 1200.0, step=5.0

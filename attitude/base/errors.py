@@ -19,7 +19,14 @@ from __future__ import annotations
 import copy
 from typing import Any
 
-__all__ = ["NO_VALUE", "AttitudeError", "InertiaWarning", "InputError", "OptionError"]
+__all__ = [
+    "NO_VALUE",
+    "AttitudeError",
+    "InertiaWarning",
+    "InputError",
+    "LawRateWarning",
+    "OptionError",
+]
 
 
 class _NoValue:
@@ -111,6 +118,21 @@ class InertiaWarning(UserWarning):
     :class:`InputError`, it carries ``key`` (the argument that holds the inertia) and
     ``reason``; ``str(warning)`` is ``key: reason``.
     """
+
+    def __init__(self, reason: str, *, key: str | None = None) -> None:
+        super().__init__(reason)
+        self.reason = reason
+        self.key = key or None
+
+    def __str__(self) -> str:
+        return f"{self.key}: {self.reason}" if self.key else self.reason
+
+
+class LawRateWarning(UserWarning):
+    """An attitude law that demands a body rate beyond the scenario's slew limits (or,
+    with none given, beyond what agile spacecraft turn at): the motion is computed as
+    the law says, and the warning says how fast and when.  ``key``: the law's scenario
+    key; ``str(warning)`` is ``key: reason``."""
 
     def __init__(self, reason: str, *, key: str | None = None) -> None:
         super().__init__(reason)

@@ -226,7 +226,7 @@ def _describe(loaded, plan, out: Path | None = None) -> str:
             f"  segment {index}   from {scenario.format_epoch(item.start_s)}: {item.motion} "
             f"({how}{period}{flips})"
         )
-    from attitude.report.torques import torques_lines
+    from attitude.report.torques import is_exact, torques_lines
 
     lines += [f"  {line}" for line in torques_lines(plan)]
     from attitude.report.guidance import guidance_lines
@@ -242,13 +242,7 @@ def _describe(loaded, plan, out: Path | None = None) -> str:
 
     lines += [f"  {line}" for line in describe_lines(loaded.pointing)]
     if plan.aem is not None:
-        steps = [item.step_s for item in plan.aem.segments]
-        lines.append(
-            f"  aem         {plan.aem.records} records (a record every "
-            f"{min(steps):.4g} to {max(steps):.4g} s), LAGRANGE interpolation within "
-            f"{plan.aem.tolerance_rad:g} rad of the "
-            f"{'propagated' if scenario.torques.any else 'exact'} attitude"
-        )
+        lines.append(f"  aem         {plan.aem.describe(is_exact(plan))}")
     from attitude.outputs.budget import free_disk_bytes, size_text
 
     if out is None:

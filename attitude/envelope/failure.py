@@ -49,6 +49,7 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from attitude.envelope.power import (
+    as_fraction,
     first_below,
     first_below_many,
     first_nodes,
@@ -307,7 +308,7 @@ def _row(
                 integral(_power_in(shared, segment.solver, normals, shadow), a, b, lip)
                 for a, b, lip, shadow in pieces
             )
-            row["power_mean"] = energy / job.window
+            row["power_mean"] = as_fraction(energy / job.window)  # the quadrature's rounding
         row["power_lost_s"] = math.nan
         quaternions = segment.solver.attitude_quaternion
         power = _Power(row, τ, quaternions, normals, pieces, analysis.precision_s)

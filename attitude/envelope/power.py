@@ -37,6 +37,7 @@ from numpy.typing import NDArray
 from attitude.base.quaternions import rotation_rows
 
 __all__ = [
+    "as_fraction",
     "first_below",
     "first_below_many",
     "first_nodes",
@@ -83,8 +84,20 @@ def mean_incidence(
         cosine = (rows[0][0] * b[0] + rows[0][1] * b[1] + rows[0][2] * b[2]) * sun[:, 0]
         cosine += (rows[1][0] * b[0] + rows[1][1] * b[1] + rows[1][2] * b[2]) * sun[:, 1]
         cosine += (rows[2][0] * b[0] + rows[2][1] * b[1] + rows[2][2] * b[2]) * sun[:, 2]
-        total += np.maximum(cosine, 0.0)
+        # Clamped to 1: the cosine of two unit vectors, each unit within a few ulps
+        # (the interpolated Sun's length is within 1e-15 of 1, measured), rounds to just
+        # above 1 for a panel square to the Sun (1.0000000000000004 under the example's
+        # Sun law): a rounding, not a power above full.
+        total += np.clip(cosine, 0.0, 1.0)
     return total / len(panels)
+
+
+def as_fraction(value: float) -> float:
+    """A mean of the power fraction from :func:`integral` (a Gauss–Legendre sum of
+    values within [0, 1], over the window) held within [0, 1]: the weights' sum and
+    the products round, and a panel square to the Sun all window long sums to just
+    above 1."""
+    return min(max(value, 0.0), 1.0)
 
 
 def first_below(

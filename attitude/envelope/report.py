@@ -49,9 +49,25 @@ def worst(table) -> int | None:
     return int(ordered.index[0])
 
 
-# Per metric, whether its worst value is its least (times, margins) or its greatest.
+# Per metric, whether its worst value is its least (times, power) or its greatest
+# (rates, flips, and a panel's least Sun angle: 0 is the panel square to the Sun, its
+# best; the worst failure leaves the Sun furthest from it).
 def _least_is_worst(name: str) -> bool:
+    if name.endswith("_least_sun_angle_deg"):
+        return False
     return not (name.startswith("rate_") or name == "flips" or name.endswith("_at_s"))
+
+
+def _worst_of(name: str, tau: np.ndarray, values: np.ndarray) -> dict[str, float | None]:
+    """The worst τ of one metric and its value, the earliest of ties; none (null) where
+    the metric has a value at no τ (a time not within the window, ``inf``, at every τ:
+    no failure time is worse than another)."""
+    known = np.isfinite(values)
+    if not known.any():
+        return {"tau_s": None, "value": None}
+    candidates = np.where(known, values, np.inf if _least_is_worst(name) else -np.inf)
+    k = int(np.argmin(candidates) if _least_is_worst(name) else np.argmax(candidates))
+    return {"tau_s": float(tau[k]), "value": float(values[k])}
 
 
 def summary(result: EnvelopeResult) -> dict[str, Any]:
@@ -60,12 +76,11 @@ def summary(result: EnvelopeResult) -> dict[str, Any]:
     ok = table[table["status"] == "ok"]
     row = worst(table)
     per_metric = {}
+    tau = ok["tau_s"].to_numpy(dtype=float)
     for name in plan.metrics:
         if name in ("rate_max_at_s",) or ok.empty:
             continue
-        values = ok[name].to_numpy(dtype=float)
-        k = int(np.argmin(values) if _least_is_worst(name) else np.argmax(values))
-        per_metric[name] = {"tau_s": float(ok["tau_s"].iloc[k]), "value": float(values[k])}
+        per_metric[name] = _worst_of(name, tau, ok[name].to_numpy(dtype=float))
     settings = plan.settings
     return to_json(
         {
@@ -197,7 +212,11 @@ def _page(result: EnvelopeResult, stats: dict[str, Any], images, files) -> str:
         _table(
             ["metric", "τ (s)", "value"],
             [
-                [name, f"{entry['tau_s']:g}", _cell(entry["value"])]
+                [
+                    name,
+                    "—" if entry["tau_s"] is None else f"{entry['tau_s']:g}",
+                    _cell(entry["value"]),
+                ]
                 for name, entry in stats["worst_per_metric"].items()
             ],
         )

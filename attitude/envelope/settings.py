@@ -231,5 +231,5 @@ def read_envelope(loaded: ScenarioFile) -> EnvelopeSettings:
             power_threshold=threshold,
             keys=keys,
         )
-    except InputError as exc:
-        raise exc.located(file=loaded.path.name) from None
+    except InputError as exc:  # its keys are the file's, from the root: said as written
+        root.refuse(exc)

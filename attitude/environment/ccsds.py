@@ -115,17 +115,21 @@ def parse_epochs(texts: list[str], scale: str, offset_s: float, where: str):
             converted.append(text.removesuffix("Z"))
         else:
             raise InputError(f"{where}: not a CCSDS epoch: {text!r}")
-    try:
-        with offline_time():
-            # Each text in its own format: isot and yday may mix in one file.
-            times = Time(
-                [Time(t, format="yday" if ":" in t[:8] else "isot", scale=scale) for t in converted]
-            )
-            if offset_s:
-                times = times + TimeDelta(offset_s, format="sec")
-            return times
-    except (ValueError, TypeError) as exc:
-        raise InputError(f"{where}: an epoch astropy cannot read ({exc})") from None
+    read = []
+    with offline_time():
+        # Each text in its own format: isot and yday may mix in one file.
+        for text, given in zip(converted, texts, strict=True):
+            try:
+                read.append(Time(text, format="yday" if ":" in text[:8] else "isot", scale=scale))
+            except (ValueError, TypeError) as exc:
+                # ERFA names the bad field ("bad month"); astropy's own words are not ours.
+                found = re.search(r'of "([^"]+)"', str(exc))
+                why = found.group(1) if found else "not a calendar date and time"
+                raise InputError(f"{where}: epoch {given.strip()!r}: {why}") from None
+        times = Time(read)
+        if offset_s:
+            times = times + TimeDelta(offset_s, format="sec")
+        return times
 
 
 def _window(count: int, nodes: int, interval: NDArray[np.intp]) -> NDArray[np.intp]:

@@ -159,6 +159,13 @@ class OemOrbit(Orbit):
             ).utc.isot
         return f"{ends[0]} to {ends[1]} UTC"
 
+    def coverage_tt(self) -> tuple[tuple[float, float], tuple[float, float]] | None:
+        """The first segment's useable start and the last one's stop (TT)."""
+        if self._day is None:
+            return None
+        first, last = self._segments[0].start_s, self._segments[-1].stop_s
+        return (self._day, first / SECONDS_PER_DAY), (self._day, last / SECONDS_PER_DAY)
+
     def _seconds(self, jd1, jd2) -> NDArray[np.float64]:
         if self._day is None:
             raise ValueError("the OEM has no segment yet")

@@ -38,6 +38,7 @@ shape ``times.shape + (3,)``.  Epochs are ``astropy.time.Time`` or ISO strings.
 
 from __future__ import annotations
 
+import math
 import re
 from abc import ABC, abstractmethod
 from typing import Any
@@ -51,7 +52,14 @@ from attitude.environment.earth import HILL_RADIUS_M
 from attitude.environment.ephemeris import timescale
 from attitude.environment.timescales import SECONDS_PER_DAY, as_time, offline_time
 
-__all__ = ["TLE_NOTED_AFTER_DAYS", "TLE_REFUSED_AFTER_DAYS", "Orbit", "TleOrbit", "tt_jd"]
+__all__ = [
+    "TLE_NOTED_AFTER_DAYS",
+    "TLE_REFUSED_AFTER_DAYS",
+    "Orbit",
+    "TleOrbit",
+    "coverage_seconds",
+    "tt_jd",
+]
 
 _LINE_LENGTH = 69
 # SGP4 elements are for days to weeks around their epoch: beyond the first limit a
@@ -71,6 +79,20 @@ def tt_jd(times: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
     with offline_time():
         tt = times.tt
         return np.ravel(tt.jd1).astype(np.float64), np.ravel(tt.jd2).astype(np.float64)
+
+
+def coverage_seconds(orbit: Any, jd: tuple[float, float]) -> tuple[float, float]:
+    """The epochs ``orbit`` serves (:meth:`Orbit.coverage_tt`) as TT seconds since the
+    two-part TT Julian date ``jd``: (−inf, inf) for a source that serves every epoch,
+    or any object without ``coverage_tt``.  What samples an orbit with a margin about a
+    span keeps the margin within these (an orbit file may cover the span exactly)."""
+    coverage = getattr(orbit, "coverage_tt", None)
+    found = coverage() if coverage is not None else None
+    if found is None:
+        return -math.inf, math.inf
+    jd1, jd2 = jd
+    (a1, a2), (b1, b2) = found
+    return ((a1 - jd1) + (a2 - jd2)) * SECONDS_PER_DAY, ((b1 - jd1) + (b2 - jd2)) * SECONDS_PER_DAY
 
 
 class Orbit(ABC):
@@ -99,6 +121,14 @@ class Orbit(ABC):
         """Refuse (InputError) a span [start, stop] (``Time``) the source cannot cover;
         return notes.  By default every span is covered."""
         return []
+
+    def coverage_tt(self) -> tuple[tuple[float, float], tuple[float, float]] | None:
+        """The first and last epochs the source serves, as two-part TT Julian dates, or
+        None where it serves every epoch (a TLE or a Keplerian orbit: their limits are
+        refused by :meth:`check_span`, days from their epoch, not at an instant).  What
+        samples the orbit around a span (the shared surroundings' aligned pieces) keeps
+        within it."""
+        return None
 
     def position_velocity(self, times: Any) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Position (m) and velocity (m/s) in the GCRS at ``times`` (``Time`` or ISO
@@ -392,13 +422,49 @@ def _check_format(line1: str, line2: str) -> None:
             raise InputError(
                 f"line{number}: columns do not follow the TLE layout {template!r}: {line!r}"
             ) from None
-        # A number that does not parse: name the line that holds it.
-        token = re.search(r"'(.*)'$", text)
-        number = 2 if token and token.group(1) not in line1 else 1
-        line = line1 if number == 1 else line2
-        raise InputError(f"line{number}: not a TLE number ({text}): {line!r}") from None
+        # A number that does not parse: name the field, in our words (sgp4's message is
+        # Python's, "invalid literal for int() with base 10", about a text it reshaped).
+        raise _not_a_number(line1, line2) from None
     except ArithmeticError as exc:
+        what = "a division by zero" if isinstance(exc, ZeroDivisionError) else "an overflow"
         raise InputError(
-            f"line2: SGP4 cannot start from these elements ({exc}; mean motion "
-            f"{line2[52:63].strip()} rev/day, eccentricity 0.{line2[26:33]}): {line2!r}"
+            f"line2: SGP4 cannot start from these elements ({what} in its initialisation; "
+            f"mean motion {line2[52:63].strip()} rev/day, eccentricity 0.{line2[26:33]}): "
+            f"{line2!r}"
         ) from None
+
+
+# The TLE's numeric fields that sgp4 reads (line, first and last column, 1-based, what
+# it holds, the form of its text): a float, an exponent with an assumed decimal point
+# (" 18000-4" is 0.18e-4), or digits.
+_FLOAT = r"[+-]?(\d+\.?\d*|\.\d+)"
+_ASSUMED = r"[+-]?\d*[+-]\d"
+_DIGITS = r"\d+"
+_TLE_NUMBERS = (
+    (1, 19, 20, "epoch year", _DIGITS),
+    (1, 21, 32, "epoch day", _FLOAT),
+    (1, 34, 43, "first derivative of the mean motion", _FLOAT),
+    (1, 45, 52, "second derivative of the mean motion", _ASSUMED),
+    (1, 54, 61, "BSTAR drag term", _ASSUMED),
+    (1, 65, 68, "element set number", _DIGITS),
+    (2, 9, 16, "inclination", _FLOAT),
+    (2, 18, 25, "right ascension of the ascending node", _FLOAT),
+    (2, 27, 33, "eccentricity", _DIGITS),
+    (2, 35, 42, "argument of perigee", _FLOAT),
+    (2, 44, 51, "mean anomaly", _FLOAT),
+    (2, 53, 63, "mean motion", _FLOAT),
+)
+
+
+def _not_a_number(line1: str, line2: str) -> InputError:
+    """The refusal of a TLE whose number sgp4 cannot read: the first field that is
+    not a number of its form, by column (else the lines)."""
+    for number, first, last, name, form in _TLE_NUMBERS:
+        line = line1 if number == 1 else line2
+        field = line[first - 1 : last]
+        if not re.fullmatch(form, field.strip()):
+            return InputError(
+                f"line{number}: columns {first}-{last} ({name}) hold {field!r}, not a number "
+                f"as the TLE layout writes it: {line!r}"
+            )
+    return InputError(f"a field is not a number as the TLE layout writes it: {line1!r}, {line2!r}")

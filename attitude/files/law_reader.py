@@ -102,14 +102,20 @@ def read_sites(root: Any) -> dict[str, GroundSite]:
             table.fail(f"a site named {name!r} is already given", "name")
         latitude = table.quantity("latitude", "angle", (), to="deg")
         if not -90.0 <= latitude <= 90.0:
-            reason = f"must be between -90 and 90 deg, got {latitude!r} deg"
+            reason = f"must be between -90 and 90 deg, got {table.written_text('latitude')}"
             table.fail(reason, "latitude", latitude)
         longitude = table.quantity("longitude", "angle", (), to="deg")
+        # East of Greenwich, either way round the globe (-180 to 180, or 0 to 360).
+        if not -180.0 <= longitude <= 360.0:
+            reason = (
+                f"must be between -180 and 360 deg (east), got {table.written_text('longitude')}"
+            )
+            table.fail(reason, "longitude", longitude)
         height = table.quantity("height", "length", (), required=False)
         if height is not None and not -1.2e4 <= height <= 1e5:
             table.fail(
                 f"must be between -12 km and 100 km (a point on or near the Earth), got "
-                f"{height:g} m",
+                f"{table.written_text('height', 'm')}",
                 "height",
                 height,
             )
@@ -240,8 +246,8 @@ def read_law(table: Any, sites: dict[str, GroundSite]) -> AttitudeLaw:
 def read_slew(table: Any) -> SlewLimits:
     """``slew = { max_rate, max_acceleration }``."""
     table.allow("max_rate", "max_acceleration")
-    rate = table.positive("max_rate", "angular_velocity")
-    acceleration = table.positive("max_acceleration", "angular_acceleration")
+    rate = table.positive("max_rate", "angular_velocity", unit_needed=True)
+    acceleration = table.positive("max_acceleration", "angular_acceleration", unit_needed=True)
     keys = {"slew.max_rate": "max_rate", "slew.max_acceleration": "max_acceleration"}
     return _call(table, None, SlewLimits, rate, acceleration, keys=keys)
 

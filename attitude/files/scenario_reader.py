@@ -92,8 +92,14 @@ class ScenarioFile:
 class _Table:
     """A TOML table with its key path, for reading typed values with clear errors."""
 
-    def __init__(self, file: Path, path: str, data: Any) -> None:
+    def __init__(
+        self, file: Path, path: str, data: Any, written: dict[str, _Written] | None = None
+    ) -> None:
         self.file, self.path = file, path
+        # What the file wrote for each quantity read so far (full key path: its text and
+        # whether it carries a unit), shared by every table of one document: errors
+        # echo a value in the unit the user gave it, not in SI.
+        self.written: dict[str, _Written] = {} if written is None else written
         if not isinstance(data, dict):
             self.fail(f"expected a table, got {data!r}")
         self.data = data
@@ -104,9 +110,19 @@ class _Table:
     def fail(self, message: str, key: str | None = None, value: Any = NO_VALUE) -> NoReturn:
         """Raise the file's error: ``message`` about ``key`` of this table (the table
         itself when None), holding ``value``."""
+        where = self.where(key) or None
         raise ScenarioFileError(
-            message, key=self.where(key) or None, file=self.file.name, value=value
+            _as_written(message, self.written.get(where or "")),
+            key=where,
+            file=self.file.name,
+            value=value,
         )
+
+    def written_text(self, key: str, bare_unit: str = "") -> str:
+        """The value of quantity ``key`` as the file writes it (``-1 deg/s``, ``-5.0``),
+        a bare number followed by ``bare_unit``, the SI unit it is read in, if given."""
+        written = self.written[self.where(key)]
+        return written.text if written.has_unit or not bare_unit else f"{written.text} {bare_unit}"
 
     def refuse(
         self, exc: InputError, key: str | None = None, keys: dict[str, str] | None = None
@@ -139,13 +155,16 @@ class _Table:
             if required:
                 self.fail("missing table", key)
             return None
-        return _Table(self.file, self.where(key), self.data[key])
+        return _Table(self.file, self.where(key), self.data[key], self.written)
 
     def tables(self, key: str) -> list[_Table]:
         value = self.data.get(key, [])
         if not isinstance(value, list):
             self.fail(f"expected an array of tables [[{key}]], got {value!r}", key, value)
-        return [_Table(self.file, f"{self.where(key)}[{i}]", item) for i, item in enumerate(value)]
+        return [
+            _Table(self.file, f"{self.where(key)}[{i}]", item, self.written)
+            for i, item in enumerate(value)
+        ]
 
     def raw(self, key: str, required: bool = True, default: Any = None) -> Any:
         if key not in self.data:
@@ -181,31 +200,37 @@ class _Table:
         shape: tuple[int, ...],
         required: bool = True,
         to: str | None = None,
+        unit_needed: bool | None = None,
     ):
         """A number or array in SI units, or ``{ value = ..., unit = "..." }``; finite.
 
         ``kind``: a key of ``SI_UNITS``; ``to``: another unit of that kind to convert
-        to (e.g. "deg").  An angle must be given with its unit; a dimensionless value
-        (quaternion, matrix, direction) takes none.
+        to (e.g. "deg").  An angle must be given with its unit, and so must any
+        quantity read with ``unit_needed`` (a slew's limits, written in deg/s on data
+        sheets); a dimensionless value (quaternion, matrix, direction) takes none.
         """
         value = self.raw(key, required)
         if value is None:
             return None
         unit = None
         if isinstance(value, dict):
-            sub = _Table(self.file, self.where(key), value)
+            sub = _Table(self.file, self.where(key), value, self.written)
             sub.allow("value", "unit")
             unit = sub.string("unit")
             value = sub.raw("value")
             if kind == "dimensionless":
                 self.fail(f"takes no unit (it is a pure number), got unit {unit!r}", key, unit)
-        elif kind == "angle":
+        elif unit_needed or (unit_needed is None and kind == "angle"):
+            what, example, bare = _UNIT_NEEDED[kind]
             self.fail(
-                f'an angle needs its unit, e.g. {{ value = {value!r}, unit = "deg" }} '
-                "(a bare number would be read as radians)",
+                f'{what} needs its unit, e.g. {{ value = {value!r}, unit = "{example}" }} '
+                f"(a bare number would be read as {bare})",
                 key,
                 value,
             )
+        self.written[self.where(key)] = _Written(
+            _short(value) if unit is None else f"{_short(value)} {unit}", unit is not None
+        )
         if not _is_numbers(value):
             self.fail(f"expected {_describe(shape)}, got {_short(value)}", key, value)
         try:
@@ -249,11 +274,38 @@ class _Table:
         except InputError as exc:
             self.fail(exc.reason, key, value)
 
-    def positive(self, key: str, kind: str, required: bool = True):
-        value = self.quantity(key, kind, (), required)
+    def positive(self, key: str, kind: str, required: bool = True, unit_needed: bool | None = None):
+        value = self.quantity(key, kind, (), required, unit_needed=unit_needed)
         if value is not None and not value > 0.0:
-            self.fail(f"must be positive, got {value!r}", key, value)
+            self.fail(f"must be positive, got {self.written_text(key)}", key, value)
         return value
+
+
+@dataclass(frozen=True)
+class _Written:
+    """A quantity as the file writes it: its text (``-1 deg/s``, ``[0.0, 1.0]``) and
+    whether that carries a unit."""
+
+    text: str
+    has_unit: bool
+
+
+# The quantities that need a unit: what each is called, an example unit, and how a
+# bare number would be read.
+_UNIT_NEEDED = {
+    "angle": ("an angle", "deg", "radians"),
+    "angular_velocity": ("a rate", "deg/s", "rad/s"),
+    "angular_acceleration": ("an angular acceleration", "deg/s2", "rad/s²"),
+}
+
+
+def _as_written(message: str, written: _Written | None) -> str:
+    """``message`` about a quantity given with a unit, with that value as the file
+    writes it when the message does not already say it (a builder's check says the
+    value in SI: ``got 0.0174533 rad/s`` for 1 deg/s)."""
+    if written is None or not written.has_unit or written.text in message:
+        return message
+    return f"{message} (given as {written.text})"
 
 
 def _is_numbers(value: Any) -> bool:
@@ -264,8 +316,16 @@ def _is_numbers(value: Any) -> bool:
 
 
 def _short(value: Any) -> str:
-    text = repr(value)
+    """``value`` as a line shows it: a float as its repr, or its %g where that is
+    the same number and shorter (1e9 read from TOML is 1e+09, not 1000000000.0); a
+    long text cut in the middle."""
+    text = _number_text(value) if isinstance(value, float) else repr(value)
     return text if len(text) <= 60 else f"{text[:40]}...{text[-10:]} ({len(text)} characters)"
+
+
+def _number_text(value: float) -> str:
+    text, short = repr(value), f"{value:g}"
+    return short if len(text) > 10 and len(short) < len(text) and float(short) == value else text
 
 
 def _describe(shape: tuple[int, ...]) -> str:
@@ -458,7 +518,8 @@ def _angle_deg(item: _Table, key: str, low: float, high: float) -> float | None:
     """An optional angle in degrees, with its unit, in [low, high) (low excluded if 0)."""
     value = item.quantity(key, "angle", (), required=False, to="deg")
     if value is not None and not (low <= value < high and (low < 0.0 or value > 0.0)):
-        item.fail(f"must be between {low:g} and {high:g} deg, got {value!r} deg", key)
+        written = item.written_text(key)
+        item.fail(f"must be between {low:g} and {high:g} deg, got {written}", key, value)
     return value
 
 
@@ -636,8 +697,9 @@ def _torques(root: _Table, scale: str, orbit: Orbit | None) -> ScenarioTorques |
         # True: the scenario's orbit, the one of [pointing] (given once, to the Scenario).
         return ScenarioTorques(gravity_gradient or None, tuple(burns), order=order, **options)
     except InputError as exc:  # its keys are the file's, from the root (torques.step)
+        reason = _as_written(exc.reason, table.written.get(exc.key or ""))
         raise ScenarioFileError(
-            exc.reason, key=exc.key, file=table.file.name, value=exc.value
+            reason, key=exc.key, file=table.file.name, value=exc.value
         ) from None
 
 
@@ -722,9 +784,9 @@ def scenario_from_document(path: Path, document: dict[str, Any]) -> ScenarioFile
             "stop": f"output.{end}",
             "duration": "output.duration",
         }
-        raise ScenarioFileError(
-            exc.reason, key=keys.get(exc.key or "", exc.key), file=path.name, value=exc.value
-        ) from None
+        key = keys.get(exc.key or "", exc.key)
+        reason = _as_written(exc.reason, root.written.get(key or ""))
+        raise ScenarioFileError(reason, key=key, file=path.name, value=exc.value) from None
     return ScenarioFile(path, scenario, pointing, _outputs(output), document)
 
 

@@ -265,6 +265,12 @@ class GroundSite(Direction):
             raise InputError(
                 f"latitude must be between -90 and 90 deg, got {math.degrees(self.latitude):g} deg"
             )
+        # East of Greenwich, either way round (-180 to 180, or 0 to 360): beyond, a typo.
+        if not -math.pi <= self.longitude <= 2.0 * math.pi:
+            raise InputError(
+                f"longitude must be between -180 and 360 deg (east), got "
+                f"{math.degrees(self.longitude):g} deg"
+            )
         if not -1.2e4 <= self.height <= 1e5:
             raise InputError(
                 f"height must be between -12 km and 100 km (a point on or near the Earth), "

@@ -321,18 +321,18 @@ def _distribution(
     if not np.all(np.asarray(scale) > 0.0):
         sub.fail(
             f"must be positive (leave {table.where(key)} out to keep the nominal value), "
-            f"got {np.asarray(scale).tolist()!r}",
+            f"got {sub.written_text(scale_key)}",
             scale_key,
         )
     if relative and not np.all(np.asarray(scale) < 1.0):
         sub.fail(
             f"is a fraction of the nominal value and must be below 1 (100 %), got "
-            f"{np.asarray(scale).tolist()!r}",
+            f"{sub.written_text(scale_key)}",
             scale_key,
         )
     if isotropic and float(scale) > _MAX_ANGLE_RAD:
         sub.fail(
-            f"must be at most 180 deg (a small rotation), got {math.degrees(scale):.6g} deg",
+            f"must be at most 180 deg (a small rotation), got {sub.written_text(scale_key)}",
             scale_key,
         )
     truncation = None

@@ -20,7 +20,11 @@ from numpy.typing import NDArray
 
 from attitude.base.errors import InputError
 from attitude.base.version import __version__
-from attitude.files.scenario_reader import ScenarioFile, scenario_from_document
+from attitude.files.scenario_reader import (
+    ScenarioFile,
+    ScenarioFileWarning,
+    scenario_from_document,
+)
 from attitude.files.scenario_writer import with_absolute_files
 from attitude.montecarlo.dispersions import Dispersions, draw_sample, read_dispersions
 from attitude.montecarlo.metrics import (
@@ -32,6 +36,7 @@ from attitude.montecarlo.metrics import (
 )
 from attitude.outputs.budget import ResourceError, available_memory_bytes
 from attitude.report.plan import RunPlan, plan_run
+from attitude.trajectory.guided import GUIDED
 
 __all__ = [
     "BatchResult",
@@ -94,6 +99,7 @@ def plan_montecarlo(
     the per-sample table against the memory available."""
     plan = plan or plan_run(loaded.scenario, loaded.pointing, METRICS_ONLY, horizon=False)
     dispersions = read_dispersions(loaded, samples, seed)
+    _warn_of_inertia_under_laws(loaded, plan, dispersions)
     mc = MonteCarloPlan(
         loaded,
         plan,
@@ -112,6 +118,35 @@ def plan_montecarlo(
             value=mc.samples,
         )
     return mc
+
+
+def _warn_of_inertia_under_laws(
+    loaded: ScenarioFile, plan: RunPlan, dispersions: Dispersions
+) -> None:
+    """One line when the inertia is dispersed but every segment is guided (no control
+    loss): the laws hold the attitude and the rate, so the draws change no motion, only
+    each segment's bounds of the body's momentum and energy, I·ω and ½ ω·Iω."""
+    dispersed = [
+        name
+        for name, found in (
+            ("principal_moments", dispersions.moments),
+            ("principal_axes", dispersions.axes),
+        )
+        if found is not None
+    ]
+    if not dispersed:
+        return
+    if not all(getattr(s.solver, "formula", "") in GUIDED for s in plan.trajectory.segments):
+        return
+    warnings.warn(
+        ScenarioFileWarning(
+            f"{loaded.path.name}: dispersions.spacecraft.{dispersed[0]}: the spacecraft is "
+            "guided by attitude laws over the whole span (no control loss): the laws hold "
+            "its attitude and rate, so its dispersed inertia changes no motion and no "
+            "pointing, only each segment's momentum and energy"
+        ),
+        stacklevel=2,
+    )
 
 
 @dataclass(frozen=True)

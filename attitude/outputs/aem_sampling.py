@@ -63,6 +63,7 @@ interval, and check them against the tolerance and the stated figure.
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, replace
 from typing import BinaryIO
 
@@ -156,6 +157,8 @@ class AemSegmentPlan:
     started_by: str | None = None
     measured_error_rad: float | None = None
     rate_rad_s: float = 0.0  # the bound on |ω| the step was guessed from
+    # Predicted, not planned: `attitude check` past its budget (plan_aem(budget_s=)).
+    predicted: bool = False
 
     @property
     def peak_margin(self) -> float:
@@ -190,6 +193,29 @@ class AemPlan:
     @property
     def records(self) -> int:
         return sum(item.count for item in self.segments)
+
+    @property
+    def predicted(self) -> int:
+        """How many segments are predicted (check past its budget), not planned."""
+        return sum(item.predicted for item in self.segments)
+
+    def describe(self, exact: bool) -> str:
+        """The plan in one line for ``attitude check`` (``exact``: the motion is closed
+        form, not propagated)."""
+        steps = [item.step_s for item in self.segments]
+        about = "about " if self.predicted else ""
+        line = (
+            f"{about}{self.records} records (a record every {min(steps):.4g} to "
+            f"{max(steps):.4g} s), {INTERPOLATION_METHOD} interpolation within "
+            f"{self.tolerance_rad:g} rad of the {'exact' if exact else 'propagated'} attitude"
+        )
+        if self.predicted:
+            planned = len(self.segments) - self.predicted
+            line += (
+                f"; {planned} of its {len(self.segments)} segments planned within check's "
+                "budget, the others' records predicted from their steps (the run plans them)"
+            )
+        return line
 
     @property
     def measured_error_rad(self) -> float | None:
@@ -439,9 +465,7 @@ def _plan_segment(
         return AemSegmentPlan(index, start_s, end_s, 2, 1, 0.0, 0.0, started_by, None, rate)
     time_tags = _time_tags_error(index, segment, end_s, tolerance_rad)
     target = _TARGET * tolerance_rad - time_tags
-    # The first guess: a uniform rotation at the largest rate, end-interval constant.
-    constant = 528.0 / math.factorial(degree + 1)  # max |∏(x − i)|, x in the first interval
-    step = (2.0 / rate) * (target / (4.0 * constant)) ** (1.0 / (degree + 1))
+    step = _first_step(rate, target, degree)
     rng = np.random.default_rng(index)
     accepted = None
     for _ in range(_MAX_ITERATIONS):
@@ -467,6 +491,50 @@ def _plan_segment(
     return accepted
 
 
+def _first_step(rate: float, target: float, degree: int) -> float:
+    """The first guess of a segment's step: a uniform rotation at the largest rate,
+    end-interval constant (module notes)."""
+    constant = 528.0 / math.factorial(degree + 1)  # max |∏(x − i)|, x in the first interval
+    return (2.0 / rate) * (target / (4.0 * constant)) ** (1.0 / (degree + 1))
+
+
+def _predicted_segment(
+    index: int,
+    segment: Segment,
+    start_s: float,
+    end_s: float,
+    tolerance_rad: float,
+    started_by: str | None,
+    ratio: float,
+) -> AemSegmentPlan:
+    """A segment's records as :func:`_plan_segment` would choose them, predicted: its
+    first guess scaled by ``ratio``, the least ratio of chosen to first step among the
+    segments planned (the most records).  The records it would refuse, 1 ns apart, are
+    refused before from the rate bound (:func:`check_time_tags`: a step that short
+    needs a rate whose time tags miss any tolerance)."""
+    length = end_s - start_s
+    most = max(2, int(length / _MIN_STEP_S) + 1)
+    rate = _largest_rate(segment)
+    if rate == 0.0 or most <= 2:
+        return AemSegmentPlan(index, start_s, end_s, 2, 1, 0.0, 0.0, started_by, None, rate)
+    time_tags = _time_tags_error(index, segment, end_s, tolerance_rad)
+    step = ratio * _first_step(rate, _TARGET * tolerance_rad - time_tags, INTERPOLATION_DEGREE)
+    count = min(max(math.ceil(length / step) + 1, INTERPOLATION_DEGREE + 1), most)
+    degree = min(INTERPOLATION_DEGREE, count - 1)
+    return AemSegmentPlan(
+        index, start_s, end_s, count, degree, math.nan, time_tags, started_by, None, rate, True
+    )
+
+
+def _ratio(item: AemSegmentPlan, tolerance_rad: float) -> float | None:
+    """A planned segment's chosen step over its first guess (None: nothing guessed, or
+    a segment shorter than a window of records, whose step says nothing of the rest)."""
+    if item.rate_rad_s == 0.0 or item.degree is None or item.count <= INTERPOLATION_DEGREE + 1:
+        return None
+    target = _TARGET * tolerance_rad - item.time_tag_rad
+    return item.step_s / _first_step(item.rate_rad_s, target, INTERPOLATION_DEGREE)
+
+
 def _pieces(
     segment: Segment, start_s: float, stop_s: float
 ) -> list[tuple[float, float, str | None]]:
@@ -489,6 +557,7 @@ def plan_aem(
     stop_s: float,
     tolerance_rad: float = DEFAULT_TOLERANCE_RAD,
     name: str = "aem_tolerance",
+    budget_s: float | None = None,
 ) -> AemPlan:
     """The AEM's segments over [start_s, stop_s]: one per stretch of smooth motion,
     between events and breakpoints, each sampled for ``tolerance_rad`` (see the
@@ -498,17 +567,35 @@ def plan_aem(
     next one starts with the post-event state there: the attitude is continuous but
     the rate jumps, and a reader must not interpolate across.  At a breakpoint both
     segments hold the same state; the rate's derivative jumps there.
+
+    ``budget_s``: `attitude check`'s CPU budget (s): the segments after it is spent
+    (at least one planned) are predicted from their rate bounds and the planned ones'
+    steps (:func:`_predicted_segment`, ``AemSegmentPlan.predicted``): a thousand burns
+    make two thousand segments, tens of seconds to plan.  Such a plan is never written.
     """
     tolerance_rad = check_tolerance(tolerance_rad, name)
-    plans = []
+    started = time.process_time()
+    plans: list[AemSegmentPlan] = []
+    ratios: list[float] = []
     for index, (segment, item) in enumerate(zip(trajectory.segments, motion, strict=True)):
         if min(segment.end_s, stop_s) - max(segment.start_s, start_s) <= SAME_INSTANT_S:
             continue  # before the output span, or a zero-length stretch between events
         for start, end, what in _pieces(segment, start_s, stop_s):
+            spent = budget_s is not None and time.process_time() - started > budget_s
             try:
+                if spent and ratios:
+                    plans.append(
+                        _predicted_segment(
+                            index, segment, start, end, tolerance_rad, what, min(ratios)
+                        )
+                    )
+                    continue
                 plans.append(_plan_segment(index, segment, item, start, end, tolerance_rad, what))
             except InputError as exc:  # the tolerance's, unless it names the rate's key
                 raise (exc if exc.key else exc.located(key=name)) from None
+            ratio = _ratio(plans[-1], tolerance_rad)
+            if ratio is not None:
+                ratios.append(ratio)
     return AemPlan(tolerance_rad, plans)
 
 
@@ -548,6 +635,8 @@ def write_planned_aem(
             "rad of the exact attitude",
         ),
     )
+    if plan.predicted:
+        raise RuntimeError("an AEM plan predicted past check's budget is not written")
     measured: list[AemSegmentPlan] = []
     for item in plan.segments:
         segment = trajectory.segments[item.segment]

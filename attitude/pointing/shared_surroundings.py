@@ -10,7 +10,9 @@ for a span and hands it to all of them.
 **What is computed.**  The span (with a margin) is cut into pieces aligned on TT
 multiples of 120 s from J2000 (600 s at the Earth's centre), the nodes of the Sun and
 Moon ephemeris of :class:`attitude.environment.ephemeris.SunMoonFromEarth` falling on
-piece ends, so that within a piece every input is analytic.  On each piece, the
+piece ends, so that within a piece every input is analytic; the first and last pieces
+are cut at the ends of what the orbit serves (an orbit file may cover the span
+exactly: :func:`attitude.environment.orbit.coverage_seconds`).  On each piece, the
 fields of :meth:`attitude.pointing.surroundings.SunMoonEarth.fields` (the apparent Sun
 and Moon from the spacecraft, and on an orbit its position and velocity, from the
 orbit's source, and the apparent Sun from the Earth's centre) are computed exactly at
@@ -69,7 +71,7 @@ from numpy.polynomial import chebyshev
 from numpy.typing import NDArray
 
 from attitude.environment.earth import EARTH_EQUATORIAL_RADIUS_M
-from attitude.environment.orbit import Orbit
+from attitude.environment.orbit import Orbit, coverage_seconds
 from attitude.environment.timescales import SECONDS_PER_DAY
 from attitude.pointing.eclipse import SUN_RADIUS_M
 from attitude.pointing.spec import PointingSpec, for_scenario
@@ -179,11 +181,12 @@ class SharedSurroundings:
         piece_s = _CENTRE_PIECE_S if orbit is None else _ORBIT_PIECE_S
         self._fields = _CENTRE_FIELDS if orbit is None else _ORBIT_FIELDS
         first, last = self._aligned(start_s - _MARGIN_S, stop_s + _MARGIN_S, piece_s)
-        self.start_s, self.stop_s = float(first[0]), float(last[-1])
+        ends = self._within_orbit(np.concatenate([first, last[-1:]]), start_s, stop_s)
+        self.start_s, self.stop_s = float(ends[0]), float(ends[-1])
         self._exact = SunMoonEarth(None, self.spec, self.start_s, self.stop_s, jd=self.jd)
         self.position_error_m = 0.0
         self.direction_error_rad = 0.0
-        edges, coefficients, exact = self._fit(np.concatenate([first, last[-1:]]))
+        edges, coefficients, exact = self._fit(ends)
         self._edges = edges
         self._coefficients = coefficients  # (pieces, degree + 1, components), powers of t
         self._exact_pieces = exact
@@ -231,6 +234,21 @@ class SharedSurroundings:
         k = np.arange(first, max(last, first + 1) + 1, dtype=np.float64)
         ends = (k - base_frac) * piece_s - offset_s
         return ends[:-1], ends[-1:]
+
+    def _within_orbit(
+        self, ends: NDArray[np.float64], start_s: float, stop_s: float
+    ) -> NDArray[np.float64]:
+        """The aligned piece ends, the outer two moved in to the orbit's coverage
+        (:func:`attitude.environment.orbit.coverage_seconds`: an orbit file that
+        covers the span exactly ends inside the first and last aligned pieces), never
+        inside [start_s, stop_s] itself, which the orbit's own check refuses when it is
+        not covered.  A piece cut so keeps its ephemeris nodes at its ends (it lies
+        within an aligned piece)."""
+        first_s, last_s = coverage_seconds(self.orbit, self.jd)
+        lower = min(max(float(ends[0]), first_s), start_s)
+        upper = max(min(float(ends[-1]), last_s), stop_s)
+        inner = ends[(ends > lower) & (ends < upper)]
+        return np.concatenate([[lower], inner, [upper]])
 
     def _exact_fields(self, seconds: NDArray[np.float64]) -> NDArray[np.float64]:
         """The fields at ``seconds``, side by side: (n, 3 × fields)."""
@@ -409,11 +427,14 @@ class SharedSurroundings:
         return out, out_rates
 
     def _difference_rates(self, seconds: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Rates by central differences (1 ms), where a piece is evaluated exactly."""
+        """Rates by central differences (1 ms), where a piece is evaluated exactly; one
+        sided at the span's ends (an orbit file may end there)."""
         step = 1e-3
-        ahead = self._exact_fields(seconds + step)
-        behind = self._exact_fields(seconds - step)
-        return (ahead - behind) / (2.0 * step)
+        ahead_s = np.minimum(seconds + step, self.stop_s)
+        behind_s = np.maximum(seconds - step, self.start_s)
+        ahead = self._exact_fields(ahead_s)
+        behind = self._exact_fields(behind_s)
+        return (ahead - behind) / (ahead_s - behind_s)[:, None]
 
     def at(self, seconds: NDArray[np.float64]) -> Surroundings:
         """The surroundings at TT ``seconds``, as :meth:`SunMoonEarth.at` gives them,

@@ -115,10 +115,10 @@ def _pointing_table(vectors: dict[str, Any]) -> str:
 
 
 def _propagation(summary: dict[str, Any]) -> str:
+    """What the run is (``torques.propagation``: guided, exact, a gyrostat or torques by
+    splitting with its error, attitude.report.torques.propagation_text)."""
     torques = summary.get("torques") or {}
-    if torques.get("modelled"):
-        return "under " + ", ".join(torques["modelled"]) + ": splitting with the exact free flow"
-    return "exact torque-free motion, no integration"
+    return torques.get("propagation") or "exact torque-free motion (closed form, no integration)"
 
 
 def _torques_section(torques: dict[str, Any] | None) -> list[str]:
@@ -130,7 +130,7 @@ def _torques_section(torques: dict[str, Any] | None) -> list[str]:
         horizon = torques["validity_horizon"]
         text = horizon["description"] if horizon else torques["validity_horizon_note"]
         parts.append(
-            f"<p>None modelled: the exact torque-free solver. Validity: {escape(text)}.</p>"
+            f"<p>None modelled: {escape(torques['propagation'])}. Validity: {escape(text)}.</p>"
         )
         return parts
     how = "given" if torques["step"] == "given" else f"chosen for {torques['accuracy_rad']:g} rad"

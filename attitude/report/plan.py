@@ -22,10 +22,11 @@ bad value.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from attitude.base.errors import InputError
+from attitude.base.errors import InputError, LawRateWarning
 from attitude.outputs.aem_sampling import AemPlan, check_time_tags, plan_aem
 from attitude.outputs.budget import OutputBudget, check_fits, estimate
 from attitude.outputs.csv import pointing_column_count
@@ -35,7 +36,7 @@ from attitude.pointing.search import SearchGrid, check_pointing
 from attitude.pointing.spec import PointingSpec, for_scenario
 from attitude.report.beside import Beside
 from attitude.scenario.scenario import Scenario
-from attitude.trajectory.guided import GUIDED
+from attitude.trajectory.guided import GUIDED, GuidedMotion
 from attitude.trajectory.horizon import (
     ValidityHorizon,
     screened_horizon,
@@ -47,7 +48,11 @@ from attitude.trajectory.motion import SegmentMotion, analyze, undersampling_not
 from attitude.trajectory.steps import CHECK_BUDGET_S
 from attitude.trajectory.trajectory import Trajectory, propagate
 
-__all__ = ["RunPlan", "horizon_beside", "plan_run"]
+__all__ = ["LAW_RATE_WARNING_DEG_S", "RunPlan", "horizon_beside", "plan_run"]
+
+# With no slew limits given, a law that demands more than this body rate (deg/s) is
+# warned of: agile spacecraft turn at about a degree a second.
+LAW_RATE_WARNING_DEG_S = 1.0
 
 
 @dataclass
@@ -101,7 +106,7 @@ def plan_run(
         check_span(scenario.start_s, scenario.stop_s, "--formats parquet")
     _check_gravity_gradient_orbit(scenario)
     say(_propagating(scenario, check))
-    trajectory = propagate(scenario, check=check)
+    trajectory = _propagated(scenario, outputs, check)
     # The size and memory checks come before the analysis and the pointing checks,
     # which do not depend on the output grid but can take a while on a long span.
     vectors, on_orbit = len(pointing.body_vectors), pointing.on_orbit
@@ -138,6 +143,7 @@ def plan_run(
     # Attitude laws: ground sites never seen, the Earth orientation table's coverage.
     guided = [n for s in trajectory.segments for n in getattr(s.solver, "notes", ())]
     notes = [*dict.fromkeys(guided), *notes]
+    _warn_of_fast_laws(scenario, trajectory)
     undersampled = undersampling_note(trajectory, motion)
     if undersampled:
         notes.append(undersampled)
@@ -160,6 +166,7 @@ def plan_run(
             scenario.stop_s,
             outputs.aem_tolerance_rad,
             outputs.tolerance_key,
+            budget_s=CHECK_BUDGET_S if check else None,
         )
     budget = estimate(
         samples,
@@ -184,6 +191,68 @@ def plan_run(
         horizon_deferred=wanted and not horizon,
         check=check,
     )
+
+
+def _warn_of_fast_laws(scenario: Scenario, trajectory: Trajectory) -> None:
+    """A :class:`LawRateWarning` for each law whose demanded body rate peaks beyond the
+    scenario's slew limits (the largest ``max_rate`` given), or, with none given,
+    beyond :data:`LAW_RATE_WARNING_DEG_S`: Sun yaw steering near β = 0 turns the yaw by
+    180° in minutes (2.4 deg/s at β = 1.6°), a ground site passed overhead at low
+    altitude needs its v/h.  The peak is the law's largest |ω| over its segment
+    (``GuidedMotion.largest_rate``: sampled, refined by Brent's search)."""
+    slews = [getattr(event, "slew", None) for _, event in scenario.events]
+    limits = [slew.max_rate for slew in slews if slew is not None]
+    limit = max(limits, default=math.radians(LAW_RATE_WARNING_DEG_S))
+    for segment in trajectory.segments:
+        solver = segment.solver
+        # A slew keeps its own limits; the exact and the torqued motion follow no law.
+        if not isinstance(solver, GuidedMotion) or solver.formula != "guided":
+            continue
+        rate, at = solver.largest_rate(segment.start_s, segment.end_s)
+        if not rate > limit:
+            continue
+        beyond = (
+            f"beyond the slews' max_rate of {math.degrees(limit):.4g} deg/s"
+            if limits
+            else f"more than {LAW_RATE_WARNING_DEG_S:g} deg/s (no slew limits are given to "
+            "compare it with)"
+        )
+        warnings.warn(
+            LawRateWarning(
+                f"the {solver.law.name} law ({solver.law.describe()}) demands a body rate "
+                f"of up to {math.degrees(rate):.3g} deg/s, at {scenario.format_epoch(at)} "
+                f"(t = {at:.6g} s), {beyond}: the run follows the law as it is",
+                key=solver.key,
+            ),
+            stacklevel=2,
+        )
+
+
+def _propagated(scenario: Scenario, outputs: OutputChoice, check: bool) -> Trajectory:
+    """The scenario propagated for the plan.  A run under torques first takes check's
+    path (:func:`propagate` with ``check``: the step search, or the estimate at a given
+    step, within check's CPU budget; its tries are the run's own): within the budget
+    that is the run itself, bit for bit, and is kept; past it, check's motion at a
+    longer step says what check refuses from it (the AEM's 1 ns time tags of a runaway
+    burn) before the run propagates for minutes, so that run refuses it at once with
+    check's line.  The full propagation follows."""
+    if check or not scenario.torques.any:
+        return propagate(scenario, check=check)
+    preview = propagate(scenario, check=True)
+    steps = preview.steps
+    found = None if steps is None else steps.measurement
+    if not preview.approximate and steps is not None and steps.settled:
+        if found is not None and found.complete:
+            return preview
+    if "aem" in outputs:
+        check_time_tags(
+            preview,
+            scenario.start_s,
+            scenario.stop_s,
+            outputs.aem_tolerance_rad,
+            outputs.tolerance_key,
+        )
+    return propagate(scenario)
 
 
 def _propagating(scenario: Scenario, check: bool) -> str:

@@ -10,7 +10,10 @@ For ``summary.json`` (``torques``), ``attitude check`` and the HTML report, from
   carries the errors through the events
   (:attr:`~attitude.trajectory.trajectory.Trajectory.error_estimate`);
 - a torque-free scenario: that the exact solver propagated it, and with an orbit its
-  validity horizon (``attitude.trajectory.horizon.validity_horizon``).
+  validity horizon (``attitude.trajectory.horizon.validity_horizon``);
+- what each run is, in one line (:func:`propagation_text`, the page's head and
+  ``torques.propagation``): guided by attitude laws, exact torque-free motion, a
+  gyrostat or torques by splitting with its estimated error, in the order they come.
 """
 
 from __future__ import annotations
@@ -18,10 +21,61 @@ from __future__ import annotations
 from typing import Any
 
 from attitude.report.plan import RunPlan
+from attitude.trajectory.guided import GUIDED
 from attitude.trajectory.steps import CHECK_BUDGET_S
 from attitude.trajectory.torqued import TorquedMotion
 
-__all__ = ["cpu_text", "horizon_text", "run_cost_s", "torques_lines", "torques_summary"]
+__all__ = [
+    "cpu_text",
+    "horizon_text",
+    "is_exact",
+    "propagation_text",
+    "run_cost_s",
+    "torques_lines",
+    "torques_summary",
+]
+
+
+def _kind(plan: RunPlan, solver: Any) -> str:
+    """How one segment is propagated, in words."""
+    if getattr(solver, "formula", "") in GUIDED:
+        return "guided by attitude laws (closed form)"
+    if not isinstance(solver, TorquedMotion):
+        return "exact torque-free motion (closed form, no integration)"
+    error = solver.error_estimate
+    if solver.formula == "gyrostat":
+        said = "" if error is None else f", estimated error {error:.2g} rad"
+        return f"a gyrostat by splitting with the exact gyroscopic flow{said}"
+    steps = plan.trajectory.steps
+    estimate = None if steps is None else steps.estimate_rad
+    said = "" if estimate is None else f", estimated error {estimate:.2g} rad over the run"
+    modelled = ", ".join(plan.scenario.torques.modelled())
+    return f"under {modelled}: splitting with the exact free flow{said}"
+
+
+def propagation_text(plan: RunPlan) -> str:
+    """What the run is, segment kinds in the order they first come: ``guided by attitude
+    laws (closed form), then a gyrostat by splitting with the exact gyroscopic flow,
+    estimated error 8.3e-08 rad``."""
+    kinds = dict.fromkeys(_kind(plan, s.solver) for s in plan.trajectory.segments)
+    return ", then ".join(kinds)
+
+
+def is_exact(plan: RunPlan) -> bool:
+    """Whether every segment is closed form (laws, slews, the torque-free solver)."""
+    return not any(isinstance(s.solver, TorquedMotion) for s in plan.trajectory.segments)
+
+
+def _no_horizon_note(plan: RunPlan, neglecting: str) -> str:
+    """Why a run that models no gravity gradient states no validity horizon."""
+    if all(getattr(s.solver, "formula", "") in GUIDED for s in plan.trajectory.segments):
+        return (
+            "guided by attitude laws over the whole span: their controller holds the "
+            "attitude, so no torque is neglected"
+        )
+    if plan.pointing.orbit is None:
+        return f"no orbit: the gravity gradient that {neglecting} neglects is not known"
+    return "not computed (the run computes it beside its outputs)"
 
 
 def torques_summary(plan: RunPlan) -> dict[str, Any]:
@@ -33,11 +87,11 @@ def torques_summary(plan: RunPlan) -> dict[str, Any]:
     if not settings.any:
         return {
             "modelled": [],
-            "propagation": "exact torque-free solver (closed form), no step",
+            "propagation": propagation_text(plan),
             "validity_horizon": horizon,
             "validity_horizon_note": None
             if horizon is not None
-            else "no orbit: the gravity gradient that torque-free motion neglects is not known",
+            else _no_horizon_note(plan, "torque-free motion"),
         }
     steps = plan.trajectory.steps
     found = None if steps is None else steps.measurement
@@ -67,7 +121,7 @@ def torques_summary(plan: RunPlan) -> dict[str, Any]:
             }
             for placed in scenario.burns
         ],
-        "propagation": "splitting with the exact free flow (docs/torques.md)",
+        "propagation": propagation_text(plan),
         "order": settings.order,
         "step": "given" if settings.step is not None else "chosen for the accuracy",
         "step_s": None if steps is None else steps.step_s,
@@ -90,15 +144,15 @@ def torques_summary(plan: RunPlan) -> dict[str, Any]:
             for step, error, ended in steps.tried
         ],
         "validity_horizon": horizon,
-        "validity_horizon_note": None if horizon is not None else _horizon_note(settings),
+        "validity_horizon_note": None if horizon is not None else _horizon_note(plan),
     }
 
 
-def _horizon_note(settings: Any) -> str:
+def _horizon_note(plan: RunPlan) -> str:
     """Why a run under torques states no validity horizon."""
-    if settings.gravity_gradient is not None:
+    if plan.scenario.torques.gravity_gradient is not None:
         return "the gravity gradient is modelled: there is nothing neglected to bound"
-    return "no orbit: the gravity gradient that the burns-only motion neglects is not known"
+    return _no_horizon_note(plan, "the burns-only motion")
 
 
 def cpu_text(seconds: float) -> str:
@@ -128,7 +182,7 @@ def torques_lines(plan: RunPlan) -> list[str]:
     """The lines of ``attitude check`` (without their indentation)."""
     entry = torques_summary(plan)
     if not entry["modelled"]:
-        lines = ["torques     none: the exact torque-free solver"]
+        lines = [f"torques     none: {entry['propagation']}"]
         horizon = horizon_text(plan)
         if horizon is not None:
             lines.append(f"horizon     {horizon}")

@@ -431,8 +431,13 @@ class Scenario:
         return t
 
     def format_epoch(self, seconds: float) -> str:
-        """ISO 8601 text of the epoch ``seconds`` after the scenario epoch, with its scale."""
-        return f"{self.iso(seconds)} {self.time_scale.upper()}"
+        """ISO 8601 text of the epoch ``seconds`` after the scenario epoch, with its scale;
+        for an instant no calendar date names (an offset of 1e30 s, which a refusal
+        says), the offset itself."""
+        try:
+            return f"{self.iso(seconds)} {self.time_scale.upper()}"
+        except (ValueError, OverflowError):  # ERFA's "unacceptable date" is a ValueError
+            return f"{float(seconds):.6g} s after the epoch (beyond any calendar date)"
 
     def iso(self, seconds: Any) -> Any:
         """ISO 8601 texts (in the scenario's scale) of TT ``seconds`` after the epoch."""

@@ -489,7 +489,11 @@ class _Propagation:
         self.count = 0  # steps computed so far
         self._arrays: tuple[NDArray[np.float64], ...] | None = None
 
-    def extend_to(self, t_max: float) -> None:
+    def extend_to(self, t_max: float, whole: bool = False) -> None:
+        """Compute the grid's steps that end by ``t_max`` (``whole``: also the step
+        that straddles it).  The dense output reaches ``t_max`` from the last of them
+        by a partial step: the straddling one would evaluate the torques past ``t_max``
+        (past an orbit file that ends there) for no state asked."""
         e = self.engine
         if (t_max - self.t_end) / self.step > _MAX_REQUEST_STEPS:
             raise InputError(
@@ -501,6 +505,11 @@ class _Propagation:
             starts, sizes = _grid_steps(
                 self.t_end, t_max, self.step, self.breakpoints, _CHUNK_STEPS
             )
+            beyond = np.flatnonzero(starts + sizes > t_max) if not whole else np.empty(0)
+            if beyond.size:
+                starts, sizes = starts[: beyond[0]], sizes[: beyond[0]]
+                if starts.size == 0:
+                    return
             arrays = e.time_data(starts, sizes)
             m, q, pending = self._state
             K = len(starts)
@@ -526,6 +535,8 @@ class _Propagation:
             self.t_end = float(starts[-1] + sizes[-1])
             self.count += K
             self._arrays = None
+            if beyond.size:
+                return
 
     def arrays(self):
         if self._arrays is None:
@@ -549,6 +560,9 @@ class _Propagation:
         m_array = np.stack(m, axis=-1)
         size = np.sum(np.abs(m_array), axis=-1)
         if not np.all(size <= largest_momentum(self.engine.moments, float(np.max(t)))):
+            # Refused as the grid refuses it, at the end of the step that runs away,
+            # whatever time was asked first: check and run ask different ones.
+            self.extend_to(float(np.max(t)), whole=True)
             _refuse_runaway(m, self.engine.moments, float(np.max(t)))
         q_array = np.stack(q, axis=-1)
         q_array /= np.linalg.norm(q_array, axis=-1, keepdims=True)

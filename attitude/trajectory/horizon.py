@@ -69,6 +69,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from attitude.base.hermite import UniformCubicHermite
+from attitude.environment.orbit import coverage_seconds
 from attitude.environment.timescales import offline_time
 from attitude.scenario.events import State
 from attitude.scenario.modes import ModeEvent
@@ -344,8 +345,12 @@ def _interpolated(orbit: Any, scenario: Scenario) -> Any:
     def exact(t: NDArray[np.float64]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         return orbit.state_tt(np.full(t.shape, jd1), jd2 + t / 86400.0)
 
-    # Kick clocks may fall a step outside the span (negative coefficients): a margin.
-    low, high = scenario.start_s - 2.0 * _ORBIT_NODES_S, scenario.stop_s + 2.0 * _ORBIT_NODES_S
+    # Kick clocks may fall a step outside the span (negative coefficients): a margin,
+    # within what the orbit serves (an orbit file may cover the span exactly; a clock
+    # beyond it is then evaluated by the orbit itself, which says so).
+    first_s, last_s = coverage_seconds(orbit, (jd1, jd2))
+    low = min(max(scenario.start_s - 2.0 * _ORBIT_NODES_S, first_s), scenario.start_s)
+    high = max(min(scenario.stop_s + 2.0 * _ORBIT_NODES_S, last_s), scenario.stop_s)
 
     def fit(spacing: float, end: float) -> tuple[Any, float]:
         """The interpolant on nodes ``spacing`` apart from ``low`` to ``end``, and its
