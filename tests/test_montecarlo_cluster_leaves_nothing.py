@@ -20,7 +20,7 @@ import psutil
 from montecarlo_scenarios import write_spinner
 from signal_dispositions import defaults
 
-from attitude.montecarlo.cluster import connect
+from attitude.jobs.cluster import connect
 
 
 def _listening_ports(processes) -> set[int]:

@@ -12,7 +12,7 @@ from attitude.envelope.engine import simulate
 from attitude.envelope.plan import plan_envelope
 from attitude.envelope.report import check_folder, write_report
 from attitude.files.scenario_reader import ScenarioFile
-from attitude.montecarlo.cluster import check_where
+from attitude.jobs.cluster import check_where
 
 __all__ = ["command"]
 

@@ -10,7 +10,7 @@ from pathlib import Path
 from attitude.base.errors import InputError
 from attitude.base.progress import Progress
 from attitude.files.scenario_reader import ScenarioFile
-from attitude.montecarlo.cluster import check_where
+from attitude.jobs.cluster import check_where
 from attitude.montecarlo.plan import emit_samples, plan_montecarlo
 from attitude.montecarlo.report import check_folder, write_montecarlo_report
 from attitude.montecarlo.simulation import simulate

@@ -1,7 +1,7 @@
-"""The envelope's failures on Dask, by the Monte Carlo's engine: the same local cluster
-or scheduler (:mod:`attitude.montecarlo.cluster`), batch sizes from the measured costs
-(:func:`attitude.montecarlo.simulation.choose_batch_size`), results gathered as tasks
-finish, a progress callback.
+"""The envelope's failures on Dask, through the jobs' engine: the same local cluster
+or scheduler as the Monte Carlo's (:mod:`attitude.jobs.cluster`), batch sizes from the
+measured costs (:func:`attitude.jobs.batches.choose_batch_size`), results gathered as
+tasks finish (:func:`attitude.jobs.batches.gather`), a progress callback.
 
 Each failure is computed from the job alone (its hand-off state, the shared
 surroundings, one step for the splitting chosen before the job), so the table is the
@@ -17,16 +17,14 @@ from typing import TYPE_CHECKING, Any
 
 from attitude.envelope.failure import BatchResult, EnvelopeJob, evaluate_batch
 from attitude.envelope.plan import EnvelopePlan, make_job
-from attitude.montecarlo.cluster import (
-    batch_ranges,
-    batches_as_they_finish,
-    check_batch_size,
+from attitude.jobs.batches import batch_ranges, check_batch_size, choose_batch_size, gather
+from attitude.jobs.cluster import (
+    WORKER_MODULES,
     check_where,
     check_workers,
     connect,
     task_overhead_s,
 )
-from attitude.montecarlo.simulation import choose_batch_size
 
 if TYPE_CHECKING:
     import pandas
@@ -35,6 +33,9 @@ __all__ = ["EnvelopeResult", "simulate"]
 
 # Failures timed on the client to size the batches.
 _TIMED = 2
+
+# What a worker imports before its first failure, beside the cluster's own list.
+_FAILURE_MODULES = ("attitude.envelope.failure",)
 
 
 @dataclass
@@ -70,7 +71,8 @@ def simulate(
     stage(f"{failure_s * 1e3:.3g} ms a failure")
     if scheduler is None:
         stage(f"starting a local Dask cluster of {count} worker processes")
-    with connect(scheduler, workers, probed=True) as client:
+    preload = WORKER_MODULES + _FAILURE_MODULES
+    with connect(scheduler, workers, probed=True, preload=preload) as client:
         threads = check_workers(client)
         overhead = task_overhead_s(client)
         size = batch_size or choose_batch_size(job.count, threads, failure_s, overhead)
@@ -98,25 +100,23 @@ def simulate(
 def _run_batches(
     client, job: EnvelopeJob, batches: list[tuple[int, int]], progress
 ) -> tuple[list[dict[str, Any]], float]:
-    """Gather the tasks as they finish (:func:`batches_as_they_finish`)."""
+    """Gather the tasks as they finish (:func:`attitude.jobs.batches.gather`)."""
     rows: list[dict[str, Any]] = []
-    done = failed = 0
     compute_s = 0.0
-    if progress:
-        progress(0, job.count, 0)
-    for first, stop, result in batches_as_they_finish(client, evaluate_batch, job, batches):
+
+    def add(first: int, stop: int, result: Any) -> int:
+        nonlocal compute_s
         if isinstance(result, BatchResult):
-            rows += result.rows
+            rows.extend(result.rows)
             compute_s += result.compute_s
-            failed += sum(row["status"] != "ok" for row in result.rows)
-        else:  # a task that died (a worker killed): its failures are rows with the error
-            error = f"the task of failures {first}-{stop - 1} failed: {result!r}"
-            rows += [
-                {"failure": k, "tau_s": float(job.seconds[k]), "status": "failed", "error": error}
-                for k in range(first, stop)
-            ]
-            failed += stop - first
-        done += stop - first
-        if progress:
-            progress(done, job.count, failed)
+            return sum(row["status"] != "ok" for row in result.rows)
+        # A task that died (a worker killed): its failures are rows with the error.
+        error = f"the task of failures {first}-{stop - 1} failed: {result!r}"
+        rows.extend(
+            {"failure": k, "tau_s": float(job.seconds[k]), "status": "failed", "error": error}
+            for k in range(first, stop)
+        )
+        return stop - first
+
+    gather(client, evaluate_batch, job, batches, job.count, add, progress)
     return rows, compute_s

@@ -10,7 +10,7 @@ A job, step by step:
    checked against the memory available.
 2. **The nominal run**, on the client: its metrics (reported beside the statistics) and
    its cost, which with Dask's measured cost per task sets the batch size
-   (:func:`choose_batch_size`).
+   (:func:`attitude.jobs.batches.choose_batch_size`).
 3. **Batches** on ``dask.distributed``: an embedded ``LocalCluster`` (processes, one
    thread each, every core by default) or the cluster at ``scheduler``.  A task
    evaluates a batch of consecutive samples (:func:`evaluate_batch`): for each, the
@@ -35,7 +35,6 @@ terminal's SIGINT, which the client handles) and nothing is written.
 
 from __future__ import annotations
 
-import math
 import pickle
 import time
 from collections.abc import Callable
@@ -45,11 +44,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from attitude.montecarlo.cluster import (
+from attitude.jobs.batches import batch_ranges, check_batch_size, choose_batch_size, gather
+from attitude.jobs.cluster import (
     WORKER_MODULES,
-    batch_ranges,
-    batches_as_they_finish,
-    check_batch_size,
     check_where,
     check_workers,
     connect,
@@ -76,14 +73,10 @@ from attitude.report.plan import plan_run
 if TYPE_CHECKING:
     import pandas
 
-__all__ = ["Envelope", "MonteCarloResult", "choose_batch_size", "simulate"]
+__all__ = ["Envelope", "MonteCarloResult", "simulate"]
 
-# A task should last this many times the scheduler's cost per task (so that the
-# overhead is at most 1 %), and every worker should get at least this many tasks
-# (balance at the end of the job, and a progress bar that moves).
-_OVERHEAD_FACTOR = 100
-
-_TASKS_PER_WORKER = 4
+# What a worker imports before its first sample, beside the cluster's own list.
+_SAMPLE_MODULES = ("attitude.montecarlo.plan",)
 
 
 class Envelope:
@@ -135,14 +128,6 @@ class MonteCarloResult:
         return self.table[self.table["status"] != "ok"]
 
 
-def choose_batch_size(samples: int, workers: int, sample_s: float, task_overhead_s: float) -> int:
-    """Samples per task: enough that a task lasts _OVERHEAD_FACTOR times the scheduler's
-    cost per task, few enough that every worker gets _TASKS_PER_WORKER tasks."""
-    long_enough = math.ceil(_OVERHEAD_FACTOR * task_overhead_s / max(sample_s, 1e-9))
-    balanced = math.ceil(samples / (_TASKS_PER_WORKER * max(workers, 1)))
-    return max(1, min(long_enough, balanced))
-
-
 def _nominal(mc: MonteCarloPlan) -> tuple[dict[str, Any], float]:
     """The nominal scenario's metrics, and the cost of one sample (s), measured on a
     second run (the first one loads the ephemeris)."""
@@ -172,7 +157,7 @@ def simulate(
     ``progress(done, total, failed)`` is called as batches finish; ``stage(text)``
     says what is happening (the command line prints both to stderr); ``probed``: the
     caller has checked ``scheduler`` and ``workers`` already
-    (:func:`attitude.montecarlo.cluster.check_where`).
+    (:func:`attitude.jobs.cluster.check_where`).
     """
     import pandas
 
@@ -189,7 +174,7 @@ def simulate(
         stage(f"starting a local Dask cluster of {count} worker processes")
     # scipy.stats draws the truncated laws: imported once for every worker, when used.
     truncated = any(d.kind == "truncated_normal" for d in mc.dispersions.distributions())
-    preload = WORKER_MODULES + (("scipy.stats",) if truncated else ())
+    preload = WORKER_MODULES + _SAMPLE_MODULES + (("scipy.stats",) if truncated else ())
     with connect(scheduler, workers, probed=True, preload=preload) as client:
         threads = check_workers(client)
         overhead = task_overhead_s(client)
@@ -254,17 +239,16 @@ def _run_batches(
     batches: list[tuple[int, int]],
     progress: Callable[[int, int, int], None] | None,
 ) -> _Gathered:
-    """Gather the tasks as they finish (:func:`batches_as_they_finish`)."""
+    """Gather the tasks as they finish (:func:`attitude.jobs.batches.gather`)."""
     gathered = _Gathered(Envelope(mc.vectors, mc.plan.scenario.output_seconds()))
-    done = 0
-    if progress:
-        progress(0, mc.samples, 0)
-    for first, stop, result in batches_as_they_finish(client, evaluate_batch, job, batches):
+
+    def add(first: int, stop: int, result: Any) -> int:
+        before = gathered.failed
         if isinstance(result, BatchResult):
             gathered.add(result)
         else:
             gathered.add_dead_task(mc, first, stop, result)
-        done += stop - first
-        if progress:
-            progress(done, mc.samples, gathered.failed)
+        return gathered.failed - before
+
+    gather(client, evaluate_batch, job, batches, mc.samples, add, progress)
     return gathered

@@ -1,5 +1,6 @@
-"""Where a Monte Carlo job runs: a ``distributed.Client`` to a local cluster or to a
-scheduler, its workers checked (the same versions) and its cost per task measured.
+"""Where a long job runs (a Monte Carlo job, an envelope): a ``distributed.Client`` to a
+local cluster or to a scheduler, its workers checked (the same versions) and its cost
+per task measured.
 
 Ctrl-C stops the job: the local cluster is closed (its worker processes never see the
 terminal's SIGINT, which the client handles), also when it comes while the cluster
@@ -18,7 +19,7 @@ import socket
 import tempfile
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -29,9 +30,7 @@ from attitude.base.version import __version__
 from attitude.outputs.folder import held_signals
 
 __all__ = [
-    "batch_ranges",
-    "batches_as_they_finish",
-    "check_batch_size",
+    "WORKER_MODULES",
     "check_where",
     "check_workers",
     "connect",
@@ -48,14 +47,13 @@ _FIRST_WORDS_S = 2.0
 
 _OVERHEAD_PROBES = 40
 
-# What a worker imports before its first sample: with a fork server (below), once for
-# every worker.
+# What a worker imports before its first task: with a fork server (below), once for
+# every worker.  A job adds the modules of its own tasks (``connect(preload=...)``).
 WORKER_MODULES = (
     "distributed",
     "numpy",
     "astropy.time",
     "astropy.utils.iers",
-    "attitude.montecarlo.plan",
     "attitude.pointing.search",
 )
 
@@ -376,40 +374,3 @@ def check_workers(client) -> int:
                 key="--scheduler",
             )
     return sum(w["nthreads"] for w in client.scheduler_info()["workers"].values())
-
-
-def check_batch_size(batch_size: int | None, count: int) -> None:
-    """A ``--batch-size`` given for a job of ``count`` items: 1 to ``count``."""
-    if batch_size is not None and not 1 <= batch_size <= count:
-        raise InputError(
-            f"expected 1 to {count}, got {batch_size}", key="--batch-size", value=batch_size
-        )
-
-
-def batch_ranges(count: int, size: int) -> list[tuple[int, int]]:
-    """[first, stop) of each task's items, ``size`` at a time over ``count``."""
-    return [(first, min(first + size, count)) for first in range(0, count, size)]
-
-
-def batches_as_they_finish(
-    client, evaluate: Callable[..., Any], job: Any, batches: list[tuple[int, int]]
-) -> Iterator[tuple[int, int, Any]]:
-    """Send ``job`` once to every worker, one task ``evaluate(job, first, stop)`` per
-    batch, and yield ``(first, stop, result)`` as the tasks finish, each released once
-    read; ``result`` is the task's value, or the exception of a task that died (a
-    worker killed, say)."""
-    from distributed import as_completed
-
-    shared = client.scatter(job, broadcast=True, hash=False)
-    futures = client.map(
-        evaluate,
-        [shared] * len(batches),
-        [a for a, _ in batches],
-        [b for _, b in batches],
-        pure=False,
-    )
-    span = {future.key: batch for future, batch in zip(futures, batches, strict=True)}
-    for future, result in as_completed(futures, client.loop, with_results=True, raise_errors=False):
-        first, stop = span[future.key]
-        yield first, stop, result
-        future.release()
