@@ -19,7 +19,14 @@ from __future__ import annotations
 import copy
 from typing import Any
 
-__all__ = ["NO_VALUE", "AttitudeError", "InertiaWarning", "InputError", "OptionError"]
+__all__ = [
+    "NO_VALUE",
+    "AttitudeError",
+    "InertiaWarning",
+    "InputError",
+    "MachineError",
+    "OptionError",
+]
 
 
 class _NoValue:
@@ -102,6 +109,14 @@ class OptionError(InputError):
             return super().__str__()
         parts = (self.file, f"{self.key} {self.value}", self.reason)
         return ": ".join(part for part in parts if part)
+
+
+class MachineError(AttitudeError):
+    """The machine failed what the input asked, through no fault of the input: a disk
+    that filled or cannot be written, a cluster that lost its scheduler or its workers,
+    a worker out of memory.  The same input may succeed elsewhere or later (a job with
+    ``--resume``).  ``str(error)`` is one line naming what failed (the folder as the
+    user wrote it, the scheduler's address); the command line exits 1 with it."""
 
 
 class InertiaWarning(UserWarning):

@@ -18,6 +18,7 @@ failed or interrupted write is left):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from html import escape
 from pathlib import Path
 from typing import Any
@@ -34,7 +35,7 @@ from attitude.montecarlo.statistics import (
     PERCENTILES,
     describe,
 )
-from attitude.outputs.budget import check_table_fits
+from attitude.outputs.budget import check_table_fits, table_size_text
 from attitude.outputs.folder import claim
 from attitude.pointing.spec import interval_precision
 from attitude.report.page import (  # the page of attitude run, its look
@@ -185,28 +186,34 @@ def _envelope_columns(result: MonteCarloResult) -> dict[str, np.ndarray]:
     return columns
 
 
-def write_montecarlo_report(result: MonteCarloResult, out_dir: str | Path) -> list[str]:
-    """Write the report of ``result`` into ``out_dir`` (see the module docstring)."""
+def write_montecarlo_report(
+    result: MonteCarloResult, out_dir: str | Path, stage: Callable[[str], None] | None = None
+) -> list[str]:
+    """Write the report of ``result`` into ``out_dir`` (see the module docstring);
+    ``stage(text)`` is told each step as it starts."""
     folder = claim(out_dir, OUTPUT_NAMES)
 
     def build(tmp: Path) -> list[str]:
-        return _build(result, tmp)
+        return _build(result, tmp, stage or (lambda text: None))
 
     return folder.write(build, result.plan.loaded.path.name, __version__)
 
 
-def _build(result: MonteCarloResult, tmp: Path) -> list[str]:
+def _build(result: MonteCarloResult, tmp: Path, stage: Callable[[str], None]) -> list[str]:
     import pandas
 
     mc, table = result.plan, result.table
+    stage(f"writing samples.parquet and samples.csv ({table_size_text(table)})")
     table.to_parquet(tmp / "samples.parquet", index=False)
     table.to_csv(tmp / "samples.csv", index=False)
     files = ["samples.parquet", "samples.csv"]
+    stage("the statistics of every metric and parameter (statistics.json)")
     stats = statistics(result)
     write_json(tmp / "statistics.json", stats)
     files.append("statistics.json")
     images = {}
     if mc.vectors and (table["status"] == "ok").any():
+        stage("drawing the Sun-angle envelopes")
         envelope = pandas.DataFrame(_envelope_columns(result))
         envelope.to_csv(tmp / "sun_angle_envelopes.csv", index_label="bin")
         files.append("sun_angle_envelopes.csv")
@@ -215,9 +222,11 @@ def _build(result: MonteCarloResult, tmp: Path) -> list[str]:
         )
     chosen = _histogram_columns(mc, table)
     if chosen:
+        stage(f"drawing the histograms of {len(chosen)} metrics")
         images["Distributions of the metrics"] = _plot_histograms(
             result, chosen, stats, tmp / "histograms.png"
         )
+    stage("writing report.html")
     (tmp / "report.html").write_text(_page(result, stats, images, files), encoding="utf-8")
     return [*files, *images.values(), "report.html"]
 

@@ -40,6 +40,7 @@ __all__ = [
     "estimate",
     "free_disk_bytes",
     "size_text",
+    "table_size_text",
 ]
 
 # Memory of a run: the libraries and the pointing's nodes, plus one chunk of samples
@@ -198,6 +199,12 @@ def check_table_fits(
             key="--out",
             value=str(out_dir),
         )
+
+
+def table_size_text(table) -> str:
+    """A table's size as a stage line says it: "1,234 rows of 40 columns"."""
+    rows, columns = table.shape
+    return f"{rows:,} rows of {columns} columns"
 
 
 def size_text(count: float) -> str:
