@@ -21,20 +21,27 @@ import numpy as np
 from attitude.base.version import __version__
 from attitude.envelope.engine import EnvelopeResult
 from attitude.envelope.plan import EnvelopePlan
-from attitude.outputs.budget import check_table_fits, table_size_text
+from attitude.outputs.budget import JobFolderSize, check_table_fits, table_size_text
 from attitude.outputs.folder import claim
 from attitude.report.page import _STYLE, _figures_and_files, _table
 from attitude.report.summaries import to_json, write_json
 
-__all__ = ["OUTPUT_NAMES", "check_folder", "summary", "worst", "write_report"]
+__all__ = ["FOLDER_SIZE", "OUTPUT_NAMES", "check_folder", "summary", "worst", "write_report"]
 
 OUTPUT_NAMES = ("envelope.parquet", "envelope.csv", "summary.json", "envelope.png", "report.html")
+
+
+# What the folder takes beside the table's cells (measured on these writers:
+# tests/test_job_size_estimate_against_the_writers.py): a column's Parquet metadata
+# and its entries in summary.json (700 bytes); the figure (at most 150 kB), the page,
+# summary.json's frame and the manifest (10 kB).
+FOLDER_SIZE = JobFolderSize(cell=16, per_column=700, fixed=160_000, checkpoint_cell=4)
 
 
 def check_folder(plan: EnvelopePlan, out_dir: str | Path) -> None:
     """Refuse, before anything runs, a folder that is not ours or a disk too small."""
     claim(out_dir, OUTPUT_NAMES, dry_run=True)
-    check_table_fits(out_dir, plan.count, len(plan.columns), "failures")
+    check_table_fits(out_dir, plan.count, len(plan.columns), "failures", FOLDER_SIZE)
 
 
 def worst(table) -> int | None:
