@@ -497,25 +497,27 @@ def _folder_lines(out: Path) -> list[str]:
 
 def _job_time(progress, noun: str, count: int, plan) -> str:
     """``check``'s time estimate of a job: one item timed beside (a forked process,
-    within the check's budget), times the items, over the cores here."""
+    given twice the check's budget), times the items, over the cores here."""
     from attitude.envelope.plan import failure_cost_s
     from attitude.montecarlo.plan import sample_cost_s
     from attitude.report.beside import Beside
     from attitude.trajectory.steps import CHECK_BUDGET_S
 
+    one = noun[:-1]
     cost: Any = sample_cost_s if noun == "samples" else failure_cost_s
-    progress(f"timing a {noun[:-1]} for the job's time estimate")
+    progress(f"timing a {one} for the job's time estimate")
     cores = len(os.sched_getaffinity(0))
+    budget = 2 * CHECK_BUDGET_S
     with Beside(cost, plan) as timing:
-        per_item = timing.result() if timing.ready(CHECK_BUDGET_S) else None
+        per_item = timing.result() if timing.ready(budget) else None
     if per_item is None:
         return (
-            f"  time        more than {CHECK_BUDGET_S:g} s of CPU a {noun[:-1]} (the check's "
-            f"budget): more than {_duration(CHECK_BUDGET_S * count)} of CPU for {count:,} {noun}"
+            f"  time        not timed: a {one} took more than {budget:g} s here (the check's "
+            f"budget), so {count:,} {noun} take more than {_duration(budget * count)} of CPU"
         )
     total = per_item * count
     return (
-        f"  time        about {_duration(total)} of CPU ({per_item:.3g} s a {noun[:-1]}, timed "
+        f"  time        about {_duration(total)} of CPU ({per_item:.3g} s a {one}, timed "
         f"now), about {_duration(total / cores)} on this machine's {cores} "
         f"core{'s' if cores > 1 else ''} (and a few seconds to start a local cluster)"
     )
