@@ -22,14 +22,17 @@ The output folder (``attitude.outputs.folder``): ``run`` writes into a new or em
 folder, or one it wrote before, where it replaces only its own previous outputs; it
 never removes or overwrites a file it did not write.
 
-Exit status, with one line on stderr and never a traceback:
-0 success; 2 a bad scenario file, a run that cannot fit, or an output folder that is
-not ours (the line names the file, the key and the value); 1 the outputs cannot be
-written (a full disk, a folder we may not write); 130 interrupted (Ctrl-C), 143
-terminated (SIGTERM), 129 hung up (SIGHUP), 128 + N for a process of the run that
-another signal N killed, and nothing of the run is left behind (a signal the caller
-ignores, as ``nohup`` does SIGHUP, stays ignored: ``attitude.base.signals``);
-3 a bug (an exception this tool did not expect; ``ATTITUDE_TRACEBACK=1`` shows its
+Exit status, with one line on stderr and never a traceback (docs/cli.md has the
+table): 0 success; 2 a bad scenario file, a run that cannot fit, an output folder that
+is not ours, cannot be written (found before computing) or that another run holds, a
+job's ``--resume`` of another job (the line names the file, the key and the value); 1
+the machine failed the run (a full disk, memory; a job's lost scheduler, workers that
+keep dying: :class:`~attitude.base.errors.MachineError`); 130 interrupted (Ctrl-C),
+143 terminated (SIGTERM), 129 hung up (SIGHUP), 128 + N for a process of the run that
+another signal N killed, and nothing of the run is left behind but a job's checkpoint,
+which its line names (a signal the caller ignores, as ``nohup`` does SIGHUP, stays
+ignored: ``attitude.base.signals``); 3 a bug (an exception this tool did not expect,
+also in a job's task: ``attitude.jobs.failures``; ``ATTITUDE_TRACEBACK=1`` shows its
 traceback).  Warnings are one line each, ``attitude: warning: FILE: KEY: ...``, and so
 are notes (``attitude: note: ...``: a clamped precision, a far TLE epoch).
 
