@@ -209,8 +209,9 @@ def test_kill_9_then_resume(reference, tmp_path, capsys):
     finally:
         job.kill()
         job.stderr.close()
-    assert (out / CHECKPOINT / "checkpoint.json").is_file()
-    assert (out / ".attitude-lock").is_file()  # stale: its holder is dead
+    # Its parts (or, had it just finished, its outputs), and its lock, stale now.
+    assert (out / CHECKPOINT / "checkpoint.json").is_file() or (out / "report.html").is_file()
+    assert (out / ".attitude-lock").is_file()
     assert main(["montecarlo", str(scenario), *options, "--resume", "--quiet"]) == 0
     assert _outputs(out) == _outputs(done)
     assert sorted(os.listdir(out)) == sorted(os.listdir(done))
