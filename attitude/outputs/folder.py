@@ -88,9 +88,10 @@ class OutputFolderError(OptionError):
     ``--emit-scenario``) and ``value`` the folder as given: ``--out results: reason``."""
 
 
-class OutputWriteError(MachineError):
+class OutputWriteError(MachineError, OSError):
     """The outputs could not be written (a full disk, a folder that became unwritable);
-    nothing of the run is left in the folder, named as the user wrote it."""
+    nothing of the run is left in the folder, named as the user wrote it.  Also an
+    ``OSError``, as the write's own error was: code that catches that still does."""
 
 
 def is_checkpoint(path: Path) -> bool:
