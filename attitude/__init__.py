@@ -17,11 +17,13 @@ checks it, and that the README's "Layout" table lists the same layers and module
 10. ``attitude.outputs``: CSV, Parquet and AEM files, the output budget and folder
 11. ``attitude.report``: a run's plan, summaries, figures, page and streamed writing
 12. ``attitude.files``: scenario files read and written
-13. ``attitude.estimation``: spin state and inertia ratios fitted to telemetry
-14. ``attitude.montecarlo``: Monte Carlo dispersions on Dask
-15. ``attitude.envelope``: the loss-of-control envelope (a control loss at every instant
+13. ``attitude.jobs``: long jobs on Dask (a local cluster or a scheduler, its workers
+    checked, the batches and their gathering), which the Monte Carlo and the envelope share
+14. ``attitude.estimation``: spin state and inertia ratios fitted to telemetry
+15. ``attitude.montecarlo``: Monte Carlo dispersions on Dask
+16. ``attitude.envelope``: the loss-of-control envelope (a control loss at every instant
     of a nominal timeline), on Dask
-16. ``attitude.cli``: the command line
+17. ``attitude.cli``: the command line
 
 The names below are importable from ``attitude`` directly; all but the errors are
 loaded on first use, so that ``import attitude`` stays light (numpy, scipy, astropy,

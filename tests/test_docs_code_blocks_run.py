@@ -1,9 +1,11 @@
 """Every code block of README.md and docs/*.md does what it shows.
 
 - A ``python`` block runs: the blocks of one page run in order in one fresh process,
-  as a reader pastes them into one session, from a scratch folder that holds the
-  repository's ``scenarios/`` and ``docs/`` (so relative paths work and nothing is
-  written into the clone).  It imports the package only as ``from attitude import``
+  as a script of them run with ``python script.py`` (a script, not ``python -c``: a
+  process that Dask or multiprocessing starts imports a script again, which ``-c``
+  hid, so the README's envelope once failed as written), from a scratch folder that
+  holds the repository's ``scenarios/`` and ``docs/`` (so relative paths work and
+  nothing is written into the clone).  It imports the package only as ``from attitude import``
   or ``import attitude``: the public API is what ``attitude`` exports.
 - A ``toml`` block parses.
 - A ``sh`` block's ``attitude check``, ``attitude run`` and ``attitude fit`` lines run to
@@ -67,9 +69,11 @@ def test_python_blocks_run(page, tmp_path):
     program = "\n".join(
         f"print('--- block at line {line}', flush=True)\n{code}" for line, code in blocks
     )
+    script = _scratch(tmp_path) / "blocks.py"
+    script.write_text(program, encoding="utf-8")
     run = subprocess.run(
-        [sys.executable, "-c", program],
-        cwd=_scratch(tmp_path),
+        [sys.executable, str(script)],
+        cwd=tmp_path,
         env=_environment(),
         capture_output=True,
         text=True,

@@ -18,9 +18,10 @@ import math
 import numpy as np
 import pytest
 
-from attitude import EnvelopeSettings, Wheels, load_scenario
+from attitude import EnvelopeSettings, InputError, Wheels, load_scenario
 from attitude.envelope.failure import evaluate_batch, failure_metrics
 from attitude.envelope.plan import make_job, plan_envelope
+from attitude.jobs.failures import TaskError
 
 SCENARIO = "scenarios/eo_envelope.toml"
 CASES = {
@@ -88,27 +89,36 @@ def test_the_batches_cover_every_outcome_of_the_power_search():
     assert any(x == math.inf for x in lost)
 
 
-def test_a_refused_failure_in_a_task_is_its_own_row(monkeypatch):
-    """A failure whose motion is refused, and one whose search is refused within the
-    task's searches together: each its own failed row, naming the error; the others the
-    same rows as before, bit for bit (the task's searches run again one at a time)."""
-    import attitude.envelope.failure as failure
-
-    job, batch = _rows("locked, threshold 0.3")
+def _planted(failure, bug: type[Exception]):
+    """``motion_after`` with failure 2's motion refused, and failure 5's attitude
+    raising ``bug`` within the task's searches together."""
     real = failure.motion_after
 
     def motion_after(job, k):
         if k == 2:
-            raise ValueError("no motion for failure 2")
+            raise InputError("no motion for failure 2")
         trajectory = real(job, k)
         if k == 5:
             solver = trajectory.segments[0].solver
 
             def refused(t, scalar_first=True):
-                raise OverflowError("the attitude of failure 5 overflows")
+                raise bug("the attitude of failure 5 overflows")
 
             solver.attitude_quaternion = refused
         return trajectory
+
+    return motion_after
+
+
+def test_a_refused_failure_in_a_task_is_its_own_row(monkeypatch):
+    """A failure whose motion is refused, and one whose search is refused within the
+    task's searches together (an InputError: their own input's refusal): each its own
+    failed row, naming the error; the others the same rows as before, bit for bit (the
+    task's searches run again one at a time)."""
+    import attitude.envelope.failure as failure
+
+    job, batch = _rows("locked, threshold 0.3")
+    motion_after = _planted(failure, InputError)
 
     monkeypatch.setattr(failure, "motion_after", motion_after)
     rows = evaluate_batch(job, 0, job.count).rows
@@ -119,3 +129,17 @@ def test_a_refused_failure_in_a_task_is_its_own_row(monkeypatch):
             assert all(math.isnan(row[c]) for c in job.columns)
         else:
             assert all(_same(row[c], before[c]) for c in before), k
+
+
+def test_an_exception_no_input_explains_is_a_bug_naming_the_failure_not_a_row(monkeypatch):
+    """An OverflowError in failure 5's search is not a refusal of its input: the task
+    ends with a TaskError naming failure 5 (exit 3 on the command line), never a
+    failed row (main at d285687 made it one)."""
+    import attitude.envelope.failure as failure
+
+    job, _ = _rows("locked, threshold 0.3")
+    monkeypatch.setattr(failure, "motion_after", _planted(failure, OverflowError))
+    with pytest.raises(TaskError) as caught:
+        evaluate_batch(job, 0, job.count)
+    assert str(caught.value).startswith("failure 5 (τ = 2250 s): OverflowError: the attitude")
+    assert "Traceback" in caught.value.details

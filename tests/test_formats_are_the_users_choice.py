@@ -178,6 +178,9 @@ def test_a_disk_full_in_the_middle_of_the_stream_leaves_nothing(
     argv = ["run", str(path), "--out", str(out), "--formats", failing, "--quiet"]
     assert main(argv) == 1
     err = capsys.readouterr().err
-    assert said(err) == ["attitude: error: No space left on device"], err
+    assert said(err) == [
+        f"attitude: error: --out {out}: the outputs could not be written (No space left on "
+        "device); nothing of this run was left in the folder"
+    ], err
     assert len(calls) == 3
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before

@@ -33,6 +33,7 @@ def test_a_full_disk_refuses_the_job_and_writes_nothing(argv, what, tmp_path, ca
     lines = said(capsys.readouterr().err)
     assert code == 2, lines
     assert len(lines) == 1, lines
-    assert f"--out: {out}: the table of " in lines[0] and f" {what} would take about " in lines[0]
-    assert "GB, and its disk has 1e-06 GB free" in lines[0], lines[0]
+    assert f"--out: {out}: the job's " in lines[0] and f" {what} would take about " in lines[0]
+    assert "(the outputs " in lines[0] and "and its checkpoint while it runs)" in lines[0]
+    assert lines[0].endswith(("and its disk has 1 kB free", "another disk")), lines[0]
     assert not out.exists()

@@ -20,7 +20,7 @@ import psutil
 from montecarlo_scenarios import write_spinner
 from signal_dispositions import defaults
 
-from attitude.montecarlo.cluster import connect
+from attitude.jobs.cluster import connect
 
 
 def _listening_ports(processes) -> set[int]:
@@ -120,15 +120,23 @@ def test_ctrl_c_closes_the_cluster_and_leaves_nothing(tmp_path):
     finally:
         if run.poll() is None:
             os.killpg(run.pid, signal.SIGKILL)
-    after = [line for line in rest if "samples" not in line]  # the bar may print once more
-    assert after == ["attitude: error: interrupted; nothing of this run was left behind"], rest
+    after = [line for line in rest if not line.startswith("[")]  # the bar may print again
     assert not any("Traceback" in line for line in lines + rest)
     deadline = time.monotonic() + 10
     while _session(run.pid) and time.monotonic() < deadline:
         time.sleep(0.2)
     assert _session(run.pid) == []
-    assert not out.exists()
-    assert sorted(p.name for p in user.iterdir()) == ["spinner.toml"]
+    # Nothing, or only the samples finished before the Ctrl-C, in the job's checkpoint.
+    if after == ["attitude: error: interrupted; nothing of this run was left behind"]:
+        assert not out.exists()
+    else:
+        assert len(after) == 1 and after[0].startswith("attitude: error: interrupted; "), rest
+        assert after[0].endswith(
+            f"of 400 samples are kept in {out}/.attitude-checkpoint: the same command with "
+            "--resume continues the job"
+        ), rest
+        assert sorted(p.name for p in out.iterdir()) == [".attitude-checkpoint"]
+    assert sorted(p.name for p in user.iterdir()) in (["spinner.toml"], ["results", "spinner.toml"])
 
 
 def test_ctrl_c_while_the_cluster_starts_stops_the_job(tmp_path):

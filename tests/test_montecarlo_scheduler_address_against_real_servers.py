@@ -17,7 +17,7 @@ from urllib.parse import urlparse
 import pytest
 from montecarlo_scenarios import write_spinner
 
-import attitude.montecarlo.cluster as cluster
+import attitude.jobs.cluster as cluster
 from attitude.base.errors import InputError
 from attitude.cli.main import main
 

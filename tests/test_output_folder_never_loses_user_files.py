@@ -219,9 +219,12 @@ def test_a_folder_that_cannot_be_written_leaves_nothing(user_folder, capsys, mon
 
     monkeypatch.setattr(attitude.outputs.folder.Path, "mkdir", refuse)
     before = _snapshot(folder)
-    assert main(["run", str(scenario), "--out", str(folder / "new"), "--quiet"]) == 1
+    # Found before anything is computed: exit 2, the folder as written (issue 27).
+    assert main(["run", str(scenario), "--out", str(folder / "new"), "--quiet"]) == 2
     err = capsys.readouterr().err
-    assert len(err.splitlines()) == 1 and "Read-only file system" in err
+    assert err.splitlines() == [
+        f"attitude: error: --out {folder / 'new'}: cannot create the folder: Read-only file system"
+    ]
     assert _snapshot(folder) == before and not (folder / "new").exists()
 
 

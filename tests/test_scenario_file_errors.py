@@ -178,7 +178,10 @@ def test_a_failed_run_leaves_no_output_and_keeps_the_old_one(tmp_path, monkeypat
 
     monkeypatch.setattr(attitude.report.run, "write_json", fail)
     assert main(["run", str(path), "--out", str(out), "--quiet"]) == 1
-    assert "attitude: error: disk full" in capsys.readouterr().err
+    assert (
+        f"attitude: error: --out {out}: the outputs could not be written (disk full)"
+        in capsys.readouterr().err
+    )
     assert {p.name: p.read_bytes() for p in out.iterdir()} == before
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "valid.toml"]
     # And into a new folder: nothing at all.

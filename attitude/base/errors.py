@@ -25,6 +25,7 @@ __all__ = [
     "InertiaWarning",
     "InputError",
     "LawRateWarning",
+    "MachineError",
     "OptionError",
 ]
 
@@ -109,6 +110,14 @@ class OptionError(InputError):
             return super().__str__()
         parts = (self.file, f"{self.key} {self.value}", self.reason)
         return ": ".join(part for part in parts if part)
+
+
+class MachineError(AttitudeError):
+    """The machine failed what the input asked, through no fault of the input: a disk
+    that filled or cannot be written, a cluster that lost its scheduler or its workers,
+    a worker out of memory.  The same input may succeed elsewhere or later (a job with
+    ``--resume``).  ``str(error)`` is one line naming what failed (the folder as the
+    user wrote it, the scheduler's address); the command line exits 1 with it."""
 
 
 class InertiaWarning(UserWarning):

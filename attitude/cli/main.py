@@ -22,14 +22,17 @@ The output folder (``attitude.outputs.folder``): ``run`` writes into a new or em
 folder, or one it wrote before, where it replaces only its own previous outputs; it
 never removes or overwrites a file it did not write.
 
-Exit status, with one line on stderr and never a traceback:
-0 success; 2 a bad scenario file, a run that cannot fit, or an output folder that is
-not ours (the line names the file, the key and the value); 1 the outputs cannot be
-written (a full disk, a folder we may not write); 130 interrupted (Ctrl-C), 143
-terminated (SIGTERM), 129 hung up (SIGHUP), 128 + N for a process of the run that
-another signal N killed, and nothing of the run is left behind (a signal the caller
-ignores, as ``nohup`` does SIGHUP, stays ignored: ``attitude.base.signals``);
-3 a bug (an exception this tool did not expect; ``ATTITUDE_TRACEBACK=1`` shows its
+Exit status, with one line on stderr and never a traceback (docs/cli.md has the
+table): 0 success; 2 a bad scenario file, a run that cannot fit, an output folder that
+is not ours, cannot be written (found before computing) or that another run holds, a
+job's ``--resume`` of another job (the line names the file, the key and the value); 1
+the machine failed the run (a full disk, memory; a job's lost scheduler, workers that
+keep dying: :class:`~attitude.base.errors.MachineError`); 130 interrupted (Ctrl-C),
+143 terminated (SIGTERM), 129 hung up (SIGHUP), 128 + N for a process of the run that
+another signal N killed, and nothing of the run is left behind but a job's checkpoint,
+which its line names (a signal the caller ignores, as ``nohup`` does SIGHUP, stays
+ignored: ``attitude.base.signals``); 3 a bug (an exception this tool did not expect,
+also in a job's task: ``attitude.jobs.failures``; ``ATTITUDE_TRACEBACK=1`` shows its
 traceback).  Warnings are one line each, ``attitude: warning: FILE: KEY: ...``, and so
 are notes (``attitude: note: ...``: a clamped precision, a far TLE epoch).
 
@@ -47,6 +50,7 @@ import signal
 import sys
 import threading
 from pathlib import Path
+from typing import Any
 
 __all__ = ["main"]
 
@@ -147,11 +151,21 @@ def _envelope_parser(commands) -> None:
 
 
 def _dask_arguments(parser, items: str) -> None:
-    """Where a Dask job runs, and how many of its ``items`` a task takes."""
+    """Where a Dask job runs, how many of its ``items`` a task takes, and ``--resume``."""
     where = parser.add_mutually_exclusive_group()
     where.add_argument("--scheduler", help="address of a Dask scheduler (default: local)")
-    where.add_argument("--workers", type=int, help="local worker processes (default: all cores)")
+    where.add_argument(
+        "--workers",
+        type=int,
+        help="local worker processes (default: all cores; 1: this process, no cluster)",
+    )
     parser.add_argument("--batch-size", type=int, help=f"{items} per task (default: from costs)")
+    parser.add_argument(
+        "--resume",
+        action="store_true",
+        help=f"continue the interrupted job whose checkpoint --out holds (its finished {items}); "
+        "without it, a checkpoint found there is discarded",
+    )
 
 
 def _outputs(args, outputs):
@@ -289,12 +303,12 @@ def _checked_run(args, state: dict) -> int:
         start=process_started_at() if state.get("argv") is None else None,
     )
     progress(f"reading {args.scenario}")
-    from attitude.base.errors import InputError
+    from attitude.base.errors import InputError, MachineError
     from attitude.files.scenario_reader import ScenarioFileError, load_scenario
-    from attitude.outputs.budget import check_fits
+    from attitude.jobs.failures import TaskError
     from attitude.outputs.folder import OutputFolderError, claim
     from attitude.outputs.formats import OUTPUT_NAMES, OutputChoice
-    from attitude.report.plan import horizon_beside, plan_run
+    from attitude.outputs.lock import folder_lock
 
     try:
         # The command line's own options first: their errors name the option, not a file.
@@ -306,75 +320,32 @@ def _checked_run(args, state: dict) -> int:
             return 2
         loaded = load_scenario(args.scenario)
         state["file"] = loaded.path.name
-        if args.command == "montecarlo":
-            from attitude.cli.montecarlo import command
-
-            return command(args, loaded, progress)
-        if args.command == "envelope":
-            from attitude.cli.envelope import command as envelope_command
-
-            return envelope_command(args, loaded, progress)
-        outputs = _outputs(args, loaded.outputs)
-        # A run computes the validity horizon beside its outputs (attitude.report.run).
-        checking = args.command == "check"
-        if "envelope" in loaded.document:  # the table in a moment, before the long checks
-            from attitude.envelope.plan import check_envelope_table
-
-            check_envelope_table(loaded)
-        plan = plan_run(
-            loaded.scenario,
-            loaded.pointing,
-            outputs,
-            horizon=checking,
-            progress=progress,
-            check=checking,
-        )
-        montecarlo = None
-        if "dispersions" in loaded.document:  # checked by run too: one reading of the file
-            from attitude.montecarlo.plan import plan_montecarlo
-
-            montecarlo = plan_montecarlo(loaded, plan)
-        envelope = None
-        if "envelope" in loaded.document:  # the same checks as `attitude envelope`
-            from attitude.envelope.plan import plan_envelope
-
-            envelope = plan_envelope(loaded, plan=plan)
-        if args.command == "check":
-            if args.out is not None:
-                check_fits(plan.budget, args.out)
+        with contextlib.ExitStack() as held:
+            if args.command == "run":  # the folder checked and held before any computing
                 claim(args.out, OUTPUT_NAMES, dry_run=True)
-            else:  # the disk a run writes to without a path: the current folder's
-                check_fits(plan.budget, Path.cwd(), shown=f"the current folder ({Path.cwd()})")
-            print(_describe(loaded, plan, args.out), flush=True)
-            if montecarlo is not None:
-                print("\n".join(montecarlo.describe()), flush=True)
-            if envelope is not None:
-                print("\n".join(envelope.describe()), flush=True)
-            return 0
-        claim(args.out, OUTPUT_NAMES, dry_run=True)  # a folder that is not ours: say so first
-        for note in plan.notes:
-            print(f"attitude: note: {loaded.path.name}: {note}", file=sys.stderr, flush=True)
-        # The horizon's screen, and the splitting beside the run if the screen cannot
-        # answer, before the writers and plots are imported.
-        with horizon_beside(plan) or contextlib.nullcontext() as horizon:
-            from attitude.report.run import write_report
-
-            write_report(
-                loaded.scenario,
-                args.out,
-                loaded.pointing,
-                loaded.path.name,
-                progress,
-                plan,
-                horizon=horizon,
-            )
-        return 0
+                held.enter_context(folder_lock(args.out, "run"))
+            elif args.command == "check" and args.out is not None:
+                claim(args.out, _folder_names(loaded), dry_run=True)
+            return _command(args, loaded, progress)
     except (ScenarioFileError, OutputFolderError) as exc:
-        _error(str(exc))
+        _error(_with_notes(str(exc), exc))
         return 2
     except InputError as exc:  # from the file's values: named after the file, unless it names one
-        _error(str(exc if exc.file else exc.located(file=state.get("file") or args.scenario.name)))
+        _error(
+            _with_notes(
+                str(exc if exc.file else exc.located(file=state.get("file") or args.scenario.name)),
+                exc,
+            )
+        )
         return 2
+    except MachineError as exc:  # the machine or the cluster: the disk, a lost scheduler
+        _error(_with_notes(str(exc), exc))
+        return 1
+    except TaskError as exc:  # a bug met by a job's task: the sample or failure named
+        if os.environ.get("ATTITUDE_TRACEBACK") and exc.details:
+            print(exc.details, file=sys.stderr, end="", flush=True)
+        _error(_with_notes(f"internal error: {exc} ({_BUG})", exc))
+        return 3
     except MemoryError:
         _error(f"{args.scenario.name}: out of memory: use a longer output.step or a shorter span")
         return 1
@@ -382,8 +353,179 @@ def _checked_run(args, state: dict) -> int:
         raise  # stdout closed by the reader: see main
     except OSError as exc:  # the file system: a full disk, a folder we cannot write
         where = f" ({exc.filename})" if getattr(exc, "filename", None) else ""
-        _error(f"{exc.strerror or exc}{where}")
+        _error(_with_notes(f"{exc.strerror or exc}{where}", exc))
         return 1
+
+
+_BUG = "a bug: please report it; ATTITUDE_TRACEBACK=1 shows the traceback"
+
+
+def _left_behind(exc: BaseException) -> str:
+    """What a stopped run leaves: nothing, or what its job's checkpoint kept."""
+    notes = getattr(exc, "__notes__", None)
+    return "; ".join(notes) if notes else "nothing of this run was left behind"
+
+
+def _with_notes(line: str, exc: BaseException) -> str:
+    """``line`` and the notes the job added to ``exc`` (what its checkpoint kept)."""
+    notes = getattr(exc, "__notes__", None) or []
+    return "; ".join([line, *notes])
+
+
+def _command(args, loaded, progress) -> int:
+    """The command of ``args`` on the scenario file ``loaded`` (errors: the caller's)."""
+    from attitude.outputs.budget import check_fits
+    from attitude.report.plan import horizon_beside, plan_run
+
+    if args.command == "montecarlo":
+        from attitude.cli.montecarlo import command
+
+        return command(args, loaded, progress)
+    if args.command == "envelope":
+        from attitude.cli.envelope import command as envelope_command
+
+        return envelope_command(args, loaded, progress)
+    outputs = _outputs(args, loaded.outputs)
+    # A run computes the validity horizon beside its outputs (attitude.report.run).
+    checking = args.command == "check"
+    if "envelope" in loaded.document:  # the table in a moment, before the long checks
+        from attitude.envelope.plan import check_envelope_table
+
+        check_envelope_table(loaded)
+    plan = plan_run(
+        loaded.scenario,
+        loaded.pointing,
+        outputs,
+        horizon=checking,
+        progress=progress,
+        check=checking,
+    )
+    montecarlo = None
+    if "dispersions" in loaded.document:  # checked by run too: one reading of the file
+        from attitude.montecarlo.plan import plan_montecarlo
+
+        montecarlo = plan_montecarlo(loaded, plan)
+    envelope = None
+    if "envelope" in loaded.document:  # the same checks as `attitude envelope`
+        from attitude.envelope.plan import plan_envelope
+
+        envelope = plan_envelope(loaded, plan=plan)
+    if args.command == "check":
+        if args.out is not None:
+            check_fits(plan.budget, args.out)
+            _check_folder(args.out, montecarlo, envelope)
+        else:  # the disk a run writes to without a path: the current folder's
+            check_fits(plan.budget, Path.cwd(), shown=f"the current folder ({Path.cwd()})")
+        print(_describe(loaded, plan, args.out), flush=True)
+        for line in _folder_lines(args.out) if args.out is not None else []:
+            print(line, flush=True)
+        if montecarlo is not None:
+            print("\n".join(montecarlo.describe()), flush=True)
+            print(_job_time(progress, "samples", montecarlo.samples, montecarlo), flush=True)
+        if envelope is not None:
+            print("\n".join(envelope.describe()), flush=True)
+            print(_job_time(progress, "failures", envelope.count, envelope), flush=True)
+        return 0
+    for note in plan.notes:
+        print(f"attitude: note: {loaded.path.name}: {note}", file=sys.stderr, flush=True)
+    # The horizon's screen, and the splitting beside the run if the screen cannot
+    # answer, before the writers and plots are imported.
+    with horizon_beside(plan) or contextlib.nullcontext() as horizon:
+        from attitude.report.run import write_report
+
+        write_report(
+            loaded.scenario,
+            args.out,
+            loaded.pointing,
+            loaded.path.name,
+            progress,
+            plan,
+            horizon=horizon,
+            lock=False,  # held since the start (_checked_run)
+        )
+    return 0
+
+
+def _folder_names(loaded) -> set[str]:
+    """The files the commands a scenario file allows may write into one folder (a
+    folder of ``run``'s, ``montecarlo``'s or ``envelope``'s): what ``check --out``
+    takes the folder for."""
+    from attitude.outputs.formats import OUTPUT_NAMES
+
+    names = set(OUTPUT_NAMES)
+    if "dispersions" in loaded.document:
+        from attitude.montecarlo.report import OUTPUT_NAMES as MONTECARLO_NAMES
+
+        names |= set(MONTECARLO_NAMES)
+    if "envelope" in loaded.document:
+        from attitude.envelope.report import OUTPUT_NAMES as ENVELOPE_NAMES
+
+        names |= set(ENVELOPE_NAMES)
+    return names
+
+
+def _check_folder(out: Path, montecarlo, envelope) -> None:
+    """``check --out``: the disk for a job's table, and the folder again (checked
+    before the plan: :func:`_checked_run`)."""
+    if montecarlo is not None:
+        from attitude.montecarlo.report import check_folder as check_montecarlo_folder
+
+        check_montecarlo_folder(montecarlo, out)
+    if envelope is not None:
+        from attitude.envelope.report import check_folder as check_envelope_folder
+
+        check_envelope_folder(envelope, out)
+
+
+def _folder_lines(out: Path) -> list[str]:
+    """What ``check --out`` says of the folder: a run writing into it, a checkpoint."""
+    from attitude.jobs.checkpoint import checkpoint_summary
+    from attitude.outputs.lock import lock_holder
+
+    lines = []
+    holder = lock_holder(out)
+    if holder is not None:
+        lines.append(f"  folder      {out}: another run, {holder}, is writing into it now")
+    kept = checkpoint_summary(out)
+    if kept is not None:
+        lines.append(f"  checkpoint  {kept}")
+    return lines
+
+
+def _job_time(progress, noun: str, count: int, plan) -> str:
+    """``check``'s time estimate of a job: one item timed beside (a forked process,
+    given twice the check's budget), times the items, over the cores here."""
+    from attitude.envelope.plan import failure_cost_s
+    from attitude.montecarlo.plan import sample_cost_s
+    from attitude.report.beside import Beside
+    from attitude.trajectory.steps import CHECK_BUDGET_S
+
+    one = noun[:-1]
+    cost: Any = sample_cost_s if noun == "samples" else failure_cost_s
+    progress(f"timing a {one} for the job's time estimate")
+    cores = len(os.sched_getaffinity(0))
+    budget = 2 * CHECK_BUDGET_S
+    with Beside(cost, plan) as timing:
+        per_item = timing.result() if timing.ready(budget) else None
+    if per_item is None:
+        return (
+            f"  time        not timed: a {one} took more than {budget:g} s here (the check's "
+            f"budget), so {count:,} {noun} take more than {_duration(budget * count)} of CPU"
+        )
+    total = per_item * count
+    return (
+        f"  time        about {_duration(total)} of CPU ({per_item:.3g} s a {one}, timed "
+        f"now), about {_duration(total / cores)} on this machine's {cores} "
+        f"core{'s' if cores > 1 else ''} (and a few seconds to start a local cluster)"
+    )
+
+
+def _duration(seconds: float) -> str:
+    if seconds < 120:
+        return f"{seconds:.2g} s"
+    if seconds < 7200:
+        return f"{seconds / 60:.3g} min"
+    return f"{seconds / 3600:.3g} h"
 
 
 # Python's full collections during a command: at most one per this many younger ones
@@ -440,11 +582,11 @@ def _main(argv: list[str] | None) -> int:
         args = _parser().parse_args(argv)
         state["argv"] = argv
         return _run(args, state)
-    except KeyboardInterrupt:
-        _error("interrupted; nothing of this run was left behind")
+    except KeyboardInterrupt as exc:
+        _error(f"interrupted; {_left_behind(exc)}")
         return 130
     except Stopped as stop:
-        _error(f"{stop.text}; nothing of this run was left behind")
+        _error(f"{stop.text}; {_left_behind(stop)}")
         return stop.exit_status
     except BrokenPipeError:  # `attitude check x | head -1`
         devnull = os.open(os.devnull, os.O_WRONLY)

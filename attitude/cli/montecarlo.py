@@ -10,12 +10,19 @@ from pathlib import Path
 from attitude.base.errors import InputError
 from attitude.base.progress import Progress
 from attitude.files.scenario_reader import ScenarioFile
-from attitude.montecarlo.cluster import check_where
+from attitude.jobs.cluster import check_where
+from attitude.montecarlo.job import montecarlo_job
 from attitude.montecarlo.plan import emit_samples, plan_montecarlo
-from attitude.montecarlo.report import check_folder, write_montecarlo_report
-from attitude.montecarlo.simulation import simulate
+from attitude.montecarlo.report import OUTPUT_NAMES
+from attitude.outputs.folder import claim
+from attitude.outputs.lock import refuse_if_held
 
-__all__ = ["ProgressBar", "command"]
+__all__ = ["ProgressBar", "command", "note"]
+
+
+def note(text: str) -> None:
+    """One ``attitude: note:`` line on stderr (shown whatever ``--quiet`` says)."""
+    print(f"attitude: note: {text}", file=sys.stderr, flush=True)
 
 
 def command(args, loaded: ScenarioFile, stage: Progress | None = None) -> int:
@@ -25,6 +32,9 @@ def command(args, loaded: ScenarioFile, stage: Progress | None = None) -> int:
     emit = args.emit_scenario is not None or args.sample is not None
     stage = stage or Progress()
     if not emit:  # where the job runs, checked first: an address tried takes seconds
+        if args.out is not None:  # and the folder (ours, writable, free) before planning
+            claim(args.out, OUTPUT_NAMES, dry_run=True)
+            refuse_if_held(args.out)
         if args.scheduler is not None:
             stage(f"trying the Dask scheduler at {args.scheduler}")
         check_where(args.scheduler, args.workers)
@@ -37,26 +47,35 @@ def command(args, loaded: ScenarioFile, stage: Progress | None = None) -> int:
             )
         if args.out is not None:
             raise InputError("runs the job; --emit-scenario writes samples instead", key="--out")
+        if args.resume:
+            raise InputError(
+                "continues a job; --emit-scenario writes samples instead", key="--resume"
+            )
         for path in emit_samples(mc, args.sample, args.emit_scenario):
             print(path, flush=True)
         return 0
     if args.out is None:
         raise InputError("the output folder is required (or --emit-scenario)", key="--out")
-    check_folder(mc, args.out)
     bar = None if args.quiet else ProgressBar(sys.stderr)
-    result = simulate(mc, args.scheduler, args.workers, args.batch_size, bar, stage, probed=True)
+    result = montecarlo_job(
+        mc,
+        args.out,
+        scheduler=args.scheduler,
+        workers=args.workers,
+        batch_size=args.batch_size,
+        progress=bar,
+        stage=stage,
+        note=lambda text: note(f"{loaded.path.name}: {text}"),
+        resume=args.resume,
+        probed=True,
+        refuse_all_failed=True,
+    )
     failed = result.failed
-    if len(failed) == mc.samples:
-        first = failed.iloc[0]
-        raise InputError(f"every sample failed; sample {first['sample']}: {first['error']}")
-    write_montecarlo_report(result, args.out)
     if len(failed):
-        print(
-            f"attitude: note: {loaded.path.name}: {len(failed)} of {mc.samples} samples "
+        note(
+            f"{loaded.path.name}: {len(failed)} of {mc.samples} samples "
             f"failed (the first: sample {failed.iloc[0]['sample']}: {failed.iloc[0]['error']}); "
-            "statistics.json lists them with their parameters",
-            file=sys.stderr,
-            flush=True,
+            "statistics.json lists them with their parameters"
         )
     stage(f"done: {Path(args.out) / 'report.html'}")
     return 0

@@ -38,9 +38,11 @@ The metrics (columns of the table; times in s after τ; ``inf``: not within the 
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 import weakref
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any
 
@@ -48,6 +50,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
+from attitude.base.errors import InputError
 from attitude.envelope.power import (
     as_fraction,
     first_below,
@@ -57,6 +60,7 @@ from attitude.envelope.power import (
     mean_incidence,
     power_fraction,
 )
+from attitude.jobs.failures import TaskError
 from attitude.pointing.search import (
     OrbitIntervals,
     PointingAnalysis,
@@ -227,17 +231,32 @@ def _structure(job: EnvelopeJob, k: int) -> tuple[dict[str, Any], _Power | None]
     return _row(job, k, trajectory, analysis, shared)
 
 
+@contextlib.contextmanager
+def _refusals_or_bugs(job: EnvelopeJob, k: int) -> Iterator[None]:
+    """An exception of the block that is neither a refusal of failure ``k``'s own
+    motion (:class:`InputError`: its row says so) nor the machine's (a memory error)
+    raised as a :class:`TaskError` naming the failure: a bug, never a row."""
+    try:
+        yield
+    except (InputError, MemoryError):
+        raise
+    except Exception as exc:
+        raise TaskError.of(exc, f"failure {k} (τ = {float(job.seconds[k]):g} s)") from exc
+
+
 def _structures(job: EnvelopeJob, ks: list[int]) -> list[Any]:
     """:func:`_structure` of failures ``ks``, their pointing searches together
     (:func:`attitude.pointing.search.pointing_analyses`: each the same, bit for bit, as
-    alone): for each, its (row, power search), or the exception that refused it.  If
-    the searches together are refused, each is searched alone (to name the one)."""
+    alone): for each, its (row, power search), or the refusal (:class:`InputError`)
+    of its motion.  If the searches together are refused, each is searched alone (to
+    name the one); any other exception is a bug (:func:`_refusals_or_bugs`)."""
     out: list[Any] = [None] * len(ks)
     motions = []
     for j, k in enumerate(ks):
         try:
-            motions.append((j, k, motion_after(job, k)))
-        except Exception as exc:
+            with _refusals_or_bugs(job, k):
+                motions.append((j, k, motion_after(job, k)))
+        except InputError as exc:
             out[j] = exc
     if not motions:
         return out
@@ -251,17 +270,19 @@ def _structures(job: EnvelopeJob, ks: list[int]) -> list[Any]:
             orbit=job.orbit,
             extrema=_extrema(job),
         )
-    except Exception:
+    except Exception:  # a refusal or a bug: each alone says which failure's, and which
         for j, k, _ in motions:
             try:
-                out[j] = _structure(job, k)
-            except Exception as exc:
+                with _refusals_or_bugs(job, k):
+                    out[j] = _structure(job, k)
+            except InputError as exc:
                 out[j] = exc
         return out
     for (j, k, trajectory), analysis in zip(motions, analyses, strict=True):
         try:
-            out[j] = _row(job, k, trajectory, analysis, shared)
-        except Exception as exc:
+            with _refusals_or_bugs(job, k):
+                out[j] = _row(job, k, trajectory, analysis, shared)
+        except InputError as exc:
             out[j] = exc
     return out
 
@@ -488,7 +509,8 @@ def _pieces(analysis, τ: float, end: float, turning: float, fraction_rate: floa
 
 def evaluate_batch(job: EnvelopeJob, first: int, stop: int) -> BatchResult:
     """Failures ``first`` to ``stop − 1`` of ``job``, each a row (runs on a worker).  A
-    failure whose motion is refused is a row with its error; the job goes on.
+    failure whose motion is refused (an :class:`InputError`) is a row with its error;
+    the job goes on.  Any other exception ends the task (:func:`_refusals_or_bugs`).
 
     The pointing searches of the batch run together (:func:`_structures`), and so do
     its power searches (:func:`_power_search`); each row is the same bit for bit as
@@ -499,7 +521,7 @@ def evaluate_batch(job: EnvelopeJob, first: int, stop: int) -> BatchResult:
     ks = list(range(first, stop))
     for k, found in zip(ks, _structures(job, ks), strict=True):
         row: dict[str, Any] = {"failure": k, "tau_s": float(job.seconds[k])}
-        if isinstance(found, Exception):  # a refused motion is this failure's row
+        if isinstance(found, InputError):  # a refused motion is this failure's row
             _failed(row, job, found)
         else:
             metrics, power = found
@@ -514,8 +536,9 @@ def evaluate_batch(job: EnvelopeJob, first: int, stop: int) -> BatchResult:
         except Exception:  # find which failure's search is refused: each alone
             for power in searches:
                 try:
-                    _power_search(_SURROUNDINGS[job], [power], job.threshold)
-                except Exception as exc:
+                    with _refusals_or_bugs(job, power.row["failure"]):
+                        _power_search(_SURROUNDINGS[job], [power], job.threshold)
+                except InputError as exc:
                     _failed(power.row, job, exc)
     return BatchResult(rows, time.process_time() - started)
 

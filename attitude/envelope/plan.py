@@ -21,7 +21,7 @@ from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
 from attitude.base.errors import InputError
-from attitude.envelope.failure import EnvelopeJob, metric_names, motion_after
+from attitude.envelope.failure import EnvelopeJob, evaluate_batch, metric_names, motion_after
 from attitude.envelope.settings import EnvelopeSettings, failure_times, read_envelope
 from attitude.files.scenario_reader import ScenarioFile
 from attitude.laws.align_constrain import LawState
@@ -37,7 +37,14 @@ from attitude.trajectory.modes import _gyrostat_step, uses_laws
 from attitude.trajectory.torqued import scenario_torque_models
 from attitude.trajectory.trajectory import propagate
 
-__all__ = ["EnvelopePlan", "check_envelope_table", "make_job", "nominal_scenario", "plan_envelope"]
+__all__ = [
+    "EnvelopePlan",
+    "check_envelope_table",
+    "failure_cost_s",
+    "make_job",
+    "nominal_scenario",
+    "plan_envelope",
+]
 
 # The columns before the metrics, and after them.
 LEADING = ("failure", "tau_s", "epoch_utc", "mode")
@@ -224,3 +231,14 @@ def make_job(plan: EnvelopePlan) -> tuple[EnvelopeJob, list[str], list[str]]:
     modes = [_mode(nominal.segments[i]) for i in index]
     epochs = [str(text) for text in np.atleast_1d(scenario.iso(seconds))]
     return job, epochs, modes
+
+
+def failure_cost_s(plan: EnvelopePlan, timed: int = 2) -> float:
+    """The CPU seconds of one failure, for ``attitude check``'s time estimate: the job
+    of ``timed`` of the plan's failure times (spread over them) made and computed in
+    this process, as the job times its first ones.  An upper bound of a long job's
+    cost a failure: the surroundings a worker computes once for its failures count
+    here whole."""
+    few = dataclasses.replace(plan, seconds=plan.seconds[:: max(1, plan.count // timed)][:timed])
+    job, _, _ = make_job(few)
+    return evaluate_batch(job, 0, job.count).compute_s / job.count

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-__all__ = ["scenario_text", "with_absolute_files"]
+__all__ = ["files_named", "scenario_text", "with_absolute_files"]
 
 
 def scenario_text(document: dict[str, Any], comments: Sequence[str] = ()) -> str:
@@ -43,3 +43,16 @@ def with_absolute_files(document: dict[str, Any], folder: Path) -> dict[str, Any
     if isinstance(document.get("events"), list):
         document["events"] = [resolved(event, "aem") for event in document["events"]]
     return document
+
+
+def files_named(document: dict[str, Any]) -> list[str]:
+    """The files ``document`` names (those :func:`with_absolute_files` makes absolute),
+    as written there."""
+    tables = [document.get("pointing"), document.get("initial_state")]
+    if isinstance(document.get("events"), list):
+        tables += document["events"]
+    found = []
+    for table in tables:
+        if isinstance(table, dict):
+            found += [table[k] for k in ("oem", "aem") if isinstance(table.get(k), str)]
+    return found

@@ -1,11 +1,8 @@
 """Monte Carlo dispersions on Dask: the dispersions and draws, a sample's metrics, the plan
-and tasks, the cluster, the job, its statistics and report.
+and tasks, the job (on Dask, through ``attitude.jobs``), its statistics and report.
 
 Modules:
 
-- ``cluster``: Where a Monte Carlo job runs: a ``distributed.Client`` to a local cluster
-  or to a scheduler, its workers checked (the same versions) and its cost per task
-  measured.
 - ``dispersions``: Dispersions: the ``[dispersions]`` table of a scenario file, and the
   samples drawn from it.
 - ``job``: A Monte Carlo job from start to end: :func:`run_montecarlo`, the Python entry

@@ -3,14 +3,16 @@
 (:class:`Job`), and a batch of samples evaluated on a worker (:func:`evaluate_batch`):
 for each, the sample's document is drawn (``attitude.montecarlo.dispersions.draw_sample``), read as
 a file is read (``scenario_from_document``), checked and propagated (``plan_run``), and
-reduced to its metrics (``attitude.montecarlo.metrics``).  A sample that fails is a row
-with its parameters and its error; the job goes on.
+reduced to its metrics (``attitude.montecarlo.metrics``).  A sample whose own input is
+refused is a row with its parameters and its error; the job goes on.
 """
 
 from __future__ import annotations
 
+import contextlib
 import time
 import warnings
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -26,6 +28,7 @@ from attitude.files.scenario_reader import (
     scenario_from_document,
 )
 from attitude.files.scenario_writer import with_absolute_files
+from attitude.jobs.failures import TaskError
 from attitude.montecarlo.dispersions import Dispersions, draw_sample, read_dispersions
 from attitude.montecarlo.metrics import (
     METRICS_ONLY,
@@ -47,6 +50,7 @@ __all__ = [
     "evaluate_batch",
     "failure_row",
     "plan_montecarlo",
+    "sample_cost_s",
 ]
 
 # The bytes the client holds per cell of the table (the DataFrame, the rows while
@@ -149,6 +153,23 @@ def _warn_of_inertia_under_laws(
     )
 
 
+def sample_cost_s(mc: MonteCarloPlan) -> float:
+    """The CPU seconds of one sample, for ``attitude check``'s time estimate: the
+    nominal planned and reduced as a worker does a sample, timed on a second run (the
+    first loads what a worker loads once: the ephemeris, compiled kernels) unless the
+    first took a second or more."""
+    loaded = mc.loaded
+
+    def once() -> float:
+        start = time.process_time()
+        plan = plan_run(loaded.scenario, loaded.pointing, METRICS_ONLY, horizon=False)
+        sample_metrics(plan)
+        return time.process_time() - start
+
+    first = once()
+    return first if first >= 1.0 else once()
+
+
 @dataclass(frozen=True)
 class Job:
     """What every task needs (scattered once to each worker): the nominal document, the
@@ -193,8 +214,14 @@ def evaluate_batch(job: Job, first: int, stop: int) -> BatchResult:
     """Samples ``first`` to ``stop - 1`` of ``job``: draw, read, check, propagate, reduce.
 
     Runs on a worker.  A sample whose draw, scenario or motion is refused (an
-    :class:`InputError`, or any other exception: it is reported, not raised) becomes
-    a failed row with its parameters and the error's one line.
+    :class:`InputError`: the sample's own input) becomes a failed row with its
+    parameters and the error's one line.  Any other exception is a bug, never a row:
+    it ends the task as a :class:`~attitude.jobs.failures.TaskError` naming the
+    sample (a memory error is the machine's: raised as it is).  The sample's plan is
+    not checked against the worker's free memory (``plan_run(free_memory=False)``):
+    the same seed gives the same table on any machine; the job checked the nominal's
+    memory before it started (:func:`plan_montecarlo`), and a worker that runs out
+    of it fails the job (:mod:`attitude.jobs.failures`).
     """
     start = time.perf_counter()
     rows: list[dict[str, Any]] = []
@@ -205,11 +232,13 @@ def evaluate_batch(job: Job, first: int, stop: int) -> BatchResult:
             rows.append(failure_row(index, sample.parameters, sample.error))
             continue
         try:
-            with warnings.catch_warnings(record=True) as caught:
+            with warnings.catch_warnings(record=True) as caught, _bugs_named(index):
                 warnings.simplefilter("always")
                 loaded = scenario_from_document(job.path, sample.document)
-                plan = plan_run(loaded.scenario, loaded.pointing, METRICS_ONLY, horizon=False)
-        except Exception as exc:  # a sample's failure is data: reported, not raised
+                plan = plan_run(
+                    loaded.scenario, loaded.pointing, METRICS_ONLY, horizon=False, free_memory=False
+                )
+        except InputError as exc:  # the sample's own input refused: data, reported
             rows.append(failure_row(index, sample.parameters, error_text(exc)))
             continue
         notes = " / ".join([str(w.message) for w in caught] + plan.notes)
@@ -218,10 +247,10 @@ def evaluate_batch(job: Job, first: int, stop: int) -> BatchResult:
     ran, extremes = [], []
     for index, parameters, plan, notes in built:
         try:
-            with warnings.catch_warnings(record=True) as caught:
+            with warnings.catch_warnings(record=True) as caught, _bugs_named(index):
                 warnings.simplefilter("always")
                 metrics, angles = sample_metrics(plan)
-        except Exception as exc:  # the same
+        except InputError as exc:  # the same
             rows.append(failure_row(index, parameters, error_text(exc)))
             continue
         notes = " / ".join(filter(None, [notes, *(str(w.message) for w in caught)]))
@@ -242,10 +271,22 @@ def evaluate_batch(job: Job, first: int, stop: int) -> BatchResult:
     return BatchResult(rows, ran, stacked, time.perf_counter() - start)
 
 
-def error_text(exc: BaseException) -> str:
-    if isinstance(exc, InputError):
-        return " / ".join(line.strip() for line in str(exc).splitlines() if line.strip())
-    return f"internal error: {type(exc).__name__}: {exc}"
+@contextlib.contextmanager
+def _bugs_named(index: int) -> Iterator[None]:
+    """An exception of the block that is neither a refusal (:class:`InputError`) nor
+    the machine's (a memory error) raised as a :class:`TaskError` naming sample
+    ``index``."""
+    try:
+        yield
+    except (InputError, MemoryError):
+        raise
+    except Exception as exc:
+        raise TaskError.of(exc, f"sample {index}") from exc
+
+
+def error_text(exc: InputError) -> str:
+    """A refusal's one line, for a failed sample's row."""
+    return " / ".join(line.strip() for line in str(exc).splitlines() if line.strip())
 
 
 def emit_samples(mc: MonteCarloPlan, indices: list[int], out_dir: str | Path) -> list[str]:

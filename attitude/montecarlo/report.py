@@ -18,6 +18,7 @@ failed or interrupted write is left):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from html import escape
 from pathlib import Path
 from typing import Any
@@ -25,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from attitude.base.version import __version__
-from attitude.montecarlo.metrics import ANGLE_STEP_DEG
+from attitude.montecarlo.metrics import ANGLE_STEP_DEG, TIME_BINS
 from attitude.montecarlo.plan import MonteCarloPlan
 from attitude.montecarlo.simulation import MonteCarloResult
 from attitude.montecarlo.statistics import (
@@ -34,7 +35,7 @@ from attitude.montecarlo.statistics import (
     PERCENTILES,
     describe,
 )
-from attitude.outputs.budget import check_table_fits
+from attitude.outputs.budget import JobFolderSize, check_table_fits, table_size_text
 from attitude.outputs.folder import claim
 from attitude.pointing.spec import interval_precision
 from attitude.report.page import (  # the page of attitude run, its look
@@ -48,6 +49,7 @@ __all__ = [
     "OUTPUT_NAMES",
     "check_folder",
     "drawn_spread",
+    "folder_size",
     "stated_precision",
     "statistics",
     "write_montecarlo_report",
@@ -66,12 +68,36 @@ _MAX_LISTED_FAILURES = 100
 _MAX_HISTOGRAMS = 16
 
 
+def folder_size(mc: MonteCarloPlan) -> JobFolderSize:
+    """What the folder takes beside the table's cells (measured on these writers:
+    tests/test_job_size_estimate_against_the_writers.py): a column's Parquet metadata
+    (800 bytes), statistics.json entry (1 kB) and line of the page (250 bytes); the
+    histograms (at most 200 kB), the Sun-angle envelopes (45 kB of figure a vector,
+    and 110 bytes a vector in each time bin's row of the CSV), the page's frame and
+    the manifest (25 kB); in the checkpoint, a sample's extremes (2 bytes for each
+    vector's two extremes in each time bin)."""
+    bins = min(TIME_BINS, mc.plan.scenario.output_count())
+    vectors = len(mc.vectors)
+    return JobFolderSize(
+        cell=30,
+        per_column=2_050,
+        fixed=200_000 + vectors * (45_000 + 110 * bins) + 20 * bins + 25_000,
+        checkpoint_cell=9,
+        checkpoint_row=4 * vectors * bins,
+    )
+
+
 def check_folder(mc: MonteCarloPlan, out_dir: str | Path) -> None:
     """Refuse, before anything runs, a folder that is not ours or a disk too small for
-    the table (CSV and Parquet) and the plots."""
+    the table (CSV and Parquet), the plots and the job's checkpoint."""
     claim(out_dir, OUTPUT_NAMES, dry_run=True)
     check_table_fits(
-        out_dir, mc.samples, len(mc.columns), "samples", ": run fewer samples or use another disk"
+        out_dir,
+        mc.samples,
+        len(mc.columns),
+        "samples",
+        folder_size(mc),
+        ": run fewer samples or use another disk",
     )
 
 
@@ -185,28 +211,34 @@ def _envelope_columns(result: MonteCarloResult) -> dict[str, np.ndarray]:
     return columns
 
 
-def write_montecarlo_report(result: MonteCarloResult, out_dir: str | Path) -> list[str]:
-    """Write the report of ``result`` into ``out_dir`` (see the module docstring)."""
+def write_montecarlo_report(
+    result: MonteCarloResult, out_dir: str | Path, stage: Callable[[str], None] | None = None
+) -> list[str]:
+    """Write the report of ``result`` into ``out_dir`` (see the module docstring);
+    ``stage(text)`` is told each step as it starts."""
     folder = claim(out_dir, OUTPUT_NAMES)
 
     def build(tmp: Path) -> list[str]:
-        return _build(result, tmp)
+        return _build(result, tmp, stage or (lambda text: None))
 
     return folder.write(build, result.plan.loaded.path.name, __version__)
 
 
-def _build(result: MonteCarloResult, tmp: Path) -> list[str]:
+def _build(result: MonteCarloResult, tmp: Path, stage: Callable[[str], None]) -> list[str]:
     import pandas
 
     mc, table = result.plan, result.table
+    stage(f"writing samples.parquet and samples.csv ({table_size_text(table)})")
     table.to_parquet(tmp / "samples.parquet", index=False)
     table.to_csv(tmp / "samples.csv", index=False)
     files = ["samples.parquet", "samples.csv"]
+    stage("the statistics of every metric and parameter (statistics.json)")
     stats = statistics(result)
     write_json(tmp / "statistics.json", stats)
     files.append("statistics.json")
     images = {}
     if mc.vectors and (table["status"] == "ok").any():
+        stage("drawing the Sun-angle envelopes")
         envelope = pandas.DataFrame(_envelope_columns(result))
         envelope.to_csv(tmp / "sun_angle_envelopes.csv", index_label="bin")
         files.append("sun_angle_envelopes.csv")
@@ -215,9 +247,11 @@ def _build(result: MonteCarloResult, tmp: Path) -> list[str]:
         )
     chosen = _histogram_columns(mc, table)
     if chosen:
+        stage(f"drawing the histograms of {len(chosen)} metrics")
         images["Distributions of the metrics"] = _plot_histograms(
             result, chosen, stats, tmp / "histograms.png"
         )
+    stage("writing report.html")
     (tmp / "report.html").write_text(_page(result, stats, images, files), encoding="utf-8")
     return [*files, *images.values(), "report.html"]
 

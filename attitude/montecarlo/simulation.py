@@ -10,7 +10,7 @@ A job, step by step:
    checked against the memory available.
 2. **The nominal run**, on the client: its metrics (reported beside the statistics) and
    its cost, which with Dask's measured cost per task sets the batch size
-   (:func:`choose_batch_size`).
+   (:func:`attitude.jobs.batches.choose_batch_size`).
 3. **Batches** on ``dask.distributed``: an embedded ``LocalCluster`` (processes, one
    thread each, every core by default) or the cluster at ``scheduler``.  A task
    evaluates a batch of consecutive samples (:func:`evaluate_batch`): for each, the
@@ -19,23 +19,28 @@ A job, step by step:
    reduced to its metrics, the numbers ``summary.json`` of ``attitude run`` reports
    (:func:`sample_metrics`), and to the extremes of each body vector's Sun angle in
    each of :data:`TIME_BINS` time bins, quantized to :data:`ANGLE_STEP_DEG` (a few kB
-   a sample instead of the whole series).  A sample that fails is a row with its
-   parameters and its error; the job goes on.
-4. **Results** stream back as tasks finish; the client adds the Sun-angle extremes
-   into per-bin histograms (:class:`Envelope`: fixed memory whatever the sample count,
-   the same counts in any order) and sorts the rows by sample.
+   a sample instead of the whole series).  A sample whose own input is refused is a
+   row with its parameters and its error; the job goes on.  Anything else (a bug, a
+   lost scheduler, workers that keep dying) ends the job: :mod:`attitude.jobs.failures`.
+   With one worker and no scheduler, the batches run in this process, no cluster.
+4. **Results** stream back as tasks finish, each kept in the job's checkpoint when it
+   has one (:mod:`attitude.jobs.checkpoint`: a job resumed from it gives the same
+   table, to the last bit); the client adds the Sun-angle extremes into per-bin
+   histograms (:class:`Envelope`: fixed memory whatever the sample count, the same
+   counts in any order) and sorts the rows by sample.
 
 Every sample draws from streams of its own (``attitude.montecarlo.dispersions``), so the table is
 the same whatever the number of workers and the batch size.  On a cluster, every
-worker needs the same version of ``attitude`` installed (checked before the job).
+worker needs this very code and the same numpy, scipy and numba (checked before the
+job: :func:`attitude.jobs.cluster.check_workers`).
 
 Ctrl-C stops the job: the local cluster is closed (its worker processes ignore the
-terminal's SIGINT, which the client handles) and nothing is written.
+terminal's SIGINT, which the client handles) and nothing is written but the
+checkpoint's finished batches.
 """
 
 from __future__ import annotations
 
-import math
 import pickle
 import time
 from collections.abc import Callable
@@ -45,17 +50,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from attitude.montecarlo.cluster import (
-    WORKER_MODULES,
-    batch_ranges,
-    batches_as_they_finish,
-    check_batch_size,
-    check_where,
-    check_workers,
-    connect,
-    task_overhead_s,
-)
-from attitude.montecarlo.dispersions import draw_sample
+from attitude.jobs.batches import check_batch_size, choose_batch_size, gather, split_ranges
+from attitude.jobs.checkpoint import Checkpoint, batch_table, canonical_rows, missing_ranges
+from attitude.jobs.cluster import WORKER_MODULES, check_where, workers_for
 from attitude.montecarlo.metrics import (
     ANGLE_STEP_DEG,
     ANGLE_STEPS,
@@ -63,27 +60,17 @@ from attitude.montecarlo.metrics import (
     sample_metrics,
     time_bin_edges,
 )
-from attitude.montecarlo.plan import (
-    BatchResult,
-    Job,
-    MonteCarloPlan,
-    error_text,
-    evaluate_batch,
-    failure_row,
-)
+from attitude.montecarlo.plan import BatchResult, Job, MonteCarloPlan, evaluate_batch
 from attitude.report.plan import plan_run
 
 if TYPE_CHECKING:
     import pandas
+    import pyarrow
 
-__all__ = ["Envelope", "MonteCarloResult", "choose_batch_size", "simulate"]
+__all__ = ["Envelope", "MonteCarloResult", "simulate"]
 
-# A task should last this many times the scheduler's cost per task (so that the
-# overhead is at most 1 %), and every worker should get at least this many tasks
-# (balance at the end of the job, and a progress bar that moves).
-_OVERHEAD_FACTOR = 100
-
-_TASKS_PER_WORKER = 4
+# What a worker imports before its first sample, beside the cluster's own list.
+_SAMPLE_MODULES = ("attitude.montecarlo.plan",)
 
 
 class Envelope:
@@ -135,14 +122,6 @@ class MonteCarloResult:
         return self.table[self.table["status"] != "ok"]
 
 
-def choose_batch_size(samples: int, workers: int, sample_s: float, task_overhead_s: float) -> int:
-    """Samples per task: enough that a task lasts _OVERHEAD_FACTOR times the scheduler's
-    cost per task, few enough that every worker gets _TASKS_PER_WORKER tasks."""
-    long_enough = math.ceil(_OVERHEAD_FACTOR * task_overhead_s / max(sample_s, 1e-9))
-    balanced = math.ceil(samples / (_TASKS_PER_WORKER * max(workers, 1)))
-    return max(1, min(long_enough, balanced))
-
-
 def _nominal(mc: MonteCarloPlan) -> tuple[dict[str, Any], float]:
     """The nominal scenario's metrics, and the cost of one sample (s), measured on a
     second run (the first one loads the ephemeris)."""
@@ -166,13 +145,15 @@ def simulate(
     progress: Callable[[int, int, int], None] | None = None,
     stage: Callable[[str], None] | None = None,
     probed: bool = False,
+    checkpoint: Checkpoint | None = None,
 ) -> MonteCarloResult:
     """Run the samples of ``mc`` on Dask (see the module docstring).
 
     ``progress(done, total, failed)`` is called as batches finish; ``stage(text)``
     says what is happening (the command line prints both to stderr); ``probed``: the
     caller has checked ``scheduler`` and ``workers`` already
-    (:func:`attitude.montecarlo.cluster.check_where`).
+    (:func:`attitude.jobs.cluster.check_where`); ``checkpoint``: where finished batches
+    are kept, and those already there are taken as they are (``--resume``).
     """
     import pandas
 
@@ -185,86 +166,126 @@ def simulate(
     nominal, sample_s = _nominal(mc)
     stage(f"nominal run: {sample_s:.3g} s a sample")
     job = Job.of(mc)
-    if scheduler is None:
-        stage(f"starting a local Dask cluster of {count} worker processes")
-    # scipy.stats draws the truncated laws: imported once for every worker, when used.
-    truncated = any(d.kind == "truncated_normal" for d in mc.dispersions.distributions())
-    preload = WORKER_MODULES + (("scipy.stats",) if truncated else ())
-    with connect(scheduler, workers, probed=True, preload=preload) as client:
-        threads = check_workers(client)
-        overhead = task_overhead_s(client)
-        size = batch_size or choose_batch_size(mc.samples, threads, sample_s, overhead)
-        batches = batch_ranges(mc.samples, size)
-        stage(
-            f"{mc.samples} samples on {threads} workers: {len(batches)} tasks of {size} "
-            f"(Dask: {1e3 * overhead:.2g} ms a task)"
-        )
-        gathered = _run_batches(client, mc, job, batches, progress)
-    wall = time.perf_counter() - started
+    gathered = _Gathered(mc, Envelope(mc.vectors, mc.plan.scenario.output_seconds()), checkpoint)
+    missing = gathered.resume(stage)
+    size = tasks = 0
+    described, threads, overhead = "the checkpoint (nothing left to compute)", 0, 0.0
+    if missing:
+        if scheduler is None and count > 1:
+            stage(f"starting a local Dask cluster of {count} worker processes")
+        # scipy.stats draws the truncated laws: imported once for every worker, when used.
+        truncated = any(d.kind == "truncated_normal" for d in mc.dispersions.distributions())
+        preload = WORKER_MODULES + _SAMPLE_MODULES + (("scipy.stats",) if truncated else ())
+        with workers_for(scheduler, workers, preload, probed=True) as where:
+            threads, overhead, described = where.threads, where.overhead_s, where.described
+            left = sum(b - a for a, b in missing)
+            size = batch_size or choose_batch_size(left, threads, sample_s, overhead)
+            batches = split_ranges(missing, size)
+            tasks = len(batches)
+            stage(
+                f"{left} samples on {threads} worker{'s' if threads > 1 else ''} "
+                f"({where.where}): {tasks} tasks of {size}"
+                + (f" (Dask: {1e3 * overhead:.2g} ms a task)" if where.client else "")
+            )
+            gather(
+                where,
+                evaluate_batch,
+                job,
+                batches,
+                mc.samples,
+                gathered.add_new,
+                progress,
+                "samples",
+                done=mc.samples - left,
+                failed=gathered.failed,
+            )
+    elif progress:
+        progress(mc.samples, mc.samples, gathered.failed)
     table = pandas.DataFrame(gathered.rows, columns=mc.columns)
     table = table.sort_values("sample", ignore_index=True)
     result_bytes = gathered.result_bytes
     execution = {
-        "scheduler": scheduler or f"local cluster ({threads} processes, one thread each)",
+        "scheduler": described,
         "workers": threads,
         "batch_size": size,
-        "tasks": len(batches),
+        "tasks": tasks,
+        "resumed_samples": gathered.resumed,
         "nominal_sample_s": sample_s,
         "task_overhead_s": overhead,
         "compute_s": gathered.compute_s,
-        "wall_s": wall,
+        "wall_s": time.perf_counter() - started,
         "job_bytes": len(pickle.dumps(job, protocol=5)),
         "result_bytes_per_task": float(np.mean(result_bytes)) if result_bytes else None,
     }
     return MonteCarloResult(mc, table, gathered.envelope, nominal, execution)
 
 
+# The checkpoint's column of each sample's Sun-angle extremes (bytes; null if it failed).
+_EXTREMES = "_sun_angle_extremes_uint16"
+
+
 @dataclass
 class _Gathered:
-    """The finished tasks' rows and envelope, summed as they come in, in any order."""
+    """The finished tasks' rows and envelope, summed as they come in, in any order, and
+    kept in the checkpoint (if any) as they come in."""
 
+    mc: MonteCarloPlan
     envelope: Envelope
+    checkpoint: Checkpoint | None
     rows: list[dict[str, Any]] = field(default_factory=list)
     failed: int = 0
+    resumed: int = 0
     compute_s: float = 0.0
     result_bytes: list[int] = field(default_factory=list)  # of the first 20 results
 
-    def add(self, result: BatchResult) -> None:
-        self.rows += result.rows
-        self.envelope.add(result.extremes)
-        self.compute_s += result.compute_s
-        self.failed += sum(row["status"] != "ok" for row in result.rows)
+    def add_new(self, first: int, stop: int, result: BatchResult) -> int:
+        """A batch just computed: kept, then added as it reads back."""
         if len(self.result_bytes) < 20:
             self.result_bytes.append(len(pickle.dumps(result, protocol=5)))
+        table = self._table(result)
+        if self.checkpoint is not None:
+            bins = result.extremes.shape[-1] if result.extremes.ndim == 4 else 0
+            self.checkpoint.add(table, {"compute_s": result.compute_s, "bins": bins})
+        return self._add(table, result.extremes, result.compute_s)
 
-    def add_dead_task(self, mc: MonteCarloPlan, first: int, stop: int, exc: Any) -> None:
-        """A task that died (a worker killed, say): its samples failed, each with the
-        parameters it drew (drawn again here: the draws are the sample's own)."""
-        error = f"the task of samples {first}-{stop - 1} failed: {error_text(exc)}"
-        for index in range(first, stop):
-            sample = draw_sample(mc.dispersions, mc.loaded.document, index)
-            self.rows.append(failure_row(index, sample.parameters, error))
-        self.failed += stop - first
+    def resume(self, stage: Callable[[str], None]) -> list[tuple[int, int]]:
+        """Add the checkpoint's batches; the ranges of samples still to compute."""
+        if self.checkpoint is None:
+            return [(0, self.mc.samples)]
+        done: list[int] = []
+        for table, meta in self.checkpoint.parts():
+            self._add(table, self._extremes(table, int(meta.get("bins", 0))), meta["compute_s"])
+            done += table.column("sample").to_pylist()
+        self.resumed = len(done)
+        if self.resumed:
+            kept = self.checkpoint.shown
+            stage(f"resumed: {self.resumed} of {self.mc.samples} samples from {kept}")
+        return missing_ranges(self.mc.samples, done)
 
+    def _table(self, result: BatchResult) -> pyarrow.Table:
+        """A batch as the checkpoint keeps it: its rows, and each sample's extremes."""
+        import pandas
 
-def _run_batches(
-    client,
-    mc: MonteCarloPlan,
-    job: Job,
-    batches: list[tuple[int, int]],
-    progress: Callable[[int, int, int], None] | None,
-) -> _Gathered:
-    """Gather the tasks as they finish (:func:`batches_as_they_finish`)."""
-    gathered = _Gathered(Envelope(mc.vectors, mc.plan.scenario.output_seconds()))
-    done = 0
-    if progress:
-        progress(0, mc.samples, 0)
-    for first, stop, result in batches_as_they_finish(client, evaluate_batch, job, batches):
-        if isinstance(result, BatchResult):
-            gathered.add(result)
-        else:
-            gathered.add_dead_task(mc, first, stop, result)
-        done += stop - first
-        if progress:
-            progress(done, mc.samples, gathered.failed)
-    return gathered
+        frame = pandas.DataFrame(result.rows, columns=self.mc.columns)
+        blobs: dict[int, bytes] = {
+            index: np.ascontiguousarray(extremes).tobytes()
+            for index, extremes in zip(result.ran, result.extremes, strict=True)
+        }
+        frame[_EXTREMES] = [blobs.get(int(index)) for index in frame["sample"]]
+        return batch_table(frame)
+
+    def _extremes(self, table: pyarrow.Table, bins: int) -> NDArray[np.uint16]:
+        blobs = [blob for blob in table.column(_EXTREMES).to_pylist() if blob is not None]
+        shape = (len(blobs), len(self.mc.vectors), 2, bins)
+        if not blobs:
+            return np.empty(shape, np.uint16)
+        return np.frombuffer(b"".join(blobs), np.uint16).reshape(shape)
+
+    def _add(self, table: pyarrow.Table, extremes: NDArray[np.uint16], compute_s: float) -> int:
+        rows = canonical_rows(table.drop_columns([_EXTREMES]))
+        self.rows += rows
+        self.envelope.add(extremes)
+        self.compute_s += compute_s
+        failed = sum(row["status"] != "ok" for row in rows)
+        self.failed += failed
+        return failed

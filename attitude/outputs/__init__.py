@@ -16,6 +16,8 @@ Modules:
   itself.
 - ``formats``: Which outputs a run writes: the formats the user chooses, and the files
   each one is.
+- ``lock``: One run at a time in an output folder: a lock the tool owns, taken before
+  anything is computed (``attitude run``, ``montecarlo``, ``envelope``).
 - ``parquet``: ``timeseries.parquet``: the time series in Apache Parquet, a row group
   per chunk.
 """

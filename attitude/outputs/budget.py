@@ -32,14 +32,17 @@ from pathlib import Path
 from attitude.base.errors import InputError
 
 __all__ = [
+    "JobFolderSize",
     "OutputBudget",
     "ResourceError",
+    "about_text",
     "available_memory_bytes",
     "check_fits",
     "check_table_fits",
     "estimate",
     "free_disk_bytes",
     "size_text",
+    "table_size_text",
 ]
 
 # Memory of a run: the libraries and the pointing's nodes, plus one chunk of samples
@@ -174,30 +177,93 @@ def free_disk_bytes(out_dir: str | Path) -> int:
     return shutil.disk_usage(_existing(Path(out_dir))).free
 
 
-# A job's table (Monte Carlo samples, envelope failures): a cell's bytes in the CSV
-# and the Parquet file, and the plots, the page and the summary beside them.
-_TABLE_CSV_BYTES_PER_CELL = 24
-_TABLE_PARQUET_BYTES_PER_CELL = 8
-_TABLE_FIXED_BYTES = 5_000_000
+# A job's folder (a Monte Carlo job's samples, an envelope's failures), measured on
+# the writers (tests/test_job_size_estimate_against_the_writers.py holds the estimate
+# to between 1 and 2 times what they write; 1.09 to 1.42 measured, 3 to 1000 rows).
+# A cell of the table is 11 to 19 bytes of CSV (the envelope's many "inf", the Monte
+# Carlo's 17 digits) and up to 8 of Parquet (full-entropy floats): each job says its
+# own (JobFolderSize.cell); each column costs its Parquet metadata and its entries in
+# the job's JSON and page (.per_column), the figures a fixed size (.fixed).  While
+# the job runs its checkpoint holds the table too (attitude.jobs.checkpoint): a few
+# bytes a cell (.checkpoint_cell), its own columns (.checkpoint_row), and a part's
+# metadata (290 bytes a column) for each of at most about a hundred parts; it is
+# removed once the outputs are written, and both are counted, at their peak.
+_CHECKPOINT_PART_COLUMN_BYTES = 290
+_CHECKPOINT_PARTS = 100
+
+
+@dataclass(frozen=True)
+class JobFolderSize:
+    """What a job's folder takes (bytes): a cell of its table in the outputs
+    (``cell``: CSV and Parquet) and in the checkpoint (``checkpoint_cell``); each
+    column (``per_column``: its Parquet metadata, its statistics, its line of the
+    page); the figures and the rest (``fixed``), and what a figure of a point a row
+    grows by (``figure_per_row``, up to ``figure_growth_at_most``: its lines fill the
+    image, which compresses less until it is filled); and each row of the checkpoint
+    beyond its cells (``checkpoint_row``: the Monte Carlo's Sun-angle extremes)."""
+
+    cell: int
+    per_column: int
+    fixed: int
+    checkpoint_cell: int
+    checkpoint_row: int = 0
+    figure_per_row: int = 0
+    figure_growth_at_most: int = 0
+
+    def outputs_bytes(self, rows: int, columns: int) -> int:
+        figure = min(rows * self.figure_per_row, self.figure_growth_at_most)
+        return rows * columns * self.cell + columns * self.per_column + self.fixed + figure
+
+    def checkpoint_bytes(self, rows: int, columns: int) -> int:
+        cells = rows * (columns * self.checkpoint_cell + self.checkpoint_row)
+        parts = min(rows, _CHECKPOINT_PARTS) * columns * _CHECKPOINT_PART_COLUMN_BYTES
+        return cells + parts
 
 
 def check_table_fits(
-    out_dir: str | Path, rows: int, columns: int, noun: str, advice: str = ""
+    out_dir: str | Path,
+    rows: int,
+    columns: int,
+    noun: str,
+    size: JobFolderSize,
+    advice: str = "",
 ) -> None:
-    """Refuse (:class:`ResourceError`, key ``--out``) a job's table of ``rows``
-    ``noun`` (CSV and Parquet) with its plots and page that would take more than
+    """Refuse (:class:`ResourceError`, key ``--out``) a job of ``rows`` ``noun`` in
+    ``columns`` whose outputs and checkpoint (``size``) would take more than
     :data:`DISK_SHARE` of the free space of the disk that holds ``out_dir``;
     ``advice`` ends the message."""
-    cell = _TABLE_CSV_BYTES_PER_CELL + _TABLE_PARQUET_BYTES_PER_CELL
-    need = rows * columns * cell + _TABLE_FIXED_BYTES
+    outputs = size.outputs_bytes(rows, columns)
+    need = outputs + size.checkpoint_bytes(rows, columns)
     free = free_disk_bytes(out_dir)
     if need > DISK_SHARE * free:
         raise ResourceError(
-            f"{out_dir}: the table of {rows:,} {noun} would take about "
-            f"{need / 1e9:.3g} GB, and its disk has {free / 1e9:.3g} GB free{advice}",
+            f"{out_dir}: the job's {rows:,} {noun} would take about {_size(need)} (the "
+            f"outputs {_size(outputs)}, and its checkpoint while it runs), and its disk "
+            f"has {_size(free)} free{advice}",
             key="--out",
             value=str(out_dir),
         )
+
+
+# The CPU seconds a job's table takes to write as CSV and Parquet, a cell (pandas and
+# pyarrow; 3.7 s for 200 000 rows of 21 columns on the development machine, idle).
+_TABLE_WRITE_S_PER_CELL = 0.9e-6
+
+
+def table_size_text(table) -> str:
+    """A table's size as a stage line says it: "1,234 rows of 40 columns", and the
+    time its writing takes when that is more than a few seconds."""
+    rows, columns = table.shape
+    return (
+        f"{rows:,} rows of {columns} columns{about_text(rows * columns * _TABLE_WRITE_S_PER_CELL)}"
+    )
+
+
+def about_text(seconds: float) -> str:
+    """ ", about 12 s" for a stage that takes a while (nothing under 3 s)."""
+    if seconds < 3.0:
+        return ""
+    return f", about {seconds:.0f} s" if seconds < 120 else f", about {seconds / 60:.0f} min"
 
 
 def size_text(count: float) -> str:

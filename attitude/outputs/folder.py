@@ -14,6 +14,15 @@ The rules, checked before anything is computed:
   would write.  Nothing is ever deleted to make room, so no flag is offered to force
   it: the remedy is always to choose a new or empty folder.
 
+Two more entries of a folder are the tool's own, and never make it foreign: the
+lock of the run writing into it (``.attitude-lock``, :mod:`attitude.outputs.lock`)
+and a long job's checkpoint (``.attitude-checkpoint/``: ``checkpoint.json`` and the
+finished batches, ``part-NNNNNN.parquet``; :mod:`attitude.jobs.checkpoint`), a folder
+holding nothing else.  Before anything is computed, :func:`claim` also tries
+the folder: a file created and removed there (or, for a folder still to be made, the
+folder itself), so that a read-only or unwritable folder is refused at the start, not
+found after the whole computation.
+
 The outputs are built in ``.attitude-partial-PID/`` *inside* the output folder (the
 same file system, so each file moves into place with an atomic ``os.replace``), and
 then moved in under a manifest that accepts either version of every file, so that a
@@ -21,7 +30,9 @@ run stopped at any instant, even by ``kill -9``, leaves a folder that the next r
 recognizes and cleans.  On any failure or signal (SIGINT, SIGTERM), the partial
 folder is removed, and so are a manifest and folders this run created: nothing is
 left beside the user's files.  SIGINT and SIGTERM are held while the files move into
-place and while cleaning up, and delivered right after.
+place and while cleaning up, and delivered right after.  A write that fails (a full
+disk) is a :class:`~attitude.base.errors.MachineError` naming the folder as the user
+wrote it, raised once nothing of the run is left in it.
 """
 
 from __future__ import annotations
@@ -38,12 +49,30 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from attitude.base.errors import OptionError
+from attitude.base.errors import MachineError, OptionError
 from attitude.base.signals import STOPPING
 
-__all__ = ["MANIFEST_NAME", "OutputFolder", "OutputFolderError", "claim", "held_signals"]
+__all__ = [
+    "CHECKPOINT_FILES",
+    "CHECKPOINT_NAME",
+    "LOCK_NAME",
+    "MANIFEST_NAME",
+    "OutputFolder",
+    "OutputFolderError",
+    "OutputWriteError",
+    "claim",
+    "held_signals",
+    "is_checkpoint",
+]
 
 MANIFEST_NAME = "attitude-manifest.json"
+LOCK_NAME = ".attitude-lock"
+CHECKPOINT_NAME = ".attitude-checkpoint"
+# The files of a checkpoint folder: its record, the parts of finished batches, and
+# one being written (renamed into place once whole).
+CHECKPOINT_FILES = re.compile(
+    r"checkpoint\.json|part-\d{6}\.parquet|\.tmp-\d+-(part\.parquet|checkpoint\.json)"
+)
 _FORMAT = "attitude output manifest"
 _FORMAT_VERSION = 1
 _PARTIAL_PREFIX = ".attitude-partial-"
@@ -52,10 +81,53 @@ _HELD = STOPPING
 
 
 class OutputFolderError(OptionError):
-    """The output folder cannot be used without touching files that are not ours.
+    """The output folder cannot be used without touching files that are not ours, or
+    cannot be written at all.
 
     ``key`` is the command-line option that named the folder (``--out``,
     ``--emit-scenario``) and ``value`` the folder as given: ``--out results: reason``."""
+
+
+class OutputWriteError(MachineError, OSError):
+    """The outputs could not be written (a full disk, a folder that became unwritable);
+    nothing of the run is left in the folder, named as the user wrote it.  Also an
+    ``OSError``, as the write's own error was: code that catches that still does."""
+
+
+def is_checkpoint(path: Path) -> bool:
+    """Whether ``path`` is a checkpoint folder of ours: a folder (not a link) holding
+    only the files of a checkpoint (:data:`CHECKPOINT_FILES`)."""
+    if path.is_symlink() or not path.is_dir():
+        return False
+    try:
+        names = os.listdir(path)
+    except OSError:
+        return False
+    return all(CHECKPOINT_FILES.fullmatch(name) for name in names)
+
+
+def _ours(folder: Path, name: str) -> bool:
+    """Whether the entry ``name`` of ``folder`` is one of the tool's own that no
+    manifest lists: a run's lock, a job's checkpoint."""
+    path = folder / name
+    if name == LOCK_NAME:
+        return path.is_file() and not path.is_symlink()
+    return name == CHECKPOINT_NAME and is_checkpoint(path)
+
+
+def _unwritable(folder: Path) -> str | None:
+    """Why the existing ``folder`` cannot take a new file (None if it can), in the
+    words of the system: a file is created there and removed.  ``os.access`` alone
+    would not do: it says nothing of a read-only file system's reason, and root
+    writes into a folder whatever its mode (then the folder is writable)."""
+    probe = folder / f".attitude-probe-{os.getpid()}-{threading.get_ident()}"
+    try:
+        descriptor = os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+    except OSError as exc:
+        return exc.strerror or str(exc)
+    os.close(descriptor)
+    probe.unlink(missing_ok=True)
+    return None
 
 
 @contextlib.contextmanager
@@ -154,6 +226,8 @@ class OutputFolder:
     owned: dict[str, dict[str, Any]]  # our files already there: name -> manifest entry
     stat: dict[str, tuple[int, int]]  # their (size, mtime_ns) when checked
     new_manifest: bool  # no manifest before this run
+    shown: str = ""  # the folder as the user wrote it, for messages
+    option: str = "--out"
 
     def write(
         self, build: Callable[[Path], list[str]], source: str = "", version: str = ""
@@ -162,8 +236,19 @@ class OutputFolder:
         then move them into the folder in place of our previous outputs.
 
         On any exception (signals included) nothing of this run is left behind and
-        the previous outputs are untouched.
+        the previous outputs are untouched; a write that fails (``OSError``: a full
+        disk) is raised as :class:`OutputWriteError`, naming the folder as given.
         """
+        try:
+            return self._write(build, source, version)
+        except OSError as exc:
+            what = exc.strerror or " ".join(str(exc).split())
+            raise OutputWriteError(
+                f"{self.option} {self.shown or self.path}: the outputs could not be written "
+                f"({what}); nothing of this run was left in the folder"
+            ) from exc
+
+    def _write(self, build: Callable[[Path], list[str]], source: str, version: str) -> list[str]:
         partial = self.path / f"{_PARTIAL_PREFIX}{os.getpid()}"
         moving = False
         try:
@@ -259,9 +344,10 @@ def claim(
     """Check that ``out_dir`` can take a run's outputs without touching the user's files.
 
     ``names``: every file name the run may write.  Creates the folder if it does not
-    exist (unless ``dry_run``: then nothing is created or cleaned, only checked).
-    Raises :class:`OutputFolderError` (one line, naming ``option``, the path and the
-    reason) if the folder is not ours, and ``OSError`` if it cannot be created.
+    exist (unless ``dry_run``: then nothing is cleaned, and a folder made to try it is
+    removed), and tries it (module notes).  Raises :class:`OutputFolderError` (one
+    line, naming ``option``, the folder as given and the reason) if the folder is not
+    ours, or cannot be created or written.
     """
     names = frozenset(names) | {MANIFEST_NAME}
     path = Path(out_dir).expanduser()
@@ -276,34 +362,48 @@ def claim(
         raise refused("is a file, not a folder; attitude leaves it alone")
     path = path.resolve()
     created: list[Path] = []
-    if not path.exists() and dry_run:
-        return OutputFolder(path, names, created, {}, {}, new_manifest=True)
+
+    def folder(
+        created: list[Path], owned: dict | None = None, stat: dict | None = None, new=True
+    ) -> OutputFolder:
+        return OutputFolder(path, names, created, owned or {}, stat or {}, new, shown, option)
+
     if not path.exists():
         missing = [path, *[p for p in path.parents if not p.exists()]]
-        for folder in reversed(missing):
+        for made in reversed(missing):
             try:
-                folder.mkdir()
+                made.mkdir()
             except FileExistsError:
                 continue
-            except OSError:
-                for made in reversed(created):
-                    with contextlib.suppress(OSError):
-                        made.rmdir()
-                raise
-            created.append(folder)
-        return OutputFolder(path, names, created, {}, {}, new_manifest=True)
+            except OSError as exc:
+                _remove_folders(created)
+                raise refused(f"cannot create the folder: {exc.strerror or exc}") from None
+            created.append(made)
+        why = _unwritable(path)
+        if why is not None or dry_run:  # a dry run: the folder made and removed, a probe
+            _remove_folders(created)
+            created = []
+        if why is not None:
+            raise refused(f"cannot be written: {why}")
+        return folder(created)
 
+    try:
+        entries = sorted(name for name in os.listdir(path) if not _ours(path, name))
+    except OSError as exc:
+        raise refused(f"cannot be read: {exc.strerror or exc}") from None
     manifest = _read_manifest(path, names)
-    entries = sorted(os.listdir(path))
+    if manifest is None and entries:
+        listed = ", ".join(entries[:3]) + (", ..." if len(entries) > 3 else "")
+        raise refused(
+            "the folder holds files that attitude did not write "
+            f"({listed}); attitude writes only into a new or empty folder, or one it "
+            f"wrote before (with {MANIFEST_NAME}): choose another folder"
+        )
+    why = _unwritable(path)  # tried once it is known to be ours (or empty)
+    if why is not None:
+        raise refused(f"cannot be written: {why}")
     if manifest is None:
-        if entries:
-            listed = ", ".join(entries[:3]) + (", ..." if len(entries) > 3 else "")
-            raise refused(
-                "the folder holds files that attitude did not write "
-                f"({listed}); attitude writes only into a new or empty folder, or one it "
-                f"wrote before (with {MANIFEST_NAME}): choose another folder"
-            )
-        return OutputFolder(path, names, created, {}, {}, new_manifest=True)
+        return folder(created)
 
     # Our folder: clean the partial folders of runs that were killed, check our files.
     for entry in entries:
@@ -329,4 +429,10 @@ def claim(
         owned[name] = {"bytes": digest[0], "sha256": digest[1]}
         status = file.lstat()
         stat[name] = (status.st_size, status.st_mtime_ns)
-    return OutputFolder(path, names, created, owned, stat, new_manifest=False)
+    return folder(created, owned, stat, new=False)
+
+
+def _remove_folders(created: list[Path]) -> None:
+    for made in reversed(created):
+        with contextlib.suppress(OSError):
+            made.rmdir()  # only if empty

@@ -102,6 +102,16 @@ class Beside(Generic[T]):
         done._value = (True, value)
         return done
 
+    def ready(self, timeout_s: float) -> bool:
+        """Whether the result is there, waiting at most ``timeout_s`` for it (True
+        where there is no child: :meth:`result` computes it then)."""
+        if self._value is not None or self._read is None:
+            return True
+        import select
+
+        readable, _, _ = select.select([self._read], [], [], max(timeout_s, 0.0))
+        return bool(readable)
+
     def result(self) -> T:
         """The function's value (or its exception, raised here)."""
         if self._value is None:

@@ -57,6 +57,7 @@ from attitude.outputs.csv import (
 )
 from attitude.outputs.folder import claim
 from attitude.outputs.formats import OUTPUT_NAMES, OutputChoice
+from attitude.outputs.lock import folder_lock
 from attitude.outputs.parquet import ParquetWriter
 from attitude.pointing.sampling import PointingSamples, pointing_samples
 from attitude.pointing.search import PointingAnalysis, pointing_analysis
@@ -135,6 +136,7 @@ def write_report(
     outputs: OutputChoice | None = None,
     chunk_samples: int = CHUNK_SAMPLES,
     horizon: Beside[ValidityHorizon] | None = None,
+    lock: bool = True,
 ) -> dict[str, Any]:
     """Propagate ``scenario`` and write its report into ``out_dir``; returns the summary.
 
@@ -145,22 +147,27 @@ def write_report(
     output epochs evaluated and written at a time; ``horizon``: the plan's deferred
     validity horizon already started beside (:func:`attitude.report.plan.horizon_beside`;
     started here otherwise, and closed either way by its owner).  Raises :class:`InputError` (the
-    scenario, or an output folder that holds files this tool did not write) before
-    anything is computed or written, and ``OSError`` if the files cannot be written.
+    scenario, or an output folder that holds files this tool did not write, or that
+    cannot be written, or that another run holds) before anything is computed or
+    written, and :class:`~attitude.outputs.folder.OutputWriteError` if the files cannot
+    be written (a full disk).  ``lock``: hold the folder's lock for the run
+    (:mod:`attitude.outputs.lock`; False: the caller holds it).
     """
     progress = progress or Progress()
     pointing = pointing or PointingSpec()
     if plan is None:
         plan = plan_run(scenario, pointing, outputs, horizon=False)
     check_fits(plan.budget, out_dir)
-    folder = claim(out_dir, OUTPUT_NAMES)
-    written: dict[str, Any] = {}
+    claim(out_dir, OUTPUT_NAMES, dry_run=True)  # a folder not ours: refused before the lock
+    with folder_lock(out_dir, "run") if lock else contextlib.nullcontext():
+        folder = claim(out_dir, OUTPUT_NAMES)
+        written: dict[str, Any] = {}
 
-    def build(tmp: Path) -> list[str]:
-        written["summary"], files = _build(plan, tmp, source, progress, chunk_samples, horizon)
-        return files
+        def build(tmp: Path) -> list[str]:
+            written["summary"], files = _build(plan, tmp, source, progress, chunk_samples, horizon)
+            return files
 
-    folder.write(build, source, __version__)
+        folder.write(build, source, __version__)
     last = "report.html" if "report" in plan.outputs else "summary.json"
     progress(f"done: {folder.path / last}")
     return written["summary"]

@@ -1,5 +1,6 @@
-"""Where a Monte Carlo job runs: a ``distributed.Client`` to a local cluster or to a
-scheduler, its workers checked (the same versions) and its cost per task measured.
+"""Where a long job runs (a Monte Carlo job, an envelope): a ``distributed.Client`` to a
+local cluster or to a scheduler, its workers checked (the same versions) and its cost
+per task measured.
 
 Ctrl-C stops the job: the local cluster is closed (its worker processes never see the
 terminal's SIGINT, which the client handles), also when it comes while the cluster
@@ -18,25 +19,25 @@ import socket
 import tempfile
 import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
+from dataclasses import dataclass
 from typing import Any
-
-import numpy as np
 
 from attitude.base.errors import InputError, OptionError
 from attitude.base.signals import STOPPING
-from attitude.base.version import __version__
+from attitude.jobs.failures import cluster_failure
+from attitude.jobs.fingerprint import differences, what_runs
 from attitude.outputs.folder import held_signals
 
 __all__ = [
-    "batch_ranges",
-    "batches_as_they_finish",
-    "check_batch_size",
+    "WORKER_MODULES",
+    "Workers",
     "check_where",
     "check_workers",
     "connect",
     "probe_scheduler",
     "task_overhead_s",
+    "workers_for",
 ]
 
 _CONNECT_TIMEOUT_S = 10
@@ -48,14 +49,18 @@ _FIRST_WORDS_S = 2.0
 
 _OVERHEAD_PROBES = 40
 
-# What a worker imports before its first sample: with a fork server (below), once for
-# every worker.
+# The cost of a task in this process, without a cluster: its batch kept in the job's
+# checkpoint (a Parquet file of a few tens of kB: 5 to 10 ms measured here), so that
+# batches are not single items, each a file.
+_IN_PROCESS_TASK_S = 0.01
+
+# What a worker imports before its first task: with a fork server (below), once for
+# every worker.  A job adds the modules of its own tasks (``connect(preload=...)``).
 WORKER_MODULES = (
     "distributed",
     "numpy",
     "astropy.time",
     "astropy.utils.iers",
-    "attitude.montecarlo.plan",
     "attitude.pointing.search",
 )
 
@@ -64,13 +69,12 @@ def _noop(index: int) -> int:
     return index
 
 
-def _worker_versions() -> tuple[str, str, str]:
-    """(attitude, numpy, scipy) on a worker; importing the sample's modules warms it up."""
-    import scipy
-
+def _what_worker_runs() -> dict[str, str]:
+    """:func:`attitude.jobs.fingerprint.what_runs` on a worker; importing the tasks'
+    modules warms it up."""
     import attitude.pointing.search  # noqa: F401 (loaded here, not in the first task)
 
-    return __version__, np.__version__, scipy.__version__
+    return what_runs()
 
 
 @contextlib.contextmanager
@@ -255,6 +259,87 @@ def _read_some(connection: socket.socket, timeout_s: float, enough: int = 256) -
     return data
 
 
+@dataclass(frozen=True)
+class Workers:
+    """Where a job's tasks run: the cluster of a Dask ``client``, or this very process
+    (``client`` None: one worker, no cluster); its thread count, Dask's cost per task,
+    how the job's record describes it, and how its failures name it."""
+
+    client: Any | None
+    threads: int
+    overhead_s: float
+    described: str
+    where: str
+
+
+@contextlib.contextmanager
+def workers_for(
+    scheduler: str | None,
+    workers: int | None,
+    preload: tuple[str, ...] = WORKER_MODULES,
+    probed: bool = False,
+) -> Iterator[Workers]:
+    """The workers of a job (:class:`Workers`), checked (:func:`check_workers`) and
+    timed (:func:`task_overhead_s`): one worker without a scheduler is this process
+    (no cluster to start, nothing to pickle, and a script without an ``if __name__ ==
+    "__main__":`` guard works: a local cluster's new processes import the script
+    again); otherwise :func:`connect`.  On a cluster, Dask's own log lines are held
+    back (a lost scheduler is the job's one line, not two tracebacks) and a failure of
+    the cluster or the machine met by the client is a
+    :class:`~attitude.jobs.failures.JobFailed` naming it."""
+    count = check_where(scheduler, workers, probe=not probed)
+    if scheduler is None and count == 1:
+        described = "this process (one worker, no cluster)"
+        yield Workers(None, 1, _IN_PROCESS_TASK_S, described, "this process")
+        return
+    where = f"--scheduler {scheduler}" if scheduler is not None else "the local Dask cluster"
+    with (
+        _quiet_dask_logs(),
+        _failures_named(where),
+        connect(scheduler, workers, probed=True, preload=preload) as client,
+    ):
+        threads = check_workers(client)
+        overhead = task_overhead_s(client)
+        described = scheduler or f"local cluster ({threads} processes, one thread each)"
+        yield Workers(client, threads, overhead, described, where)
+
+
+@contextlib.contextmanager
+def _quiet_dask_logs() -> Iterator[None]:
+    """Dask's loggers in this process silent for the block (restored after): each
+    one, since Dask's configuration gives some their own level ("Couldn't gather 1
+    keys, rescheduling" is ``distributed.client``'s warning)."""
+    import logging
+
+    names = ("distributed", "tornado", "asyncio")
+    loggers = [logging.getLogger(name) for name in names] + [
+        logger
+        for name, logger in list(logging.root.manager.loggerDict.items())
+        if name.startswith(tuple(f"{n}." for n in names)) and isinstance(logger, logging.Logger)
+    ]
+    levels = [logger.level for logger in loggers]
+    for logger in loggers:
+        logger.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        for logger, level in zip(loggers, levels, strict=True):
+            logger.setLevel(level)
+
+
+@contextlib.contextmanager
+def _failures_named(where: str) -> Iterator[None]:
+    """A failure of the cluster or the machine in the block (the client's calls: a
+    connection lost, a timeout) raised as :class:`JobFailed` naming ``where``."""
+    try:
+        yield
+    except Exception as exc:
+        failed = cluster_failure(exc, where)
+        if failed is None:
+            raise
+        raise failed from None
+
+
 @contextlib.contextmanager
 def connect(
     scheduler: str | None = None,
@@ -358,58 +443,23 @@ def task_overhead_s(client) -> float:
 
 
 def check_workers(client) -> int:
-    """The workers' thread count, after checking that they run this very code."""
-    here = _worker_versions()
+    """The workers' thread count, after checking that they run this very code: the
+    same digest of the package's files and the same numpy, scipy and numba
+    (:mod:`attitude.jobs.fingerprint`), else one line naming what differs."""
+    here = what_runs()
     try:
-        versions = client.run(_worker_versions)
+        answers = client.run(_what_worker_runs)
     except Exception as exc:  # a worker without attitude, say
         text = " ".join(f"{type(exc).__name__}: {exc}".split())
         raise InputError(f"the workers cannot run attitude ({text})", key="--scheduler") from None
-    if not versions:
+    if not answers:
         raise InputError("the cluster has no workers", key="--scheduler")
-    for address, theirs in versions.items():
-        if tuple(theirs) != here:
+    for address, theirs in sorted(answers.items()):
+        differ = differences(theirs if isinstance(theirs, dict) else {}, here)
+        if differ:
             raise InputError(
-                f"worker {address} runs attitude {theirs[0]} with numpy "
-                f"{theirs[1]} and scipy {theirs[2]}; this is attitude {here[0]} with numpy "
-                f"{here[1]} and scipy {here[2]}: install the same versions on every worker",
+                f"worker {address} runs {'; '.join(differ)}: install this very code and "
+                "these versions on every worker",
                 key="--scheduler",
             )
     return sum(w["nthreads"] for w in client.scheduler_info()["workers"].values())
-
-
-def check_batch_size(batch_size: int | None, count: int) -> None:
-    """A ``--batch-size`` given for a job of ``count`` items: 1 to ``count``."""
-    if batch_size is not None and not 1 <= batch_size <= count:
-        raise InputError(
-            f"expected 1 to {count}, got {batch_size}", key="--batch-size", value=batch_size
-        )
-
-
-def batch_ranges(count: int, size: int) -> list[tuple[int, int]]:
-    """[first, stop) of each task's items, ``size`` at a time over ``count``."""
-    return [(first, min(first + size, count)) for first in range(0, count, size)]
-
-
-def batches_as_they_finish(
-    client, evaluate: Callable[..., Any], job: Any, batches: list[tuple[int, int]]
-) -> Iterator[tuple[int, int, Any]]:
-    """Send ``job`` once to every worker, one task ``evaluate(job, first, stop)`` per
-    batch, and yield ``(first, stop, result)`` as the tasks finish, each released once
-    read; ``result`` is the task's value, or the exception of a task that died (a
-    worker killed, say)."""
-    from distributed import as_completed
-
-    shared = client.scatter(job, broadcast=True, hash=False)
-    futures = client.map(
-        evaluate,
-        [shared] * len(batches),
-        [a for a, _ in batches],
-        [b for _, b in batches],
-        pure=False,
-    )
-    span = {future.key: batch for future, batch in zip(futures, batches, strict=True)}
-    for future, result in as_completed(futures, client.loop, with_results=True, raise_errors=False):
-        first, stop = span[future.key]
-        yield first, stop, result
-        future.release()
