@@ -97,6 +97,9 @@ _CASES = {
         (np.full(_X.size, 0.5), np.full(_X.size, 0.5), "C2"),
     ],
     "noisy": [(-1.0 + 0.3 * _NOISE[0], 1.0 - 0.3 * _NOISE[1], "C1")],
+    "with a gap (NaN)": [
+        (np.where(np.abs(_X - 50.0) < 10.0, np.nan, np.sin(_X) - 0.5), np.sin(_X) + 0.5, "C0")
+    ],
 }
 
 
@@ -121,10 +124,12 @@ def test_the_bands_are_the_picture_of_fill_between_and_plot(case):
     painted = np.any(ours < 255, axis=2)  # rows from the top
     height = painted.shape[0]
     for low, high, _ in series:
-        x, y_low = axes.transData.transform(np.column_stack([_X, low])).T
+        x = axes.transData.transform(np.column_stack([_X, np.zeros(_X.size)]))[:, 0]
+        _, y_low = axes.transData.transform(np.column_stack([_X, low])).T
         _, y_high = axes.transData.transform(np.column_stack([_X, high])).T
-        for column in np.intersect1d(np.floor(x).astype(int), columns):
-            inside = np.floor(x).astype(int) == column
+        finite = np.isfinite(y_low) & np.isfinite(y_high)
+        for column in np.intersect1d(np.floor(x[finite]).astype(int), columns):
+            inside = finite & (np.floor(x).astype(int) == column)
             top = height - 1 - int(np.floor(np.max(y_high[inside])))
             bottom = height - 1 - int(np.floor(np.min(y_low[inside])))
             assert np.all(painted[top : bottom + 1, column]), (case, column)

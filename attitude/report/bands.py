@@ -62,6 +62,15 @@ def extent_near(
     return low, high
 
 
+def _pixels_along(to_pixels, values: NDArray[np.float64], axis: int) -> NDArray[np.float64]:
+    """Display pixels of ``values`` along one axis of a rectilinear axes' transform: the
+    other coordinate held at 0, so that a NaN value (a gap in a series) stays its own,
+    and does not make its time NaN as well (0 × NaN, in the affine transform)."""
+    points = np.zeros((np.size(values), 2))
+    points[:, axis] = values
+    return to_pixels.transform(points)[:, axis]
+
+
 class _Layers:
     """The premultiplied image that the layers are painted into, and the buffers each
     layer's coverage is counted in: allocated once per image (fresh pages cost more
@@ -215,8 +224,8 @@ class Bands(Artist):
         axes: Any = self.axes
         to_pixels = axes.transData
         for low, high, color in self._series:
-            x, y_low = to_pixels.transform(np.column_stack([self._x, low])).T
-            _, y_high = to_pixels.transform(np.column_stack([self._x, high])).T
+            x = _pixels_along(to_pixels, self._x, 0)
+            y_low, y_high = (_pixels_along(to_pixels, y, 1) for y in (low, high))
             y_low, y_high = y_low - bottom, y_high - bottom
             rgba = (*to_rgb(color), 1.0)
             if not self._edges:
