@@ -23,10 +23,21 @@ def short_commit(tree: Path) -> str:
     ).stdout.strip()
 
 
+def cpu_model() -> str:
+    """The processor's model name (``/proc/cpuinfo``), or the architecture."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
 def machine_line() -> str:
     """The machine, its cores, the kernel and the Python that ran the benchmark."""
     return (
-        f"{platform.machine()}, {os.cpu_count()} cores, {platform.system()} "
+        f"{cpu_model()} ({platform.machine()}), {os.cpu_count()} cores, {platform.system()} "
         f"{platform.release()}, Python {platform.python_version()}"
     )
 

@@ -52,9 +52,21 @@ def process_started_at() -> float:
     since_import = now - _IMPORTED
     # The process began before this import, and not much before it: /proc counts from
     # the fork, and a shell that runs its last command by exec (``sh -c "pip install .
-    # && attitude run ..."``) forked this process before everything it ran first.  What
-    # came before the import here is Python's start, which computes: a few times the
-    # CPU this process has used, at most.  Otherwise (that, or clocks that disagree: a
-    # container's /proc/uptime, say) the import is close.
-    plausible = since_import + 5.0 * time.process_time() + 0.5
+    # && attitude run ..."``) forked this process before everything it ran first, while
+    # it slept waiting for them.  Python's start, before the import here, runs: its
+    # time is the time this process has been on a CPU or waiting for one (however
+    # loaded the machine), and a little reading of files.  Otherwise (that, or clocks
+    # that disagree: a container's /proc/uptime, say) the import is close.
+    plausible = since_import + _running_s() + 0.5
     return now - age if since_import - 0.1 <= age <= plausible else _IMPORTED
+
+
+def _running_s() -> float:
+    """The time this process has spent on a CPU or runnable, waiting for one, since its
+    fork (Linux's /proc/self/schedstat, ns); where that is not kept, five times its
+    CPU time (Python's start on a machine under some load)."""
+    try:
+        on_cpu, waiting = Path("/proc/self/schedstat").read_text().split()[:2]
+        return (int(on_cpu) + int(waiting)) * 1e-9
+    except (OSError, ValueError):
+        return 5.0 * time.process_time()

@@ -3,6 +3,7 @@ the figures, the HTML page and the streamed writing of every output.
 
 Modules:
 
+- ``bands``: The figures' bands (``attitude.report.plots``), rasterised per pixel column.
 - ``beside``: One computation in a forked process beside the run, on the machine's other
   core.
 - ``figures``: What the report's figures show, sampled from the exact motion, and where
@@ -18,6 +19,8 @@ Modules:
 - ``run``: A scenario run, from a scenario to its report folder, streamed in chunks.
 - ``summaries``: The run's summary (``summary.json``, and the report page built from
   it): what each part of it says, from the objects that hold it.
+- ``ticks``: The figures' ticks, tick labels, grid lines and axis labels, drawn as a few
+  artists.
 - ``torques``: What a run says about torques: which were modelled, the method, its step
   and error.
 """

@@ -45,9 +45,11 @@ __all__ = [
 # 9 in at 100 dpi: 900 pixels across, the text (in points) as large relative to the
 # figure as at any dpi; fewer pixels to rasterise and to encode than at 110 dpi (-17 %).
 _DPI = 100
-# zlib's fastest level for the PNGs: the encoding is a fifth of a figure's time at the
-# default level (6), a tenth at this one, for files about 15 % larger.
+# zlib's fastest level for the PNGs (savefig's options, for the figures drawn elsewhere;
+# this module's own are written by _png): the encoding is a fifth of a figure's time
+# at the default level (6), a tenth at this one, for files about 15 % larger.
 PNG_OPTIONS: dict[str, Any] = {"pil_kwargs": {"compress_level": 1}}
+_ZLIB_LEVEL = 1
 # At least the width of the axes in pixels (9 in at 100 dpi, less the margins).
 PIXEL_COLUMNS = 900
 
@@ -163,18 +165,30 @@ class Zoom:
 
 
 def _panels(rows: int, height_in: float) -> tuple[Figure, list]:
-    """A 9-inch-wide figure of ``rows`` panels, with fixed margins: a layout engine
-    (constrained, tight) measures every text and redraws, and took 40% of a figure's
-    time here."""
+    """A 9-inch-wide figure of ``rows`` panels, with fixed margins (a layout engine,
+    constrained or tight, measures every text and redraws: 40% of a figure's time),
+    each with its ticks and grid (:func:`_ticks`)."""
     from matplotlib.figure import Figure  # here: a run without plots never loads matplotlib
 
     height = height_in * rows + 0.6
-    figure = Figure(figsize=(9.0, height))
+    figure = Figure(figsize=(9.0, height), dpi=_DPI)
     inch = 1.0 / height
     figure.subplots_adjust(
         left=0.085, right=0.98, bottom=0.55 * inch, top=1.0 - 0.4 * inch, hspace=0.85 / height_in
     )
-    return figure, list(figure.subplots(rows, 1, squeeze=False)[:, 0])
+    panels = list(figure.subplots(rows, 1, squeeze=False)[:, 0])
+    for axes in panels:
+        _ticks(axes)
+    return figure, panels
+
+
+def _ticks(axes) -> None:
+    """The axes' ticks, tick labels, axis labels and grid, drawn by
+    ``attitude.report.ticks`` (matplotlib's own axis drawing was over half of the
+    figures' time): the same ticks, in the same places."""
+    from attitude.report.ticks import Ticks
+
+    Ticks(axes, grid_alpha=0.3)
 
 
 def _title(axes, text: str) -> None:
@@ -186,23 +200,67 @@ def _title(axes, text: str) -> None:
 
 
 def _save(figure: Figure, path: Path) -> str:
-    """The figure as an opaque RGB PNG: its background is white, so the alpha channel
-    that matplotlib's own PNG carries says nothing, and without it there is a quarter
-    less to compress (a fifth of the encoding's time)."""
+    """The figure as an opaque RGB PNG (its background is white: the alpha channel of
+    matplotlib's own PNG says nothing).
+
+    The text is drawn without hinting: the font's hinting program, run for every glyph
+    of every label, was a third of the text's time, and the text most of a figure's;
+    unhinted glyphs at 100 dpi read the same.  (rcParams set for this drawing only, and
+    restored: a library does not change its caller's matplotlib state.)"""
+    import matplotlib
     from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from PIL import Image  # matplotlib's own dependency, its PNG writer
 
     figure.set_dpi(_DPI)
     canvas = FigureCanvasAgg(figure)
-    canvas.draw()
+    with matplotlib.rc_context({"text.hinting": "no_hinting"}):
+        canvas.draw()
     rgb = np.asarray(canvas.buffer_rgba())[:, :, :3]
-    Image.fromarray(rgb).save(path, format="png", dpi=(_DPI, _DPI), **PNG_OPTIONS["pil_kwargs"])
+    path.write_bytes(_png(rgb, _DPI))
     return path.name
 
 
-def _draw_envelope(axes, envelope: Envelope, unit_s: float, colors: dict[str, str], scale=None):
-    """Each series as its samples (few) or its band with edges (many); returns True if
-    anything was drawn."""
+def _png(rgb: NDArray[np.uint8], dpi: int) -> bytes:
+    """An 8-bit RGB PNG of ``rgb`` (rows from the top), every row under the "Up" filter
+    (PNG spec., 9.2: each byte less the byte above it), deflated by zlib at its fastest.
+
+    Written here rather than by Pillow, which tries all five filters on every row and
+    keeps the best (four tenths of the encoding's time): for a figure, whose rows mostly
+    repeat the row above, "Up" alone compresses as well (the same size within 1 %)."""
+    import zlib
+
+    height, width, _ = rgb.shape
+    rows = np.empty((height, 1 + 3 * width), dtype=np.uint8)
+    rows[:, 0] = 2  # the filter type: Up
+    flat = rgb.reshape(height, 3 * width)
+    rows[0, 1:] = flat[0]  # the row above the first is zeros
+    np.subtract(flat[1:], flat[:-1], out=rows[1:, 1:])  # modulo 256, as the spec. says
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        body = kind + data
+        return len(data).to_bytes(4, "big") + body + zlib.crc32(body).to_bytes(4, "big")
+
+    per_metre = round(dpi / 0.0254)
+    header = width.to_bytes(4, "big") + height.to_bytes(4, "big") + bytes([8, 2, 0, 0, 0])
+    return b"".join(
+        (
+            b"\x89PNG\r\n\x1a\n",
+            chunk(b"IHDR", header),
+            chunk(b"pHYs", per_metre.to_bytes(4, "big") * 2 + b"\x01"),
+            chunk(b"IDAT", zlib.compress(rows.tobytes(), _ZLIB_LEVEL)),
+            chunk(b"IEND", b""),
+        )
+    )
+
+
+def _draw_envelope(
+    axes, envelope: Envelope, unit_s: float, colors: dict[str, str], scale=None
+) -> list:
+    """Each series as its samples (few: lines) or its band with edges (many); returns
+    the legend's handles for the bands (the lines carry their own labels)."""
+    from matplotlib.patches import Patch
+
+    from attitude.report.bands import BAND_ALPHA, Bands
+
     scale = scale or {}
     kept = envelope.samples()
     if kept is not None:
@@ -215,16 +273,32 @@ def _draw_envelope(axes, envelope: Envelope, unit_s: float, colors: dict[str, st
                 linewidth=1.0,
                 label=name,
             )
-        return t.size > 0
+        return []
     filled = envelope.filled()
+    if not np.any(filled):
+        return []
     x = envelope.centres()[filled] / unit_s
+    series = []
     for name in envelope.names:
         k = scale.get(name, 1.0)
         low, high = envelope.low[name][filled] * k, envelope.high[name][filled] * k
-        axes.fill_between(x, low, high, color=colors[name], alpha=0.35, linewidth=0, label=name)
-        axes.plot(x, low, color=colors[name], linewidth=0.6)
-        axes.plot(x, high, color=colors[name], linewidth=0.6)
-    return bool(np.any(filled))
+        series.append((low, high, colors[name]))
+    axes.add_artist(Bands(x, series, edges=False))
+    axes.add_artist(Bands(x, series, edges=True))
+    least = min(float(np.min(low)) for low, _, _ in series)
+    most = max(float(np.max(high)) for _, high, _ in series)
+    axes.update_datalim([(x[0], least), (x[-1], most)])
+    axes.autoscale_view()
+    return [
+        Patch(facecolor=colors[name], alpha=BAND_ALPHA, linewidth=0, label=name)
+        for name in envelope.names
+    ]
+
+
+def _legend(axes, bands: list, **options) -> None:
+    """The axes' legend: the bands' handles first, then its labelled artists'."""
+    handles, _ = axes.get_legend_handles_labels()
+    axes.legend(handles=[*bands, *handles], **options)
 
 
 def _shade(axes, spans_s: Sequence[tuple[float, float]], unit_s: float, low, high, label=None):
@@ -270,7 +344,6 @@ def _zoom_panel(axes, zoom: Zoom, colors: dict[str, str], ylabel: str, scale=Non
     axes.set_xlabel(label)
     axes.set_ylabel(ylabel)
     _title(axes, zoom.title)
-    axes.grid(alpha=0.3)
     return unit_s
 
 
@@ -289,15 +362,14 @@ def plot_angular_velocity(
     unit_s, label = time_unit(envelope.stop_s - envelope.start_s)
     colors = {name: f"C{i}" for i, name in enumerate(envelope.names)}
     degrees = dict.fromkeys(envelope.names, 180.0 / np.pi)
-    _draw_envelope(axes, envelope, unit_s, colors, degrees)
+    bands = _draw_envelope(axes, envelope, unit_s, colors, degrees)
     for event in events_s:
         axes.axvline(event / unit_s, color="0.4", linestyle=":", linewidth=1.0)
     axes.set_xlim(envelope.start_s / unit_s, envelope.stop_s / unit_s)
     axes.set_xlabel(label)
     axes.set_ylabel("body angular velocity (deg/s)")
     _title(axes, title or "Angular velocity in body axes (band: range in each pixel column)")
-    axes.grid(alpha=0.3)
-    axes.legend(loc="upper right", fontsize="small", ncols=3)
+    _legend(axes, bands, loc="upper right", fontsize="small", ncols=3)
     if zoom is not None:
         _zoom_panel(panels[1], zoom, colors, "body angular velocity (deg/s)", degrees)
     return _save(figure, path)
@@ -312,6 +384,8 @@ def _sun_angle_guides(
 ) -> None:
     """What a Sun-angle panel is read against: each vector's exclusion limit (dashed, in
     its colour), the eclipses shaded, and the full 0-180° range."""
+    from matplotlib.ticker import FixedLocator
+
     for name, limit in limits_deg.items():
         if limit is not None:
             axes.axhline(
@@ -323,8 +397,9 @@ def _sun_angle_guides(
             )
     _shade(axes, shaded_s, unit_s, 0.0, 180.0, "eclipse")
     axes.set_ylim(0.0, 180.0)
-    axes.set_yticks(np.arange(0, 181, 30))
-    axes.grid(alpha=0.3)
+    # (set_yticks would make the seven tick objects that attitude.report.ticks does
+    # without)
+    axes.yaxis.set_major_locator(FixedLocator(list(range(0, 181, 30))))
 
 
 def plot_sun_angles(
@@ -341,13 +416,13 @@ def plot_sun_angles(
     colors = {name: f"C{i}" for i, name in enumerate(envelope.names)}
     top = panels[0]
     unit_s, label = time_unit(envelope.stop_s - envelope.start_s)
-    _draw_envelope(top, envelope, unit_s, colors)
+    bands = _draw_envelope(top, envelope, unit_s, colors)
     _sun_angle_guides(top, limits_deg, colors, shadow_s, unit_s)
     top.set_xlim(envelope.start_s / unit_s, envelope.stop_s / unit_s)
     top.set_xlabel(label)
     top.set_ylabel("angle from the Sun (deg)")
     _title(top, title or "Sun angle on the body vectors (band: range in each pixel column)")
-    top.legend(loc="upper right", fontsize="small", ncols=2)
+    _legend(top, bands, loc="upper right", fontsize="small", ncols=2)
     if zoom is not None:
         zoom_unit_s = _zoom_panel(panels[1], zoom, colors, "angle from the Sun (deg)")
         _sun_angle_guides(panels[1], limits_deg, colors, zoom.shaded_s, zoom_unit_s)
@@ -400,7 +475,6 @@ def plot_eclipse(
         _title(axes, title or f"Eclipses: the duration of each of the {len(passes)} passes")
     axes.set_xlim(span_s[0] / unit_s, span_s[1] / unit_s)
     axes.set_xlabel(label)
-    axes.grid(alpha=0.3)
     if zoom is not None:
         _zoom_panel(panels[1], zoom, {"sunlit": "tab:orange"}, "Sun disc visible")
         panels[1].set_ylim(-0.05, 1.05)
@@ -491,7 +565,6 @@ def _draw_from_mean(flat, directions: list[tuple[int, NDArray[np.float64]]]) -> 
     flat.set_aspect("equal", adjustable="datalim")
     flat.set_xlabel("angle from the mean direction (deg)")
     flat.set_ylabel("angle from the mean direction (deg)")
-    flat.grid(alpha=0.3)
     _title(flat, "seen from the mean direction")
     if len(directions) > 1:
         flat.legend(loc="best", fontsize="small")
@@ -513,6 +586,7 @@ def plot_polhode(
     figure.subplots_adjust(left=0.02, right=0.97, bottom=0.1, top=0.88, wspace=0.15)
     sphere = figure.add_subplot(1, 2, 1, projection="3d")
     flat = figure.add_subplot(1, 2, 2)
+    _ticks(flat)
     figure.suptitle(title or "Angular momentum direction in body axes (polhode)")
     _unit_sphere(sphere)
     directions = _momentum_directions(paths)
