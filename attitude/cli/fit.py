@@ -130,6 +130,16 @@ def _context(path: Path):
         burns=burns,
     )
     torques = scenario.torques if scenario.torques.any else None
+    if torques is not None and torques.burns:
+        # The burns at absolute epochs: an offset counts from the file's epoch, and the
+        # fit's t = 0 is the telemetry's first sample.
+        at = {b.index: scenario.times(b.start_s) for b in scenario.burns}
+        torques = dataclasses.replace(
+            torques,
+            burns=tuple(
+                dataclasses.replace(burn, epoch=at[k]) for k, burn in enumerate(torques.burns)
+            ),
+        )
     return context, tuple(impulses), torques, scenario.orbit
 
 

@@ -37,6 +37,7 @@ from scipy.spatial.transform import Rotation
 
 from attitude.base.errors import InputError
 from attitude.base.quantities import as_si_array, as_si_scalar
+from attitude.estimation.burns import known_burns
 from attitude.estimation.linear_guess import Guess, candidates, impulse_scale
 from attitude.estimation.model import ExactModel, Impulse, Layout
 from attitude.estimation.solve import Data, FitRefused, Solution, fit_from_starts, residuals
@@ -338,7 +339,9 @@ def fit_spin_state(
     data, noise = _data(telemetry, gyro_sigma, attitude_sigma)
     _refuse_without_motion(telemetry, data)
     impulse_list = _impulses(impulses, telemetry)
-    has_burns = torques is not None and bool(getattr(torques, "burns", ()))
+    burns = known_burns(getattr(torques, "burns", ()), telemetry.epoch) if torques else ()
+    start, end = telemetry.span
+    has_burns = any(b.stop > start and b.start < end for b in burns)  # in the arc
     if gyro_bias and telemetry.gyro is None:
         raise InputError("gyro_bias needs gyro rates", file=source)
     layout = Layout(
@@ -361,7 +364,7 @@ def fit_spin_state(
                 "fixes: the torque depends on the attitude, which rates alone barely show",
                 file=source,
             )
-    model = _model(layout, impulse_list, torques, telemetry, orbit)
+    model = _model(layout, impulse_list, torques, telemetry, orbit, burns)
     starts, guess_text = _starts(model, telemetry, guess, principal_axes, data)
     notes.append(guess_text)
     solution = fit_from_starts(starts, data)
@@ -494,9 +497,13 @@ def _impulses(impulses: Any, telemetry: Telemetry) -> tuple[Impulse, ...]:
     return tuple(out)
 
 
-def _model(layout: Layout, impulses, torques, telemetry: Telemetry, orbit=None):
+def _model(layout: Layout, impulses, torques, telemetry: Telemetry, orbit=None, burns=()):
+    """The exact motion, across known impulses and burns (attitude.estimation.burns);
+    under gravity gradient, the propagated scenario (attitude.estimation.scenario_model)."""
     if torques is None or not getattr(torques, "any", True):
         return ExactModel(layout, impulses)
+    if getattr(torques, "gravity_gradient", None) is None:
+        return ExactModel(layout, impulses, burns)
     from attitude.estimation.scenario_model import ScenarioModel
 
     return ScenarioModel(
@@ -527,21 +534,37 @@ def _first_attitude(telemetry: Telemetry, moments, axes: Rotation, ω0) -> Rotat
 def _starts(model, telemetry: Telemetry, guess: Any, principal_axes: bool, data: Data):
     """(model, x, label, first arc end) for each start, and the guess's description."""
     impulses = getattr(model, "impulses", ())
+    # Burns in the exact model, or in the torques of a propagated one.
+    burns = model.burns or known_burns(
+        getattr(getattr(model, "torques", None), "burns", ()), telemetry.epoch
+    )
     if guess is not None:
         guesses = [_from_guess(guess)]
         text = "started from the guess given"
     else:
-        guesses, text = candidates(telemetry, principal_axes, tuple(i.t for i in impulses))
+        guesses, text = candidates(
+            telemetry,
+            principal_axes,
+            tuple(i.t for i in impulses),
+            tuple((b.start, b.stop) for b in burns),
+        )
     starts = []
     t_first = float(data.times[0])
     for g in guesses:
         Q0 = _first_attitude(telemetry, g.moments, g.axes, g.ω0)
-        if model.layout.scale and impulses:
+        if model.layout.scale:
             scale = impulse_scale(
-                telemetry, g.moments, g.axes, impulses, _rough_attitude(telemetry)
+                telemetry,
+                g.moments,
+                g.axes,
+                impulses,
+                _rough_attitude(telemetry),
+                burns,
             )
             if scale is not None:
-                g = Guess(g.moments * scale, g.axes, g.ω0, g.label + ", scale from the impulses")
+                g = Guess(
+                    g.moments * scale, g.axes, g.ω0, g.label + ", scale from the impulses or burns"
+                )
         m, x = model.start(g.moments, g.axes, g.ω0, Q0)
         try:
             period = EulerSolver(g.moments, g.moments * g.axes.inv().apply(g.ω0)).period
