@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
+from signal_dispositions import defaults
 
 from attitude import EulerSolver, fit_spin_state
 from attitude.cli.main import main
@@ -262,7 +263,10 @@ def test_the_example_telemetry_fits_to_the_truth_that_made_it(tmp_path, monkeypa
 
 
 def test_ctrl_c_leaves_nothing_behind(tmp_path):
-    """SIGINT in the middle of a fit: exit status 130, one line, and no output folder."""
+    """SIGINT in the middle of a fit: exit status 130, one line, and no output folder.
+    The child starts with SIGINT at its default action whatever pytest started with (a
+    ``pytest &`` ignores it, and the command rightly keeps an ignored SIGINT ignored:
+    tests/signal_dispositions.py)."""
     import signal
     import subprocess
     import sys
@@ -289,6 +293,7 @@ def test_ctrl_c_leaves_nothing_behind(tmp_path):
         ],
         stderr=subprocess.PIPE,
         text=True,
+        preexec_fn=defaults,
     )
     first = process.stderr.readline()  # "attitude fit: long.csv: 80000 rows read; fitting"
     assert "fitting" in first, first
