@@ -294,7 +294,8 @@ def fit_spin_state(
         (N, 3) body rates, rad/s (or a ``Quantity``); rows of NaN where missing.
     quaternions
         (N, 4) attitude, body → ICRF, scalar first (w, x, y, z); rows of NaN where
-        missing.  q and −q are the same attitude.
+        missing.  q and −q are the same attitude.  Or a ``Rotation`` of N attitudes
+        (body → ICRF), one per time (a star tracker that reads at every time).
     gyro_sigma, attitude_sigma
         The white noise of each sensor: rad/s (one value or one per axis) and rad per
         axis (or ``Quantity``).  Estimated from the data when not given.

@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
 
 from attitude.base.errors import InputError
 from attitude.base.quantities import as_si_array
@@ -181,6 +182,18 @@ def _frozen(values: NDArray[np.float64]) -> NDArray[np.bool_]:
     return frozen
 
 
+def _rotation_quaternions(attitude: Rotation, count: int, source: str) -> NDArray[np.float64]:
+    """N attitudes given as a ``Rotation`` (one per time) as (N, 4) quaternions, scalar
+    first."""
+    if attitude.single or len(attitude) != count:
+        shown = "a single rotation" if attitude.single else f"{len(attitude)} rotations"
+        raise InputError(
+            f"quaternions as a Rotation must hold one attitude per time ({count}), got {shown}",
+            file=source,
+        )
+    return attitude.as_quat(scalar_first=True)
+
+
 def prepare_telemetry(
     times: Any,
     angular_velocity: Any = None,
@@ -191,7 +204,8 @@ def prepare_telemetry(
 
     ``times``: an astropy ``Time`` array or seconds; ``angular_velocity``: (N, 3) body
     rates, rad/s (or a ``Quantity``); ``quaternions``: (N, 4) body → ICRF, scalar first
-    (w, x, y, z).  Rows of NaN are missing readings of that kind.
+    (w, x, y, z), or a ``scipy.spatial.transform.Rotation`` of N attitudes (body →
+    ICRF).  Rows of NaN are missing readings of that kind.
     """
     if angular_velocity is None and quaternions is None:
         raise InputError("give angular_velocity, quaternions or both", file=source)
@@ -209,6 +223,8 @@ def prepare_telemetry(
         )
         gyro = _sensor(t, ω, present, "angular_velocity", source, notes)
     if quaternions is not None:
+        if isinstance(quaternions, Rotation):  # what the package returns: an attitude
+            quaternions = _rotation_quaternions(quaternions, t.size, source)
         q, present = _readings(quaternions, "dimensionless", 4, t.size, source, "quaternions")
         norm = np.linalg.norm(np.where(present[:, None], q, 1.0), axis=1)
         bad = present & (np.abs(norm - 1.0) > NORM_TOLERANCE)
