@@ -35,7 +35,10 @@ from attitude.base.errors import InputError
 from attitude.environment.timescales import SAME_INSTANT_S
 from attitude.estimation.telemetry import Telemetry, _uniform_runs
 
-__all__ = ["Guess", "Rates", "candidates", "measured_rates"]
+__all__ = ["GUESS_SAMPLES", "Guess", "Rates", "candidates", "measured_rates"]
+
+# The guess is solved on at most this many readings of each sensor (the first ones).
+GUESS_SAMPLES = 50_000
 
 
 @dataclass(frozen=True)
@@ -80,13 +83,19 @@ def measured_rates(
     (known burns: not torque-free) left out; None if no run is."""
     t_parts, ω_parts, dω_parts, scaled_parts = [], [], [], []
     if telemetry.gyro is not None and len(telemetry.gyro) >= 7:
-        t, ω, source = telemetry.gyro.t, telemetry.gyro.values, "gyro"
+        # The first GUESS_SAMPLES readings: a guess needs the motion's shape (tens of
+        # periods), not every reading of a long arc.
+        t, ω, source = (
+            telemetry.gyro.t[:GUESS_SAMPLES],
+            telemetry.gyro.values[:GUESS_SAMPLES],
+            "gyro",
+        )
     elif telemetry.attitude is not None and len(telemetry.attitude) >= 8:
-        q = telemetry.attitude.values
+        q = telemetry.attitude.values[:GUESS_SAMPLES]
         R = Rotation.from_quat(q, scalar_first=True)
-        steps = np.diff(telemetry.attitude.t)
+        steps = np.diff(telemetry.attitude.t[:GUESS_SAMPLES])
         increments = (R[:-1].inv() * R[1:]).as_rotvec()  # body axes, ≈ ω dt
-        t = telemetry.attitude.t[:-1] + 0.5 * steps
+        t = telemetry.attitude.t[: GUESS_SAMPLES - 1] + 0.5 * steps
         ω, source = increments / steps[:, None], "quaternions"
     else:
         return None
@@ -179,16 +188,16 @@ def candidates(
     rates = measured_rates(telemetry, breaks, excluded)
     if rates is None:
         raise InputError(
-            f"{telemetry.source}: the samples are too sparse for the linear first guess (it "
-            "needs runs of 7 or more evenly spaced gyro readings or 8 quaternions close enough "
-            "to differentiate): give a guess (an EulerSolver or an earlier fit)"
+            "the samples are too sparse for the linear first guess (it needs runs of 7 or "
+            "more evenly spaced gyro readings or 8 quaternions close enough to differentiate)",
+            file=telemetry.source,
         )
     # Euler's equations are homogeneous of degree 2 in (ω, ω̇/W): scaled by the typical
     # rate W, the rows are of order one whatever the units (no underflow or overflow).
     ω, dω = rates.ω / rates.W, rates.ω_dot_scaled
     rows = _tensor_rows(ω, dω) if principal_axes else _principal_rows(ω, dω)
     if not np.all(np.isfinite(rows)):
-        raise InputError(f"{telemetry.source}: the rates' products overflow: rates too large")
+        raise InputError("the rates' products overflow: rates too large", file=telemetry.source)
     scale = np.linalg.norm(rows, axis=0)
     scale[scale == 0.0] = 1.0
     _, s, Vt = np.linalg.svd(rows / scale, full_matrices=False)
@@ -221,9 +230,10 @@ def candidates(
             )
     if not guesses:
         raise InputError(
-            f"{telemetry.source}: the measured rates follow Euler's equations of no rigid body "
-            f"(the linear guess gives moments of both signs; smallest singular values "
-            f"{s[-1]:.3g}, {s[-2]:.3g}): torques, a biased or mislabelled gyro, or noise alone?"
+            f"the measured rates follow Euler's equations of no rigid body (the linear guess "
+            f"gives moments of both signs; smallest singular values {s[-1]:.3g}, "
+            f"{s[-2]:.3g}): torques, a biased or mislabelled gyro, or noise alone?",
+            file=telemetry.source,
         )
     out = []
     for moments, axes, label in guesses:

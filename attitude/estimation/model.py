@@ -22,11 +22,13 @@ Logarithms keep the moments positive; a rotation vector about a reference that t
 moves between its stages (``recentred``) keeps the attitude and the axes away from
 their singularities.
 
-``ExactModel`` is the torque-free motion with known angular impulses: ``EulerSolver``
-between the impulses, and the Jacobian from the exact flow's sensitivities
-(attitude.solver.sensitivities) chained through each impulse by the chain rule.
+``ExactModel`` is the torque-free motion with known angular impulses and burns:
+``EulerSolver`` between them, and the Jacobian from the exact flow's sensitivities
+(attitude.solver.sensitivities) chained through each impulse by the chain rule, and
+across each burn by the variational equations integrated with the motion
+(attitude.estimation.burns).
 ``ScenarioModel`` (attitude.estimation.scenario_model) is the same interface over a
-propagated scenario (gravity gradient, burns), with a finite-difference Jacobian.
+propagated scenario (gravity gradient), with a finite-difference Jacobian.
 """
 
 from __future__ import annotations
@@ -85,6 +87,9 @@ def left_jacobian_inverse(r: NDArray[np.float64]) -> NDArray[np.float64]:
         )
     return np.eye(3) - 0.5 * K + c[:, None, None] * (K @ K)
 
+
+# Times evaluated at once for the Jacobian (a bound on the memory of a long arc).
+_CHUNK = 65_536
 
 # One solver's stretch of a prediction: m_p (N, 3), Q_p (a Rotation, or None when the
 # attitude is not needed) and ∂(δθ_p, m_p)/∂x (N, 6, n, or None without the Jacobian).
@@ -286,20 +291,40 @@ class ExactModel:
             hi = t_end - SAME_INSTANT_S if impulses else t_end
             last = not math.isfinite(t_end)
             if torque is None:
+                # One evaluation of the piece for every sample in it and its end (the
+                # solver's constants and their gradients once).
                 solver = EulerSolver(J, m_p, Q_p, t0)
-                for name, times in wanted.items():
-                    inside = _inside(times, lo, hi)
-                    if inside is not None and times is not None:
-                        piece = self._segment(solver, times[inside], D, J, need_attitude, jacobian)
-                        pieces[name].append((inside, piece))
+                chosen = [
+                    (name, inside)
+                    for name, times in wanted.items()
+                    if (inside := _inside(times, lo, hi)) is not None
+                ]
+                parts = [wanted[name][inside] for name, inside in chosen]  # type: ignore[index]
+                if not last:
+                    parts.append(np.array([t_end]))
+                if parts:
+                    m_at, Q_at, dY_at = self._segment(
+                        solver, np.concatenate(parts), D, J, need_attitude, jacobian
+                    )
+                first = 0
+                for name, inside in chosen:
+                    part = slice(first, first + inside.size)
+                    first += inside.size
+                    pieces[name].append(
+                        (
+                            inside,
+                            (
+                                m_at[part],
+                                None if Q_at is None else Q_at[part],
+                                None if dY_at is None else dY_at[part],
+                            ),
+                        )
+                    )
                 if last:
                     break
-                m_at, Q_at, dY_at = self._segment(
-                    solver, np.array([t_end]), D, J, need_attitude, jacobian
-                )
-                m_end = m_at[0]
-                Q_end = Q_at[0] if Q_at is not None else Q_p
-                dY = dY_at[0] if dY_at is not None else None
+                m_end = m_at[-1]
+                Q_end = Q_at[-1] if Q_at is not None else Q_p
+                dY = dY_at[-1] if dY_at is not None else None
             else:
                 m_end, Q_end, dY = self._across_burn(
                     x, J, Ar, m_p, Q_p, D, t0, t_end, lo, hi, torque, wanted, pieces, jacobian
@@ -428,9 +453,25 @@ class ExactModel:
             m = solver.angular_momentum(times)
             R = solver.attitude(times) if attitude else None
             return m, R, None
-        sens = flow_sensitivities(solver, times, attitude=attitude)
-        jac = sens.jacobian
-        if not attitude:  # the attitude rows are not computed, and nothing needs them
-            jac = jac.copy()
-            jac[:, 0:3, :] = 0.0
-        return sens.angular_momentum, sens.attitude, np.einsum("nij,jp->nip", jac, D)
+        if times.size <= _CHUNK:
+            sens = flow_sensitivities(solver, times, attitude=attitude)
+            jac = sens.jacobian
+            if not attitude:  # the attitude rows are not computed, and nothing needs them
+                jac[:, 0:3, :] = 0.0
+            return sens.angular_momentum, sens.attitude, np.einsum("nij,jp->nip", jac, D)
+        # In chunks: the sensitivities' (N, 6, 9) of a long arc need not all exist at once.
+        m = np.empty((times.size, 3))
+        out = np.empty((times.size, 6, D.shape[1]))
+        quats = np.empty((times.size, 4)) if attitude else None
+        for first in range(0, times.size, _CHUNK):
+            part = slice(first, first + _CHUNK)
+            sens = flow_sensitivities(solver, times[part], attitude=attitude)
+            jac = sens.jacobian
+            if not attitude:  # the attitude rows are not computed, and nothing needs them
+                jac[:, 0:3, :] = 0.0
+            m[part] = sens.angular_momentum
+            np.einsum("nij,jp->nip", jac, D, out=out[part])
+            if quats is not None and sens.attitude is not None:
+                quats[part] = sens.attitude.as_quat()
+        R = Rotation.from_quat(quats) if quats is not None else None
+        return m, R, out
