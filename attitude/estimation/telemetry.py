@@ -66,6 +66,8 @@ class Telemetry:
     epoch: Any = None
     source: str = "telemetry"
     notes: list[str] = field(default_factory=list)
+    # The gyro read exactly 0 on every axis at every one of its (two or more) readings.
+    gyro_reads_zero: bool = False
 
     @property
     def span(self) -> tuple[float, float]:
@@ -168,17 +170,14 @@ def _sensor(
 def _frozen(values: NDArray[np.float64]) -> NDArray[np.bool_]:
     """The repeats (not the first reading) of runs of ``FROZEN_RUN`` or more identical rows."""
     repeat = np.concatenate([[False], np.all(values[1:] == values[:-1], axis=1)])
+    # Runs of repeats: [start, stop) where ``repeat`` is True; a run of k repeats is a
+    # run of k + 1 identical readings.
+    edges = np.diff(np.concatenate([[0], repeat.astype(np.int8), [0]]))
+    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
     frozen = np.zeros(len(values), dtype=bool)
-    k = 0
-    while k < len(values):
-        if not repeat[k]:
-            k += 1
-            continue
-        start = k
-        while k < len(values) and repeat[k]:
-            k += 1
-        if k - start + 1 >= FROZEN_RUN:
-            frozen[start:k] = True
+    for start, stop in zip(starts, stops, strict=True):
+        if stop - start + 1 >= FROZEN_RUN:
+            frozen[start:stop] = True
     return frozen
 
 
@@ -221,6 +220,7 @@ def prepare_telemetry(
         ω, present = _readings(
             angular_velocity, "angular_velocity", 3, t.size, source, "angular_velocity"
         )
+        zero = int(np.count_nonzero(present)) >= 2 and not np.any(ω[present])
         gyro = _sensor(t, ω, present, "angular_velocity", source, notes)
     if quaternions is not None:
         if isinstance(quaternions, Rotation):  # what the package returns: an attitude
@@ -241,6 +241,7 @@ def prepare_telemetry(
     if gyro is None and attitude is None:
         raise InputError("every reading is missing", file=source)
     telemetry = Telemetry(gyro, attitude, epoch, source, notes)
+    telemetry.gyro_reads_zero = angular_velocity is not None and zero
     for sensor, name in ((gyro, "angular_velocity"), (attitude, "quaternions")):
         if sensor is not None and len(sensor) > 2:
             gaps = np.diff(sensor.t)
