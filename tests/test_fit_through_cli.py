@@ -543,6 +543,13 @@ def test_refusals_name_the_option_and_the_file_once_in_our_words(tmp_path, capsy
         "t_s,omega_body_x_rad_s,omega_body_y_rad_s,omega_body_z_rad_s\n0,1,2,3\n1,1,2,3\n"
     )
     refused([str(tmp_path / "epoch.csv")], "epoch.csv: # epoch:")
+    (tmp_path / "hex.csv").write_text(
+        "t_s,omega_body_x_rad_s,omega_body_y_rad_s,omega_body_z_rad_s\n0x10,1,2,3\n1,1_000,2,3\n"
+    )
+    epoch = ["--epoch", "2027-01-01T00:00:00"]
+    refused([str(tmp_path / "hex.csv"), *epoch], "row 0, column t_s: '0x10' is not a number")
+    (tmp_path / "cut.parquet").write_bytes(b"PAR1" + b"\x00" * 20)
+    refused([str(tmp_path / "cut.parquet")], "no Parquet footer")
 
 
 def test_the_fitted_scenario_is_one_its_own_check_accepts(tmp_path, capsys):

@@ -83,12 +83,8 @@ def _quantity(text: str | None, kind: str, option: str, counts: tuple[int, ...] 
         )
     values = [float(v) for v in found.group(1).split(",")]
     if len(values) not in counts:
-        wanted = " or ".join(str(c) for c in counts)
-        raise InputError(
-            f"{text!r}: {len(values)} values, where {wanted} (one per body axis) are taken",
-            key=option,
-            value=text,
-        )
+        wanted = "one value" if counts == (1,) else "1 or 3 values (one per body axis)"
+        raise InputError(f"{text!r}: {len(values)} values, where it takes {wanted}", key=option)
     with warnings.catch_warnings():  # astropy's style advice on "rad/s/s" is not ours
         warnings.simplefilter("ignore", UnitsWarning)
         converted = [float(convert_unit(v, found.group(2).strip(), kind, option)) for v in values]

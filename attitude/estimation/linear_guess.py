@@ -93,9 +93,10 @@ def measured_rates(
     elif telemetry.attitude is not None and len(telemetry.attitude) >= 8:
         q = telemetry.attitude.values[:GUESS_SAMPLES]
         R = Rotation.from_quat(q, scalar_first=True)
-        steps = np.diff(telemetry.attitude.t[:GUESS_SAMPLES])
+        fixes = telemetry.attitude.t[:GUESS_SAMPLES]
+        steps = np.diff(fixes)
         increments = (R[:-1].inv() * R[1:]).as_rotvec()  # body axes, ≈ ω dt
-        t = telemetry.attitude.t[: GUESS_SAMPLES - 1] + 0.5 * steps
+        t = fixes[:-1] + 0.5 * steps
         ω, source = increments / steps[:, None], "quaternions"
     else:
         return None

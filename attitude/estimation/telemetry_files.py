@@ -165,7 +165,9 @@ def _columns(names: list[str], file: str) -> dict[str, Any]:
 
 
 def _numbers(table, column: str, file: str) -> NDArray[np.float64]:
-    """A column as float64, nulls as NaN; a cell that is not a number is refused."""
+    """A column as float64, nulls as NaN; a cell that is not a decimal number is
+    refused, naming its row (a CSV's cells are read as texts: Arrow's own inference
+    takes '0x10' for 16)."""
     import pyarrow as pa
     import pyarrow.compute as pc
 
@@ -173,17 +175,19 @@ def _numbers(table, column: str, file: str) -> NDArray[np.float64]:
     if not (pa.types.is_floating(values.type) or pa.types.is_integer(values.type)):
         if pa.types.is_null(values.type):
             return np.full(len(values), np.nan)
-        texts = values.cast(pa.string())
-        for row, text in enumerate(texts.to_pylist()):
-            if text is None or text.strip().lower() in ("", "nan"):
-                continue
-            try:
-                float(text)
-            except ValueError:
-                raise InputError(
-                    f"{text!r} is not a number", file=file, key=f"row {row}, column {column}"
-                ) from None
-        values = pc.cast(texts, pa.float64())
+        texts = pc.utf8_trim_whitespace(values.cast(pa.string()))
+        texts = pc.if_else(pc.equal(texts, ""), pa.scalar(None, pa.string()), texts)
+        try:
+            values = pc.cast(texts, pa.float64())
+        except pa.ArrowInvalid:
+            for row, text in enumerate(texts.to_pylist()):
+                try:
+                    pc.cast(pa.array([text], pa.string()), pa.float64())
+                except pa.ArrowInvalid:
+                    raise InputError(
+                        f"{text!r} is not a number", file=file, key=f"row {row}, column {column}"
+                    ) from None
+            raise  # pragma: no cover (the column failed and no cell does)
     array = values.to_numpy(zero_copy_only=False).astype(np.float64)
     return np.where(np.isnan(array), np.nan, array)
 
@@ -298,9 +302,10 @@ def _csv(path: Path, head: bytes, time_scale, epoch) -> TelemetryFile:
     # writes as "CSV") when its header has semicolons and no comma.
     delimiter = ";" if ";" in first and "," not in first else ","
     header = next(csv.reader([first], delimiter=delimiter)) if first else []
-    # Epoch texts stay texts (Arrow would parse them as POSIX timestamps, which have no
-    # leap second), and so do the numbers, until each column is checked.
-    texts = {name: pa.string() for name in header if name.strip().lower() in _TIME_NAMES}
+    # Every cell is read as text: epochs (Arrow would parse them as POSIX timestamps,
+    # which have no leap second) and numbers (its inference reads '0x10' as 16), each
+    # column then converted and checked (_numbers, _iso_times).
+    texts = {name: pa.string() for name in header}
     try:
         table = pa_csv.read_csv(
             path,
@@ -351,9 +356,13 @@ def _parquet(path: Path, time_scale, epoch) -> TelemetryFile:
     try:
         table = pq.read_table(path)
     except (pa.ArrowInvalid, OSError) as exc:
-        raise InputError(
-            f"not a readable Parquet file: {str(exc).splitlines()[0][:200]}", file=file
-        ) from None
+        text = str(exc).splitlines()[0] if str(exc) else ""
+        reason = (
+            "no Parquet footer (the file is cut short, or not Parquet)"
+            if "magic bytes" in text
+            else text[:200]
+        )
+        raise InputError(f"not a readable Parquet file: {reason}", file=file) from None
     metadata = table.schema.metadata or {}
     stated = metadata.get(b"attitude.epoch")
     if epoch is None and stated:
