@@ -149,7 +149,7 @@ def test_bad_rows_are_refused_with_the_row_and_the_value():
         fit_spin_state([], angular_velocity=np.empty((0, 3)))
     with pytest.raises(InputError, match="numeric"):
         fit_spin_state(t, angular_velocity=[["a", "b", "c"]] * t.size)
-    with pytest.raises(InputError, match="gyro_sigma must be positive"):
+    with pytest.raises(InputError, match="gyro_sigma: must be positive"):
         _fit(t, ω, gyro_sigma=-1.0)
     with pytest.raises(InputError, match="every reading is missing"):
         fit_spin_state(t, angular_velocity=np.full_like(ω, np.nan))

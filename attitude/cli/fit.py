@@ -61,29 +61,45 @@ def add_parser(commands) -> None:
     fit.add_argument("--quiet", action="store_true", help="no progress messages")
 
 
-def _quantity(text: str | None, kind: str, option: str):
-    """'1e-4 rad/s' as SI numbers (one value, or several separated by commas)."""
+def _quantity(text: str | None, kind: str, option: str, counts: tuple[int, ...] = (1,)):
+    """'1e-4 rad/s' as SI numbers (one value, or ``counts`` of them separated by commas:
+    one per axis)."""
     if text is None:
         return None
+    import math
     import re
+    import warnings
+
+    from astropy.units import UnitsWarning
 
     from attitude.base.errors import InputError
     from attitude.base.quantities import convert_unit
 
-    number = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
-    found = re.fullmatch(rf"\s*({number}(?:\s*,\s*{number})*)\s*(\S.*)?", text)
+    number = r"[-+]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|nan|inf|infinity)"
+    found = re.fullmatch(rf"\s*({number}(?:\s*,\s*{number})*)\s*(\S.*)?", text, flags=re.IGNORECASE)
     if not found or not found.group(2):
         raise InputError(
             f'{text!r} needs a value with its unit, e.g. "1e-4 rad/s"', key=option, value=text
         )
-    try:
-        values = [float(v) for v in found.group(1).split(",")]
-    except ValueError:
-        raise InputError(f"{text!r}: not a number", key=option, value=text) from None
-    converted = [float(convert_unit(v, found.group(2).strip(), kind, option)) for v in values]
-    if not all(v > 0.0 for v in converted):
-        raise InputError(f"must be positive, got {text!r}", key=option, value=text)
+    values = [float(v) for v in found.group(1).split(",")]
+    if len(values) not in counts:
+        wanted = "one value" if counts == (1,) else "1 or 3 values (one per body axis)"
+        raise InputError(f"{text!r}: {len(values)} values, where it takes {wanted}", key=option)
+    with warnings.catch_warnings():  # astropy's style advice on "rad/s/s" is not ours
+        warnings.simplefilter("ignore", UnitsWarning)
+        converted = [float(convert_unit(v, found.group(2).strip(), kind, option)) for v in values]
+    if not all(math.isfinite(v) and v > 0.0 for v in converted):
+        raise InputError(f"must be positive and finite, got {text!r}", key=option, value=text)
     return converted[0] if len(converted) == 1 else converted
+
+
+# The fit's parameters that refusals name, as the options of this command.
+_OPTIONS = {
+    "gyro_sigma": "--gyro-sigma",
+    "attitude_sigma": "--attitude-sigma",
+    "principal_axes": "--principal-axes",
+    "gyro_bias": "--gyro-bias",
+}
 
 
 def _context(path: Path):
@@ -130,25 +146,59 @@ def _context(path: Path):
         burns=burns,
     )
     torques = scenario.torques if scenario.torques.any else None
+    if torques is not None and torques.burns:
+        # The burns at absolute epochs: an offset counts from the file's epoch, and the
+        # fit's t = 0 is the telemetry's first sample.
+        at = {b.index: scenario.times(b.start_s) for b in scenario.burns}
+        torques = dataclasses.replace(
+            torques,
+            burns=tuple(
+                dataclasses.replace(burn, epoch=at[k]) for k, burn in enumerate(torques.burns)
+            ),
+        )
     return context, tuple(impulses), torques, scenario.orbit
 
 
-def command(args: argparse.Namespace) -> int:
-    """Run ``attitude fit`` (options parsed by attitude.cli.main); the exit status."""
+def _check_time_options(args: argparse.Namespace) -> None:
+    """--time-scale and --epoch refused at once when wrong, used by the file or not."""
+    from attitude.base.errors import OptionError
+    from attitude.environment.timescales import SCALES, as_time
+
+    if args.time_scale is not None and args.time_scale.strip().lower() not in SCALES:
+        raise OptionError(
+            f"expected one of {', '.join(SCALES)}",
+            key="--time-scale",
+            value=args.time_scale,
+        )
+    if args.time_scale is not None:
+        args.time_scale = args.time_scale.strip().lower()
+    if args.epoch is not None:
+        as_time(args.epoch, args.time_scale or "utc", "--epoch")
+
+
+def command(args: argparse.Namespace, own_process: bool = False) -> int:
+    """Run ``attitude fit`` (options parsed by attitude.cli.main); the exit status.
+
+    Progress goes to stderr as ``attitude run``'s does (attitude.base.progress): each
+    stage as it starts, the growing arc's stages with an estimate of the time left, on
+    a clock that counts from the process's start (``own_process``)."""
     from attitude.base.errors import InputError
+    from attitude.base.progress import Progress, process_started_at
     from attitude.outputs.folder import OutputFolderError, claim
 
-    def say(line: str) -> None:
-        if not args.quiet:
-            print(line, file=sys.stderr, flush=True)
-
+    progress = Progress(
+        None if args.quiet else lambda line: print(line, file=sys.stderr, flush=True),
+        start=process_started_at() if own_process else None,
+    )
+    progress(f"reading {args.telemetry}")
     try:
         from attitude.estimation.fit import fit_spin_state
         from attitude.estimation.report import OUTPUT_NAMES, write_fit_report
         from attitude.estimation.telemetry_files import read_telemetry
 
-        gyro_sigma = _quantity(args.gyro_sigma, "angular_velocity", "--gyro-sigma")
+        gyro_sigma = _quantity(args.gyro_sigma, "angular_velocity", "--gyro-sigma", (1, 3))
         attitude_sigma = _quantity(args.attitude_sigma, "angle", "--attitude-sigma")
+        _check_time_options(args)
         claim(args.out, OUTPUT_NAMES, dry_run=True)  # a folder that is not ours: say so first
         context = impulses = torques = orbit = None
         if args.scenario is not None:
@@ -160,7 +210,7 @@ def command(args: argparse.Namespace) -> int:
                 "the fitted scenario has one",
                 file=args.telemetry.name,
             )
-        say(f"attitude fit: {args.telemetry.name}: {len(telemetry.times)} rows read; fitting")
+        progress(f"{args.telemetry.name}: {len(telemetry.times)} rows read")
         fit = fit_spin_state(
             telemetry.times,
             angular_velocity=telemetry.angular_velocity,
@@ -173,23 +223,24 @@ def command(args: argparse.Namespace) -> int:
             torques=torques,
             orbit=orbit,
             source=args.telemetry.name,
+            progress=progress,
         )
         fit.notes[:0] = telemetry.notes
-        say(fit.summary())
+        if not args.quiet:
+            print(fit.summary(), file=sys.stderr, flush=True)
         name = args.name or f"{args.telemetry.stem} (fitted)"
-        write_fit_report(fit, args.out, args.telemetry.name, name, context)
-        say(f"done: {Path(args.out) / 'report.html'}")
+        write_fit_report(fit, args.out, args.telemetry.name, name, context, progress=progress)
+        progress(f"done: {Path(args.out) / 'report.html'}")
         return 0
     except OutputFolderError as exc:
         print(f"attitude: error: {exc}", file=sys.stderr, flush=True)
         return 2
     except InputError as exc:
-        # Errors that name no file (an option, a fit's refusal) are the telemetry's.
-        located = (
-            exc
-            if exc.file or (exc.key or "").startswith("--")
-            else exc.located(file=args.telemetry.name)
-        )
+        # Errors that name no file (an option, a fit's refusal) are the telemetry's; a
+        # parameter of the fit is named as this command's option.
+        located = exc.located(key=_OPTIONS[exc.key]) if exc.key in _OPTIONS else exc
+        if not (located.file or (located.key or "").startswith("--")):
+            located = located.located(file=args.telemetry.name)
         text = " / ".join(str(located).splitlines())
         print(f"attitude: error: {text}", file=sys.stderr, flush=True)
         return 2

@@ -287,7 +287,7 @@ def _run(args, state: dict) -> int:
         if args.command == "fit":
             from attitude.cli.fit import command
 
-            return command(args)
+            return command(args, own_process=state.get("argv") is None)
         return _checked_run(args, state)
 
 

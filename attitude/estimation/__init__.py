@@ -2,8 +2,12 @@
 
 Modules:
 
+- ``burns``: Known burns in the fitted motion: constant torques over intervals, crossed
+  by integrating the motion together with its sensitivities.
 - ``fit``: ``fit_spin_state``: the inertia ratios and spin state that best explain
   telemetry.
+- ``global_start``: A global start for sparse fixes: the inertia ratios and the phase
+  searched from the fixes themselves, and every family of solutions that fits reported.
 - ``linear_guess``: The first guess, without any search: Euler's equations are linear
   in the moments.
 - ``model``: The motion the fit adjusts: its parameters, and the predicted rates and
@@ -11,8 +15,8 @@ Modules:
 - ``report``: The outputs of ``attitude fit``: the fitted scenario, the parameter table,
   the residuals, the uncertainty growth and a page, written through the output
   folder's rules.
-- ``scenario_model``: The fitted motion under known torques: gravity gradient on a
-  given orbit, burns, with known impulses, through the splitting of ``TorquedSolver``.
+- ``scenario_model``: The fitted motion under gravity gradient on a given orbit (with
+  the scenario's burns and known impulses), through the splitting of ``TorquedSolver``.
 - ``solve``: Least squares on the exact motion: robust, over a growing arc, from
   several starts, and never stopping in a local minimum.
 - ``statistics``: What a converged fit says about itself: the covariance, the goodness

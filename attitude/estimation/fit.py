@@ -4,7 +4,9 @@ The pipeline (docs/estimation.md): the telemetry is checked and cleaned
 (attitude.estimation.telemetry), each sensor's noise taken as given or estimated from
 the data's high differences, a body without motion in its own axes refused (a steady
 spin shows no inertia ratio, noise alone no motion at all); the linear first guess
-(attitude.estimation.linear_guess) gives the starts; least squares on the exact motion
+(attitude.estimation.linear_guess) gives the starts (for fixes too sparse for it, the
+global start of attitude.estimation.global_start, which reports every family of
+solutions the fixes allow); least squares on the exact motion
 over a growing arc (attitude.estimation.solve) keeps the first start that fits down to
 the noise; its covariance and goodness of fit (attitude.estimation.statistics) are then
 checked against what the data can show (``_observability``), and what they cannot
@@ -28,6 +30,7 @@ What is observable (checked, and stated in ``SpinStateFit.observability``):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -37,7 +40,8 @@ from scipy.spatial.transform import Rotation
 
 from attitude.base.errors import InputError
 from attitude.base.quantities import as_si_array, as_si_scalar
-from attitude.estimation.linear_guess import Guess, candidates, impulse_scale
+from attitude.estimation.burns import known_burns
+from attitude.estimation.linear_guess import Guess, candidates, impulse_scale, measured_rates
 from attitude.estimation.model import ExactModel, Impulse, Layout
 from attitude.estimation.solve import Data, FitRefused, Solution, fit_from_starts, residuals
 from attitude.estimation.statistics import Goodness, covariance, goodness
@@ -73,6 +77,11 @@ class SpinStateFit:
     t = 0; with attitude fixes, the attitude error at t = 0 (a body-axes rotation
     vector about ``attitude``); with the principal axes estimated, their error (a
     body-axes rotation vector about ``principal_axes``); with a gyro bias, the bias.
+
+    ``families``: every family of solutions that fits the data within the noise, best
+    χ² first, this fit the first; several (``ambiguous``) when sparse fixes do not
+    decide the number of turns between them: each is a ``SpinStateFit`` with its own
+    covariance, and none is more the answer than the others.
     """
 
     inertia_ratios: NDArray[np.float64]  # (1, I2/I1, I3/I1)
@@ -105,6 +114,14 @@ class SpinStateFit:
     _model: Any = field(repr=False)
     _x: NDArray[np.float64] = field(repr=False)
     _cov_x: NDArray[np.float64] = field(repr=False)
+    # Every family of solutions that fits within the noise, best first, this fit the
+    # first: several for sparse fixes whose turns between them the data do not decide.
+    families: list[SpinStateFit] = field(default_factory=list, repr=False)
+
+    @property
+    def ambiguous(self) -> bool:
+        """True when several families of solutions fit the data within the noise."""
+        return len(self.families) > 1
 
     @property
     def parameter_sigma(self) -> NDArray[np.float64]:
@@ -255,6 +272,18 @@ class SpinStateFit:
                 f", 1σ {np.degrees(self.attitude_sigma).max():.3g} deg"
             )
         lines.append(f"reduced chi2 {self.reduced_chi2:.4g}")
+        if self.ambiguous:
+            lines.append(
+                f"{len(self.families)} families of solutions fit within the noise (the data do "
+                "not decide between them):"
+            )
+            for k, family in enumerate(self.families):
+                r, s = family.inertia_ratios, family.inertia_ratios_sigma
+                ω = ", ".join(f"{v:.6g}" for v in family.angular_velocity)
+                lines.append(
+                    f"  family {k + 1}: 1 : {r[1]:.7g} ± {s[1]:.2g} : {r[2]:.7g} ± {s[2]:.2g}, "
+                    f"rate at t0 {ω} rad/s, reduced chi2 {family.reduced_chi2:.4g}"
+                )
         return "\n".join(lines + self.observability)
 
 
@@ -281,6 +310,7 @@ def fit_spin_state(
     torques: Any = None,
     orbit: Any = None,
     source: str = "telemetry",
+    progress: Callable[[str], None] | None = None,
 ) -> SpinStateFit:
     """Fit the exact torque-free motion to gyro rates and/or attitude quaternions.
 
@@ -293,7 +323,8 @@ def fit_spin_state(
         (N, 3) body rates, rad/s (or a ``Quantity``); rows of NaN where missing.
     quaternions
         (N, 4) attitude, body → ICRF, scalar first (w, x, y, z); rows of NaN where
-        missing.  q and −q are the same attitude.
+        missing.  q and −q are the same attitude.  Or a ``Rotation`` of N attitudes
+        (body → ICRF), one per time (a star tracker that reads at every time).
     gyro_sigma, attitude_sigma
         The white noise of each sensor: rad/s (one value or one per axis) and rad per
         axis (or ``Quantity``).  Estimated from the data when not given.
@@ -310,8 +341,10 @@ def fit_spin_state(
         absolute moments observable.
     guess
         A start instead of the linear guess (an ``EulerSolver`` at the first sample, in
-        body axes, or an earlier ``SpinStateFit``): for attitude fixes too sparse to
-        differentiate.
+        body axes, or an earlier ``SpinStateFit``).  Without one, fixes too sparse to
+        differentiate (radar passes a day apart, with the rates at each) are started by
+        a global search from the fixes themselves (attitude.estimation.global_start),
+        and every family of solutions that fits is reported (``families``).
     torques
         A ``ScenarioTorques`` (gravity gradient, burns) fitted through the splitting
         (``TorquedSolver``); None for the torque-free motion.
@@ -320,12 +353,17 @@ def fit_spin_state(
         ``Scenario(orbit=...)`` takes it.
     source
         The name used in messages (the file the telemetry came from).
+    progress
+        Told each stage as it starts or ends, with an estimate of the time left (one
+        line each; the command line writes them to stderr); None: silent.
 
     Returns a ``SpinStateFit``.  Raises ``FitRefused`` (an ``InputError``) when the
     telemetry cannot determine the fit, saying why: too short an arc, no motion, only
     local minima, a parameter the data leave undetermined.
     """
     telemetry = prepare_telemetry(times, angular_velocity, quaternions, source)
+    if telemetry.gyro_reads_zero:
+        _refuse_at_rest(telemetry)
     if telemetry.gyro is not None:
         fastest = float(np.max(np.abs(telemetry.gyro.values)))
         if fastest > MAX_RATE:
@@ -335,12 +373,16 @@ def fit_spin_state(
                 file=source,
             )
     notes = list(telemetry.notes)
+    say = progress or (lambda text: None)
     data, noise = _data(telemetry, gyro_sigma, attitude_sigma)
+    say(_described(telemetry, noise))
     _refuse_without_motion(telemetry, data)
     impulse_list = _impulses(impulses, telemetry)
-    has_burns = torques is not None and bool(getattr(torques, "burns", ()))
+    burns = known_burns(getattr(torques, "burns", ()), telemetry.epoch) if torques else ()
+    start, end = telemetry.span
+    has_burns = any(b.stop > start and b.start < end for b in burns)  # in the arc
     if gyro_bias and telemetry.gyro is None:
-        raise InputError("gyro_bias needs gyro rates", file=source)
+        raise InputError("needs gyro rates, and there are none", key="gyro_bias", file=source)
     layout = Layout(
         attitude=telemetry.attitude is not None,
         scale=bool(impulse_list) or has_burns,
@@ -361,17 +403,23 @@ def fit_spin_state(
                 "fixes: the torque depends on the attitude, which rates alone barely show",
                 file=source,
             )
-    model = _model(layout, impulse_list, torques, telemetry, orbit)
+    model = _model(layout, impulse_list, torques, telemetry, orbit, burns)
+    if guess is None and _too_sparse(telemetry, model):
+        say("fit: too sparse for the linear guess: the global start from the fixes")
+        return _global_fit(model, telemetry, data, noise, notes, say)
     starts, guess_text = _starts(model, telemetry, guess, principal_axes, data)
     notes.append(guess_text)
-    solution = fit_from_starts(starts, data)
+    say(f"fit: {len(starts)} start(s): {guess_text}")
+    solution = fit_from_starts(starts, data, say)
     notes += solution.notes
     if solution.tried:
         notes.append(
             f"{len(solution.tried)} start(s) rejected before the one kept ({solution.start}): "
             + "; ".join(solution.tried)
         )
-    return _result(solution, telemetry, noise, notes)
+    fit = _result(solution, telemetry, noise, notes)
+    fit.families = [fit]
+    return fit
 
 
 # ----------------------------------------------------------------- pieces
@@ -392,8 +440,10 @@ def _data(telemetry: Telemetry, gyro_sigma: Any, attitude_sigma: Any) -> tuple[D
             σ_g = difference_noise(g.t, g.values)
             if σ_g is None:
                 raise InputError(
-                    f"{telemetry.source}: the gyro samples are too few or too sparse to "
-                    "estimate their noise from the data: give gyro_sigma"
+                    "the gyro samples are too few or too sparse (20 or more sixth differences "
+                    "of evenly spaced readings are needed) to estimate their noise: give it",
+                    key="gyro_sigma",
+                    file=telemetry.source,
                 )
             σ_g = np.maximum(σ_g, 1e-300)
             noise["gyro"] = {
@@ -401,7 +451,9 @@ def _data(telemetry: Telemetry, gyro_sigma: Any, attitude_sigma: Any) -> tuple[D
                 "source": "estimated from 6th differences",
             }
         if np.any(σ_g <= 0.0):
-            raise InputError(f"gyro_sigma must be positive, got {σ_g.tolist()}")
+            raise InputError(
+                f"must be positive, got {σ_g.tolist()}", key="gyro_sigma", file=telemetry.source
+            )
     if a is not None:
         if attitude_sigma is not None:
             σ_a = as_si_scalar(attitude_sigma, "angle", "attitude_sigma")
@@ -410,12 +462,16 @@ def _data(telemetry: Telemetry, gyro_sigma: Any, attitude_sigma: Any) -> tuple[D
             σ_a = _attitude_noise(a.t, a.values)
             if σ_a is None:
                 raise InputError(
-                    f"{telemetry.source}: the attitude fixes are too few or too sparse to "
-                    "estimate their noise from the data: give attitude_sigma"
+                    "the attitude fixes are too few or too sparse (30 or more evenly spaced "
+                    "ones are needed) to estimate their noise: give it",
+                    key="attitude_sigma",
+                    file=telemetry.source,
                 )
             noise["attitude"] = {"sigma_rad": σ_a, "source": "estimated from 6th differences"}
         if not σ_a > 0.0:
-            raise InputError(f"attitude_sigma must be positive, got {σ_a!r}")
+            raise InputError(
+                f"must be positive, got {σ_a!r}", key="attitude_sigma", file=telemetry.source
+            )
     data = Data(
         None if g is None else g.t,
         None if g is None else g.values,
@@ -443,6 +499,33 @@ def _attitude_noise(t: NDArray[np.float64], q: NDArray[np.float64]) -> float | N
     return float(np.sqrt(np.mean(σ * σ))) or None
 
 
+def _refuse_at_rest(telemetry: Telemetry) -> None:
+    """A gyro that reads exactly zero: no rotation measured.  What that leaves to fit."""
+    turned = 0.0
+    a = telemetry.attitude
+    if a is not None and len(a) >= 2:
+        R = Rotation.from_quat(a.values, scalar_first=True)
+        turned = math.degrees(float(np.max((R[0].inv() * R).magnitude())))
+    said = "the gyro reads exactly 0 rad/s on every axis at every reading: no rotation is measured"
+    if turned > 1.0:
+        raise FitRefused(
+            f"{said}, while the attitude fixes turn by up to {turned:.3g} deg: a gyro that is "
+            "off or not connected; fit the attitude fixes alone (without the gyro's readings)",
+            file=telemetry.source,
+        )
+    attitude = (
+        f"its attitude is the star tracker's fixed reading (within {turned:.2g} deg)"
+        if a is not None
+        else "and without attitude fixes not even its attitude is known"
+    )
+    raise FitRefused(
+        f"{said} (a body at rest, or a gyro that is off): a body at rest shows no inertia "
+        f"ratio, no spin state and nothing to predict (the moments show only in a motion); "
+        f"{attitude}",
+        file=telemetry.source,
+    )
+
+
 def _refuse_without_motion(telemetry: Telemetry, data: Data) -> None:
     """A body whose rates do not vary beyond the gyro noise shows no inertia ratio."""
     if data.rates is None or data.σ_rates is None or data.rates.shape[0] < 10:
@@ -456,13 +539,15 @@ def _refuse_without_motion(telemetry: Telemetry, data: Data) -> None:
         mean = np.median(ω, axis=0)
         if np.all(np.abs(mean) < 5.0 * σ):
             raise FitRefused(
-                f"{telemetry.source}: noise only: the gyro reads no rotation beyond its noise "
-                f"({np.linalg.norm(σ):.3g} rad/s); there is no motion to fit"
+                f"noise only: the gyro reads no rotation beyond its noise "
+                f"({np.linalg.norm(σ):.3g} rad/s); there is no motion to fit",
+                file=telemetry.source,
             )
         raise FitRefused(
-            f"{telemetry.source}: a steady spin at {np.linalg.norm(mean):.6g} rad/s: the rates "
-            "do not vary beyond the gyro noise over the arc, and a spin about a principal "
-            "axis shows no inertia ratio (a longer arc, or a nutation, would)"
+            f"a steady spin at {np.linalg.norm(mean):.6g} rad/s: the rates do not vary beyond "
+            "the gyro noise over the arc, and a spin about a principal axis shows no inertia "
+            "ratio (a longer arc, or a nutation, would)",
+            file=telemetry.source,
         )
 
 
@@ -494,9 +579,13 @@ def _impulses(impulses: Any, telemetry: Telemetry) -> tuple[Impulse, ...]:
     return tuple(out)
 
 
-def _model(layout: Layout, impulses, torques, telemetry: Telemetry, orbit=None):
+def _model(layout: Layout, impulses, torques, telemetry: Telemetry, orbit=None, burns=()):
+    """The exact motion, across known impulses and burns (attitude.estimation.burns);
+    under gravity gradient, the propagated scenario (attitude.estimation.scenario_model)."""
     if torques is None or not getattr(torques, "any", True):
         return ExactModel(layout, impulses)
+    if getattr(torques, "gravity_gradient", None) is None:
+        return ExactModel(layout, impulses, burns)
     from attitude.estimation.scenario_model import ScenarioModel
 
     return ScenarioModel(
@@ -527,21 +616,37 @@ def _first_attitude(telemetry: Telemetry, moments, axes: Rotation, ω0) -> Rotat
 def _starts(model, telemetry: Telemetry, guess: Any, principal_axes: bool, data: Data):
     """(model, x, label, first arc end) for each start, and the guess's description."""
     impulses = getattr(model, "impulses", ())
+    # Burns in the exact model, or in the torques of a propagated one.
+    burns = model.burns or known_burns(
+        getattr(getattr(model, "torques", None), "burns", ()), telemetry.epoch
+    )
     if guess is not None:
         guesses = [_from_guess(guess)]
         text = "started from the guess given"
     else:
-        guesses, text = candidates(telemetry, principal_axes, tuple(i.t for i in impulses))
+        guesses, text = candidates(
+            telemetry,
+            principal_axes,
+            tuple(i.t for i in impulses),
+            tuple((b.start, b.stop) for b in burns),
+        )
     starts = []
     t_first = float(data.times[0])
     for g in guesses:
         Q0 = _first_attitude(telemetry, g.moments, g.axes, g.ω0)
-        if model.layout.scale and impulses:
+        if model.layout.scale:
             scale = impulse_scale(
-                telemetry, g.moments, g.axes, impulses, _rough_attitude(telemetry)
+                telemetry,
+                g.moments,
+                g.axes,
+                impulses,
+                _rough_attitude(telemetry),
+                burns,
             )
             if scale is not None:
-                g = Guess(g.moments * scale, g.axes, g.ω0, g.label + ", scale from the impulses")
+                g = Guess(
+                    g.moments * scale, g.axes, g.ω0, g.label + ", scale from the impulses or burns"
+                )
         m, x = model.start(g.moments, g.axes, g.ω0, Q0)
         try:
             period = EulerSolver(g.moments, g.moments * g.axes.inv().apply(g.ω0)).period
@@ -555,6 +660,58 @@ def _starts(model, telemetry: Telemetry, guess: Any, principal_axes: bool, data:
         first_end = t_first + min(0.5 * period if math.isfinite(period) else math.inf, turn)
         starts.append((m, x, g.label, first_end))
     return starts, text
+
+
+def _too_sparse(telemetry: Telemetry, model) -> bool:
+    """No run of samples is dense enough to differentiate: the linear first guess has
+    nothing to solve, and the global start (attitude.estimation.global_start) is used."""
+    impulses = getattr(model, "impulses", ())
+    burns = getattr(model, "burns", ())
+    breaks = tuple(i.t for i in impulses)
+    return measured_rates(telemetry, breaks, tuple((b.start, b.stop) for b in burns)) is None
+
+
+def _described(telemetry: Telemetry, noise: dict) -> str:
+    """One line on what is fitted: the samples of each sensor and their noise."""
+    parts = []
+    for sensor, name in ((telemetry.gyro, "gyro"), (telemetry.attitude, "attitude")):
+        if sensor is not None:
+            σ = noise[name].get("sigma_rad_s", noise[name].get("sigma_rad"))
+            σ_text = ", ".join(f"{v:.3g}" for v in σ) if isinstance(σ, list) else f"{float(σ):.3g}"
+            unit = "rad/s" if name == "gyro" else "rad"
+            parts.append(
+                f"{len(sensor)} {name} samples (σ {σ_text} {unit}, {noise[name]['source']})"
+            )
+    start, end = telemetry.span
+    return f"fit: {' and '.join(parts)} over {end - start:.6g} s"
+
+
+def _global_fit(model, telemetry: Telemetry, data: Data, noise: dict, notes: list[str], say=None):
+    """Every family of solutions of sparse fixes (attitude.estimation.global_start): the
+    best as the fit, all of them in its ``families``; the fit says when there are
+    several."""
+    from attitude.estimation.global_start import families
+
+    solutions, text = families(model, data, telemetry.source, say)
+    fits = [_result(s, telemetry, noise, [*notes, text]) for s in solutions]
+    if len(fits) > 1:
+        ranges = [
+            f"{name} {min(f.inertia_ratios[k] for f in fits):.6g} to "
+            f"{max(f.inertia_ratios[k] for f in fits):.6g}"
+            for k, name in ((1, "I2/I1"), (2, "I3/I1"))
+        ]
+        line = (
+            f"the fixes do not decide between {len(fits)} families of solutions (numbers "
+            f"of turns between the fixes) that fit within the noise: {', '.join(ranges)}; "
+            "each is in fit.families with its covariance (more fixes, or closer ones, "
+            "would decide)"
+        )
+        for k, f in enumerate(fits):
+            f.observability.insert(0, line)
+            f.notes.append(f"family {k + 1} of {len(fits)}, reduced chi2 {f.reduced_chi2:.4g}")
+    for f in fits:
+        f.families = fits
+    return fits[0]
 
 
 def _rough_attitude(telemetry: Telemetry):
@@ -742,17 +899,19 @@ def _observability(model, solver, telemetry, σ_y, index, ratios, I1) -> tuple[l
     if not math.isfinite(period) or arc < period:
         shown = "infinite (the separatrix)" if not math.isfinite(period) else f"{period:.6g} s"
         raise FitRefused(
-            f"{source}: the telemetry spans {arc:.6g} s, less than one period of the body's "
-            f"motion ({shown} by the best fit): the inertia ratios are not determined by it "
-            "(no fit is better than a wrong one); fit a longer arc"
+            f"the telemetry spans {arc:.6g} s, less than one period of the body's motion "
+            f"({shown} by the best fit): the inertia ratios are not determined by it (no fit "
+            "is better than a wrong one); fit a longer arc",
+            file=source,
         )
     for name, ratio in (("I2/I1", ratios[1]), ("I3/I1", ratios[2])):
         σ = σ_y[index[name]]
         if not σ <= RATIO_LIMIT * ratio:
             raise FitRefused(
-                f"{source}: {name} = {ratio:.6g} ± {σ:.3g}: the telemetry does not determine "
-                f"the inertia ratios (1σ beyond {RATIO_LIMIT:.0%}); a longer arc, or one "
-                "with more motion in the body axes, would"
+                f"{name} = {ratio:.6g} ± {σ:.3g}: the telemetry does not determine the inertia "
+                f"ratios (1σ beyond {RATIO_LIMIT:.0%}); a longer arc, or one with more motion "
+                "in the body axes, would",
+                file=source,
             )
     lines = []
     absolute = False
@@ -792,10 +951,11 @@ def _observability(model, solver, telemetry, σ_y, index, ratios, I1) -> tuple[l
         σ = [σ_y[index[f"axes_{a}"]] for a in "xyz"]
         if max(σ) > AXES_LIMIT_RAD:
             raise FitRefused(
-                f"{source}: the principal axes are not determined (1σ up to "
-                f"{math.degrees(max(σ)):.3g} deg, refused beyond "
-                f"{math.degrees(AXES_LIMIT_RAD):.0f} deg): a nearly symmetric body leaves them "
-                "free about its symmetry axis; fit without principal_axes"
+                f"the principal axes are not determined (1σ up to {math.degrees(max(σ)):.3g} "
+                f"deg, refused beyond {math.degrees(AXES_LIMIT_RAD):.0f} deg): a nearly "
+                "symmetric body leaves them free about its symmetry axis; fit without them",
+                key="principal_axes",
+                file=source,
             )
         lines.append(
             f"principal axes observable in the sensor frame to {math.degrees(max(σ)):.3g} deg"

@@ -35,7 +35,10 @@ from attitude.base.errors import InputError
 from attitude.environment.timescales import SAME_INSTANT_S
 from attitude.estimation.telemetry import Telemetry, _uniform_runs
 
-__all__ = ["Guess", "Rates", "candidates", "measured_rates"]
+__all__ = ["GUESS_SAMPLES", "Guess", "Rates", "candidates", "measured_rates"]
+
+# The guess is solved on at most this many readings of each sensor (the first ones).
+GUESS_SAMPLES = 50_000
 
 
 @dataclass(frozen=True)
@@ -69,19 +72,31 @@ def _window(dt: float, speed: float, length: int) -> int:
     return w if w % 2 else w - 1
 
 
-def measured_rates(telemetry: Telemetry, breaks: tuple[float, ...] = ()) -> Rates | None:
+def measured_rates(
+    telemetry: Telemetry,
+    breaks: tuple[float, ...] = (),
+    excluded: tuple[tuple[float, float], ...] = (),
+) -> Rates | None:
     """Body rates and ω̇ from the gyro (or, without one, from dense quaternions), over
     each evenly sampled run long enough for the filter, the runs cut at ``breaks``
-    (the times of impulses, where the rates jump); None if no run is."""
+    (the times of impulses, where the rates jump) and with the intervals ``excluded``
+    (known burns: not torque-free) left out; None if no run is."""
     t_parts, ω_parts, dω_parts, scaled_parts = [], [], [], []
     if telemetry.gyro is not None and len(telemetry.gyro) >= 7:
-        t, ω, source = telemetry.gyro.t, telemetry.gyro.values, "gyro"
+        # The first GUESS_SAMPLES readings: a guess needs the motion's shape (tens of
+        # periods), not every reading of a long arc.
+        t, ω, source = (
+            telemetry.gyro.t[:GUESS_SAMPLES],
+            telemetry.gyro.values[:GUESS_SAMPLES],
+            "gyro",
+        )
     elif telemetry.attitude is not None and len(telemetry.attitude) >= 8:
-        q = telemetry.attitude.values
+        q = telemetry.attitude.values[:GUESS_SAMPLES]
         R = Rotation.from_quat(q, scalar_first=True)
-        steps = np.diff(telemetry.attitude.t)
+        fixes = telemetry.attitude.t[:GUESS_SAMPLES]
+        steps = np.diff(fixes)
         increments = (R[:-1].inv() * R[1:]).as_rotvec()  # body axes, ≈ ω dt
-        t = telemetry.attitude.t[:-1] + 0.5 * steps
+        t = fixes[:-1] + 0.5 * steps
         ω, source = increments / steps[:, None], "quaternions"
     else:
         return None
@@ -90,13 +105,19 @@ def measured_rates(telemetry: Telemetry, breaks: tuple[float, ...] = ()) -> Rate
     W = speed or 1.0
     runs = []
     for run in _uniform_runs(t):
+        edges = [e for interval in excluded for e in interval]
         cuts = [
             run.start,
             *(int(np.searchsorted(t, b - SAME_INSTANT_S)) for b in breaks),
+            *(int(np.searchsorted(t, e)) for e in edges),
             run.stop,
         ]
         cuts = sorted(c for c in set(cuts) if run.start <= c <= run.stop)
-        runs += [slice(a, b) for a, b in itertools.pairwise(cuts) if b > a]
+        runs += [
+            slice(a, b)
+            for a, b in itertools.pairwise(cuts)
+            if b > a and not any(lo <= t[a] < hi for lo, hi in excluded)
+        ]
     for run in runs:
         n = run.stop - run.start
         if n < 7:
@@ -155,26 +176,29 @@ def _positive(v: NDArray[np.float64]) -> NDArray[np.float64] | None:
 
 
 def candidates(
-    telemetry: Telemetry, principal_axes: bool, breaks: tuple[float, ...] = ()
+    telemetry: Telemetry,
+    principal_axes: bool,
+    breaks: tuple[float, ...] = (),
+    excluded: tuple[tuple[float, float], ...] = (),
 ) -> tuple[list[Guess], str]:
     """The starts of the fit, best first, and a line describing the linear guess.
 
     Raises :class:`InputError` if the telemetry gives no rates to solve for (sparse
     attitude fixes alone: give the fit a guess) or the rates fit no rigid body.
     """
-    rates = measured_rates(telemetry, breaks)
+    rates = measured_rates(telemetry, breaks, excluded)
     if rates is None:
         raise InputError(
-            f"{telemetry.source}: the samples are too sparse for the linear first guess (it "
-            "needs runs of 7 or more evenly spaced gyro readings or 8 quaternions close enough "
-            "to differentiate): give a guess (an EulerSolver or an earlier fit)"
+            "the samples are too sparse for the linear first guess (it needs runs of 7 or "
+            "more evenly spaced gyro readings or 8 quaternions close enough to differentiate)",
+            file=telemetry.source,
         )
     # Euler's equations are homogeneous of degree 2 in (ω, ω̇/W): scaled by the typical
     # rate W, the rows are of order one whatever the units (no underflow or overflow).
     ω, dω = rates.ω / rates.W, rates.ω_dot_scaled
     rows = _tensor_rows(ω, dω) if principal_axes else _principal_rows(ω, dω)
     if not np.all(np.isfinite(rows)):
-        raise InputError(f"{telemetry.source}: the rates' products overflow: rates too large")
+        raise InputError("the rates' products overflow: rates too large", file=telemetry.source)
     scale = np.linalg.norm(rows, axis=0)
     scale[scale == 0.0] = 1.0
     _, s, Vt = np.linalg.svd(rows / scale, full_matrices=False)
@@ -207,9 +231,10 @@ def candidates(
             )
     if not guesses:
         raise InputError(
-            f"{telemetry.source}: the measured rates follow Euler's equations of no rigid body "
-            f"(the linear guess gives moments of both signs; smallest singular values "
-            f"{s[-1]:.3g}, {s[-2]:.3g}): torques, a biased or mislabelled gyro, or noise alone?"
+            f"the measured rates follow Euler's equations of no rigid body (the linear guess "
+            f"gives moments of both signs; smallest singular values {s[-1]:.3g}, "
+            f"{s[-2]:.3g}): torques, a biased or mislabelled gyro, or noise alone?",
+            file=telemetry.source,
         )
     out = []
     for moments, axes, label in guesses:
@@ -242,42 +267,79 @@ def _mirror(moments: NDArray[np.float64], ω: NDArray[np.float64]) -> NDArray[np
     return out
 
 
+def _side_rate(gyro, at: float, before: bool) -> NDArray[np.float64] | None:
+    """The gyro rate at ``at`` from a quadratic through the five nearest readings on
+    one side (before it, or at or after it); None with fewer than three there."""
+    index = np.flatnonzero(gyro.t < at if before else gyro.t >= at)
+    nearest = index[np.argsort(np.abs(gyro.t[index] - at))[:5]]
+    if nearest.size < 3:
+        return None
+    τ = gyro.t[nearest] - at
+    design = np.stack([np.ones_like(τ), τ, τ * τ], axis=1)
+    coefficients, *_ = np.linalg.lstsq(design, gyro.values[nearest], rcond=None)
+    return np.asarray(coefficients[0])  # the quadratic's value at ``at``
+
+
 def impulse_scale(
-    telemetry: Telemetry, moments: NDArray[np.float64], axes: Rotation, impulses, attitude
+    telemetry: Telemetry,
+    moments: NDArray[np.float64],
+    axes: Rotation,
+    impulses,
+    attitude,
+    burns=(),
 ) -> float | None:
-    """The first moment I1 (kg m²) that makes the measured jumps of the rates at known
-    impulses match Δω = I⁻¹ ΔH for the guessed ratios: a linear least squares in 1/I1,
-    with each side's rate at the impulse from a quadratic through its five nearest gyro
-    readings; None without a gyro reading on both sides.  ``attitude``: a rough Q(t)
-    (for impulses in inertial axes), or None."""
+    """The factor c that makes the moments c · ``moments`` change the measured rates
+    across the known impulses and burns as they did: a linear least squares in 1/c, in
+    the rates (where the errors of the measured changes are), over
+
+    - each impulse: ω⁺ − ω⁻ = (1/c) ΔH / r (principal axes, r the guessed moments),
+      each side's rate at the impulse from a quadratic through its five nearest readings;
+    - each body burn, Euler's equations integrated over [a, b]:
+      ω(b) − ω(a) + [∫ ω × (r ω) dt] / r = (1/c) Aᵀ Γ (b − a) / r, the integral by the
+      trapezoidal rule over the readings within it;
+    - each inertial burn, the inertial momentum's change seen in the body at b:
+      ω(b) − [R (r ω(a))] / r = (1/c) (Q(b) A)ᵀ Γ (b − a) / r, with R = (Q(b) A)ᵀ Q(a) A
+      and Q from the nearest attitude fix.
+
+    None without gyro readings on both sides.  ``attitude``: a rough Q(t) (for inertial
+    axes), or None; ``burns``: ``KnownBurn`` s (attitude.estimation.burns)."""
     gyro = telemetry.gyro
     if gyro is None:
         return None
-    a_rows, jumps = [], []
+    A = axes.inv()
+    a_rows, changes = [], []  # changes = (1/c) a_rows, stacked
     for impulse in impulses:
-        sides = []
         at = impulse.t - SAME_INSTANT_S  # a reading a nanosecond before is after it
-        for mask in (gyro.t < at, gyro.t >= at):
-            index = np.flatnonzero(mask)
-            nearest = index[np.argsort(np.abs(gyro.t[index] - impulse.t))[:5]]
-            if nearest.size < 3:
-                break
-            τ = gyro.t[nearest] - impulse.t
-            design = np.stack([np.ones_like(τ), τ, τ * τ], axis=1)
-            coefficients, *_ = np.linalg.lstsq(design, gyro.values[nearest], rcond=None)
-            sides.append(coefficients[0])  # the quadratic's value at the impulse
-        if len(sides) < 2:
+        before, after = _side_rate(gyro, at, True), _side_rate(gyro, at, False)
+        if before is None or after is None:
             continue
         ΔH = impulse.vector
         if impulse.frame != "body":
             if attitude is None:
                 continue
             ΔH = attitude(impulse.t).inv().apply(ΔH)
-        # In principal axes: Δω_p = ΔH_p / (I1 r), r the ratios.
-        a_rows.append(axes.inv().apply(ΔH) / moments)
-        jumps.append(axes.inv().apply(sides[1] - sides[0]))
+        a_rows.append(A.apply(ΔH) / moments)
+        changes.append(A.apply(after - before))
+    for burn in burns:
+        a, b = max(burn.start, float(gyro.t[0])), min(burn.stop, float(gyro.t[-1]))
+        ω_a, ω_b = _side_rate(gyro, a, True), _side_rate(gyro, b, False)
+        if not b > a or ω_a is None or ω_b is None:
+            continue
+        if burn.frame == "body":
+            within = (gyro.t > a) & (gyro.t < b)
+            t = np.concatenate([[a], gyro.t[within], [b]])
+            ω = A.apply(np.concatenate([[ω_a], gyro.values[within], [ω_b]]))
+            turning = np.cross(ω, moments * ω)
+            integral = 0.5 * np.sum((turning[1:] + turning[:-1]) * np.diff(t)[:, None], axis=0)
+            a_rows.append(A.apply(burn.torque) * (b - a) / moments)
+            changes.append(ω[-1] - ω[0] + integral / moments)
+        elif attitude is not None:
+            P_a, P_b = attitude(a) * axes, attitude(b) * axes  # principal -> ICRF
+            carried = (P_b.inv() * P_a).apply(moments * A.apply(ω_a)) / moments
+            a_rows.append(P_b.inv().apply(burn.torque) * (b - a) / moments)
+            changes.append(A.apply(ω_b) - carried)
     if not a_rows:
         return None
-    a, Δω = np.concatenate(a_rows), np.concatenate(jumps)
-    u = float(a @ Δω) / float(a @ a) if float(a @ a) > 0 else 0.0
-    return 1.0 / u if u > 0 else None
+    rows, measured = np.concatenate(a_rows), np.concatenate(changes)
+    u = float(rows @ measured) / float(rows @ rows) if float(rows @ rows) > 0 else 0.0
+    return 1.0 / u if u > 0.0 and math.isfinite(1.0 / u) else None

@@ -22,22 +22,27 @@ Logarithms keep the moments positive; a rotation vector about a reference that t
 moves between its stages (``recentred``) keeps the attitude and the axes away from
 their singularities.
 
-``ExactModel`` is the torque-free motion with known angular impulses: ``EulerSolver``
-between the impulses, and the Jacobian from the exact flow's sensitivities
-(attitude.solver.sensitivities) chained through each impulse by the chain rule.
+``ExactModel`` is the torque-free motion with known angular impulses and burns:
+``EulerSolver`` between them, and the Jacobian from the exact flow's sensitivities
+(attitude.solver.sensitivities) chained through each impulse by the chain rule, and
+across each burn by the variational equations integrated with the motion
+(attitude.estimation.burns).
 ``ScenarioModel`` (attitude.estimation.scenario_model) is the same interface over a
-propagated scenario (gravity gradient, burns), with a finite-difference Jacobian.
+propagated scenario (gravity gradient), with a finite-difference Jacobian.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial.transform import Rotation
 
+from attitude.base.errors import InputError
 from attitude.environment.timescales import SAME_INSTANT_S
+from attitude.estimation.burns import KnownBurn, burn_flow, torque_pieces
 from attitude.solver.euler_solver import EulerSolver
 from attitude.solver.sensitivities import flow_sensitivities, skew
 
@@ -62,6 +67,14 @@ def right_jacobian(φ: NDArray[np.float64]) -> NDArray[np.float64]:
     return np.eye(3) - a * K + b * (K @ K)
 
 
+def _inside(times: NDArray[np.float64] | None, lo: float, hi: float) -> NDArray[np.intp] | None:
+    """The indices of ``times`` in [lo, hi), or None (no times, or none there)."""
+    if times is None:
+        return None
+    inside = np.flatnonzero((times >= lo) & (times < hi))
+    return inside if inside.size else None
+
+
 def left_jacobian_inverse(r: NDArray[np.float64]) -> NDArray[np.float64]:
     """J_l(r)⁻¹ for each row of r (N, 3): log(exp([a]×) exp([r]×)) = r + J_l(r)⁻¹ a."""
     angle = np.linalg.norm(r, axis=1)
@@ -74,6 +87,9 @@ def left_jacobian_inverse(r: NDArray[np.float64]) -> NDArray[np.float64]:
         )
     return np.eye(3) - 0.5 * K + c[:, None, None] * (K @ K)
 
+
+# Times evaluated at once for the Jacobian (a bound on the memory of a long arc).
+_CHUNK = 65_536
 
 # One solver's stretch of a prediction: m_p (N, 3), Q_p (a Rotation, or None when the
 # attitude is not needed) and ∂(δθ_p, m_p)/∂x (N, 6, n, or None without the Jacobian).
@@ -150,6 +166,7 @@ class ExactModel:
 
     layout: Layout
     impulses: tuple[Impulse, ...] = ()
+    burns: tuple[KnownBurn, ...] = ()
     Q_ref: Rotation = field(default_factory=Rotation.identity)
     A_ref: Rotation = field(default_factory=Rotation.identity)
     rate_unit: float = 1.0  # rad/s
@@ -258,43 +275,72 @@ class ExactModel:
         L = self.layout
         J, A, m_p, Q_p, D = self._initial(x)
         Ar = A.as_matrix()
-        need_attitude = t_attitude is not None or any(i.frame != "body" for i in self.impulses)
+        need_attitude = (
+            t_attitude is not None
+            or any(i.frame != "body" for i in self.impulses)
+            or any(b.frame != "body" for b in self.burns)
+        )
         rates, attitudes = Prediction(), Prediction()
         pieces: dict[str, list[tuple[NDArray[np.intp], _Piece]]] = {"rates": [], "attitude": []}
-        events = sorted(self.impulses, key=lambda i: i.t)
-        # A sample within a nanosecond before an impulse is at it, and after it (the
-        # scenarios' rule: an epoch's outputs are the post-event state).
-        bounds = [-np.inf] + [e.t - SAME_INSTANT_S for e in events] + [np.inf]
-        t0 = 0.0
-        for k in range(len(bounds) - 1):
-            solver = EulerSolver(J, m_p, Q_p, t0)
-            lo, hi = bounds[k], bounds[k + 1]
-            for name, times in (("rates", t_rates), ("attitude", t_attitude)):
-                if times is None:
-                    continue
-                inside = np.flatnonzero((times >= lo) & (times < hi))
-                if inside.size == 0:
-                    continue
-                pieces[name].append(
-                    (inside, self._segment(solver, times[inside], D, J, need_attitude, jacobian))
-                )
-            if k == len(events):
-                break
-            event = events[k]
-            m_at, Q_at, dY_at = self._segment(
-                solver, np.array([event.t]), D, J, need_attitude, True
-            )
-            assert dY_at is not None and (Q_at is not None or not need_attitude)  # asked for
-            m_end, Q_end, dY = m_at[0], Q_at[0] if Q_at is not None else Q_p, dY_at[0]
-            D = np.concatenate([dY, D[6:9]], axis=0)
-            if event.frame == "body":
-                Δm = Ar.T @ event.vector
-                if L.axes:
-                    D[3:6, L.block("α")] += skew(Δm) @ right_jacobian(x[L.block("α")])
+        wanted = {"rates": t_rates, "attitude": t_attitude}
+        t0, lo = 0.0, -np.inf
+        for t_end, torque, impulses in self._time_line():
+            # A sample within a nanosecond before an impulse is at it, and after it (the
+            # scenarios' rule: an epoch's outputs are the post-event state); a burn's
+            # edges are where the motion is continuous.
+            hi = t_end - SAME_INSTANT_S if impulses else t_end
+            last = not math.isfinite(t_end)
+            if torque is None:
+                # One evaluation of the piece for every sample in it and its end (the
+                # solver's constants and their gradients once).
+                solver = EulerSolver(J, m_p, Q_p, t0)
+                chosen = [
+                    (name, inside)
+                    for name, times in wanted.items()
+                    if (inside := _inside(times, lo, hi)) is not None
+                ]
+                parts = [wanted[name][inside] for name, inside in chosen]  # type: ignore[index]
+                if not last:
+                    parts.append(np.array([t_end]))
+                if parts:
+                    m_at, Q_at, dY_at = self._segment(
+                        solver, np.concatenate(parts), D, J, need_attitude, jacobian
+                    )
+                first = 0
+                for name, inside in chosen:
+                    part = slice(first, first + inside.size)
+                    first += inside.size
+                    pieces[name].append(
+                        (
+                            inside,
+                            (
+                                m_at[part],
+                                None if Q_at is None else Q_at[part],
+                                None if dY_at is None else dY_at[part],
+                            ),
+                        )
+                    )
+                if last:
+                    break
+                m_end = m_at[-1]
+                Q_end = Q_at[-1] if Q_at is not None else Q_p
+                dY = dY_at[-1] if dY_at is not None else None
             else:
-                Δm = Q_end.inv().apply(event.vector)
-                D[3:6] += skew(Δm) @ D[0:3]
-            m_p, Q_p, t0 = m_end + Δm, Q_end, event.t
+                m_end, Q_end, dY = self._across_burn(
+                    x, J, Ar, m_p, Q_p, D, t0, t_end, lo, hi, torque, wanted, pieces, jacobian
+                )
+            if dY is not None:
+                D = np.concatenate([dY, D[6:9]], axis=0)
+            for event in impulses:
+                if event.frame == "body":
+                    Δm = Ar.T @ event.vector
+                    if L.axes:
+                        D[3:6, L.block("α")] += skew(Δm) @ right_jacobian(x[L.block("α")])
+                else:
+                    Δm = Q_end.inv().apply(event.vector)
+                    D[3:6] += skew(Δm) @ D[0:3]
+                m_end = m_end + Δm
+            m_p, Q_p, t0, lo = m_end, Q_end, t_end, hi
         ω_scale = 1.0 / J
         if t_rates is not None:
             m_all = np.empty((t_rates.size, 3))
@@ -333,6 +379,73 @@ class ExactModel:
             attitudes.dθ = dθ
         return rates, attitudes
 
+    def _time_line(self):
+        """The motion's pieces from t = 0: (end, torque, impulses at the end), with
+        torque None where the motion is torque-free and (Γ_body, Γ_inertial) over a
+        burn; the last piece ends at +inf."""
+        pieces = torque_pieces(self.burns)
+        edges = {e for a, b, _, _ in pieces for e in (a, b)} - {0.0}
+        breaks = sorted({i.t for i in self.impulses} | edges)
+        on = {a: (Γ_b, Γ_i) for a, _, Γ_b, Γ_i in pieces}
+        t0 = 0.0
+        for t_end in [*breaks, math.inf]:
+            impulses = [i for i in self.impulses if i.t == t_end]  # in the order given
+            yield t_end, on.get(t0), impulses
+            t0 = t_end
+
+    def _across_burn(
+        self, x, J, Ar, m_p, Q_p, D, t0, t_end, lo, hi, torque, wanted, pieces, jacobian
+    ):
+        """A piece of a burn: the samples in [lo, hi) (attitude.estimation.burns), and
+        the state (with its derivative, if asked) at its end."""
+        L = self.layout
+        Γ_b, Γ_i = torque
+        g_b = Ar.T @ Γ_b  # the body torque in the principal axes
+        G_α = None
+        if jacobian and L.axes:  # g_b = Aᵀ Γ_b moves with the axes
+            G_α = np.zeros((3, L.size))
+            G_α[:, L.block("α")] = skew(g_b) @ right_jacobian(x[L.block("α")])
+        if t0 <= 0.0 and any(t is not None and np.any(t < 0.0) for t in wanted.values()):
+            raise InputError(
+                "the motion before t = 0 under a burn on at t = 0 is not modelled: "
+                "times before the first sample"
+            )
+        index, times = [], []
+        for t in wanted.values():
+            inside = _inside(t, lo, hi)
+            index.append(inside)
+            times.append(np.empty(0) if inside is None or t is None else t[inside])
+        flow = burn_flow(
+            J,
+            m_p,
+            Q_p,
+            D[0:6] if jacobian else None,
+            D[6:9] if jacobian else None,
+            t0,
+            t_end,
+            np.concatenate(times),
+            g_b,
+            Γ_i,
+            G_α,
+        )
+        first = 0
+        for name, inside, t in zip(wanted, index, times, strict=True):
+            if inside is None:
+                continue
+            part = slice(first, first + t.size)
+            first += t.size
+            pieces[name].append(
+                (
+                    inside,
+                    (
+                        flow.m[part],
+                        flow.attitude[part],
+                        None if flow.jacobian is None else flow.jacobian[part],
+                    ),
+                )
+            )
+        return flow.m_end, flow.attitude_end, flow.jacobian_end
+
     @staticmethod
     def _segment(solver: EulerSolver, times, D, J, attitude: bool, jacobian: bool) -> _Piece:
         """m_p (N, 3), Q_p (Rotation, or None) and ∂(δθ_p, m_p)/∂x (N, 6, n) at ``times``."""
@@ -340,9 +453,25 @@ class ExactModel:
             m = solver.angular_momentum(times)
             R = solver.attitude(times) if attitude else None
             return m, R, None
-        sens = flow_sensitivities(solver, times, attitude=attitude)
-        jac = sens.jacobian
-        if not attitude:  # the attitude rows are not computed, and nothing needs them
-            jac = jac.copy()
-            jac[:, 0:3, :] = 0.0
-        return sens.angular_momentum, sens.attitude, np.einsum("nij,jp->nip", jac, D)
+        if times.size <= _CHUNK:
+            sens = flow_sensitivities(solver, times, attitude=attitude)
+            jac = sens.jacobian
+            if not attitude:  # the attitude rows are not computed, and nothing needs them
+                jac[:, 0:3, :] = 0.0
+            return sens.angular_momentum, sens.attitude, np.einsum("nij,jp->nip", jac, D)
+        # In chunks: the sensitivities' (N, 6, 9) of a long arc need not all exist at once.
+        m = np.empty((times.size, 3))
+        out = np.empty((times.size, 6, D.shape[1]))
+        quats = np.empty((times.size, 4)) if attitude else None
+        for first in range(0, times.size, _CHUNK):
+            part = slice(first, first + _CHUNK)
+            sens = flow_sensitivities(solver, times[part], attitude=attitude)
+            jac = sens.jacobian
+            if not attitude:  # the attitude rows are not computed, and nothing needs them
+                jac[:, 0:3, :] = 0.0
+            m[part] = sens.angular_momentum
+            np.einsum("nij,jp->nip", jac, D, out=out[part])
+            if quats is not None and sens.attitude is not None:
+                quats[part] = sens.attitude.as_quat()
+        R = Rotation.from_quat(quats) if quats is not None else None
+        return m, R, out

@@ -22,12 +22,14 @@ the user's is ever replaced, and nothing half-written is left).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from html import escape
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from attitude.base.errors import InputError
 from attitude.base.version import __version__
@@ -38,6 +40,7 @@ from attitude.environment.timescales import (
     tt_seconds,
 )
 from attitude.estimation.fit import DEFAULT_HORIZON_DEG, SpinStateFit
+from attitude.estimation.global_start import MAX_FAMILIES
 from attitude.outputs.folder import claim
 from attitude.report.page import _STYLE, _figures_and_files, _table
 from attitude.report.summaries import write_json
@@ -46,6 +49,7 @@ __all__ = ["OUTPUT_NAMES", "FitContext", "scenario_document", "write_fit_report"
 
 OUTPUT_NAMES = (
     "fitted_scenario.toml",
+    *(f"fitted_scenario_family_{k}.toml" for k in range(2, MAX_FAMILIES + 1)),
     "parameters.csv",
     "correlations.csv",
     "fit.json",
@@ -54,8 +58,12 @@ OUTPUT_NAMES = (
     "uncertainty.png",
     "report.html",
 )
-# The fitted scenario's span: the prediction horizon, within these bounds.
+# The fitted scenario's span: the prediction horizon, within 30 days and this many
+# output steps (about 15 MB of `attitude run`'s default outputs at 20 000).
 MAX_DURATION_S = 30 * 86400.0
+MAX_OUTPUT_STEPS = 20_000
+# The residuals' figure draws at most this many samples a sensor (and every outlier).
+PLOTTED_POINTS = 20_000
 
 
 @dataclass
@@ -116,10 +124,13 @@ def scenario_document(
     # Beyond the horizon search (30 arcs under torques, whose propagation costs per
     # second of span), the span stops where the search did.
     searched = (30.0 if getattr(fit._model, "torques", None) else 1e6) * (end - fit.span[0])
-    reach = horizon_s if math.isfinite(horizon_s) else end + searched
-    duration = min(max(reach, end), MAX_DURATION_S)
-    period = fit.period if math.isfinite(fit.period) else duration
-    step = min(duration / 1000.0, period / 20.0)
+    reach = min(max(horizon_s if math.isfinite(horizon_s) else end + searched, end), MAX_DURATION_S)
+    document["output"] = {"duration": float(reach), "step": float(reach)}
+    shortest = _shortest_period(document, context)
+    # The step `attitude check` accepts (a tenth of the motion's shortest period, to 3
+    # digits, down), and at most MAX_OUTPUT_STEPS of it: a sensible size of outputs.
+    step = _three_digits_down(0.1 * shortest) if math.isfinite(shortest) else reach / 1000.0
+    duration = min(reach, MAX_OUTPUT_STEPS * step)
     document["output"] = {"duration": float(duration), "step": float(step)}
     if context.pointing:
         document["pointing"] = context.pointing
@@ -151,6 +162,14 @@ def scenario_document(
         f"chi2 {fit.reduced_chi2:.4g}.",
         *fit.observability,
     ]
+    if len(fit.families) > 1:
+        k = next((i for i, f in enumerate(fit.families) if f is fit), 0) + 1
+        comments.append(
+            f"Family {k} of {len(fit.families)}: the data do not decide between "
+            f"{len(fit.families)} families of solutions that fit within the noise; each has "
+            "its scenario (fitted_scenario.toml, fitted_scenario_family_2.toml, ...) and "
+            "its parameters in fit.json."
+        )
     if dropped:
         comments.append(
             f"{dropped} impulse(s) or burn(s) of {context.source} start before the epoch: "
@@ -170,17 +189,59 @@ def scenario_document(
         when = _epoch_text(time_from_tt_seconds(fit.epoch, horizon_s), scale)
         comments.append(
             f"Prediction horizon: the 1σ attitude uncertainty reaches {DEFAULT_HORIZON_DEG:g} deg "
-            f"{horizon_s:.6g} s after the epoch ({when} {scale.upper()}); output.duration is "
-            "set to it"
-            + (f", capped at {MAX_DURATION_S / 86400:g} days" if duration < horizon_s else "")
-            + "."
+            f"{horizon_s:.6g} s after the epoch ({when} {scale.upper()})."
         )
     else:
         comments.append(
             f"The 1σ attitude uncertainty stays below {DEFAULT_HORIZON_DEG:g} deg as far as it was "
-            f"searched; output.duration is {duration:.6g} s."
+            "searched."
         )
+    comments.append(
+        f"output.step is a tenth of the motion's shortest period ({shortest:.6g} s), the step "
+        "`attitude check` takes as sampling the motion; output.duration is the prediction "
+        f"horizon, at most {MAX_DURATION_S / 86400:g} days and {MAX_OUTPUT_STEPS} steps "
+        f"(about 15 MB of `attitude run`'s default outputs)"
+        + (
+            f": here {duration:.6g} s, short of the horizon (set a longer one to predict further)"
+            if duration < min(horizon_s, MAX_DURATION_S)
+            else ""
+        )
+        + "."
+    )
     return document, comments
+
+
+def _shortest_period(document: dict[str, Any], context: FitContext) -> float:
+    """The shortest period `attitude check` reads in the fitted scenario's torque-free
+    motion (body, spin, nutation, precession, flips: attitude.trajectory.motion's
+    undersampling rule), over its span and across its impulses; inf if none."""
+    from attitude.files.scenario_reader import scenario_from_document
+    from attitude.trajectory.motion import analyze
+    from attitude.trajectory.trajectory import propagate
+
+    free = {k: v for k, v in document.items() if k not in ("torques", "pointing")}
+    scenario = scenario_from_document(Path("fitted_scenario.toml"), free).scenario
+    trajectory = propagate(scenario)
+    periods = [math.inf]
+    for item in analyze(trajectory, locate=False):
+        for period in (
+            item.period_s,
+            item.spin_period_s,
+            item.nutation_period_s,
+            item.precession_period_s,
+            item.flip_period_s,
+        ):
+            if period is not None and math.isfinite(period) and period > 0.0:
+                periods.append(period)
+    return min(periods)
+
+
+def _three_digits_down(value: float) -> float:
+    """``value`` rounded down to three significant digits (a step to read)."""
+    if not value > 0.0:
+        return value
+    scale = 10.0 ** (math.floor(math.log10(value)) - 2)
+    return math.floor(value / scale) * scale
 
 
 def _summary(fit: SpinStateFit, horizon_s: float, source: str) -> dict[str, Any]:
@@ -237,6 +298,33 @@ def _summary(fit: SpinStateFit, horizon_s: float, source: str) -> dict[str, Any]
         "prediction_horizon_threshold_deg": DEFAULT_HORIZON_DEG,
         "outliers": outliers,
         "notes": fit.notes,
+        "families": [_family(k, family) for k, family in enumerate(fit.families or [fit])],
+    }
+
+
+def _family(k: int, family: SpinStateFit) -> dict[str, Any]:
+    """A family of solutions in fit.json: its parameters, covariance and χ²."""
+    return {
+        "family": k + 1,
+        "scenario": "fitted_scenario.toml" if k == 0 else f"fitted_scenario_family_{k + 1}.toml",
+        "inertia_ratios": family.inertia_ratios,
+        "inertia_ratios_sigma": family.inertia_ratios_sigma,
+        "angular_velocity_rad_s": family.angular_velocity,
+        "angular_velocity_sigma_rad_s": family.angular_velocity_sigma,
+        "parameters": [
+            {"name": n, "value": v, "sigma": s, "unit": u}
+            for n, v, s, u in zip(
+                family.parameter_names,
+                family.parameter_values,
+                family.parameter_sigma,
+                family.parameter_units,
+                strict=True,
+            )
+        ],
+        "covariance": family.covariance,
+        "reduced_chi2": family.reduced_chi2,
+        "chi2": family.goodness.chi2,
+        "degrees_of_freedom": family.goodness.dof,
     }
 
 
@@ -247,11 +335,17 @@ def write_fit_report(
     name: str,
     context: FitContext | None = None,
     horizon_s: float | None = None,
+    progress: Callable[[str], None] | None = None,
 ) -> list[str]:
-    """Write the outputs (module docstring) into ``out_dir``; the names written."""
+    """Write the outputs (module docstring) into ``out_dir``; the names written.
+    ``progress`` is told each stage (the horizon's search, the writing)."""
+    say = progress or (lambda text: None)
     folder = claim(out_dir, OUTPUT_NAMES)
+    if horizon_s is None:
+        say("the prediction horizon: where the 1σ attitude uncertainty reaches 10 deg")
     horizon = fit.horizon() if horizon_s is None else horizon_s
     document, comments = scenario_document(fit, name, horizon, context, source)
+    say(f"writing {', '.join(n for n in OUTPUT_NAMES if not n.startswith('fitted_scenario_'))}")
 
     def build(tmp: Path) -> list[str]:
         from attitude.files.scenario_reader import scenario_from_document
@@ -261,6 +355,15 @@ def write_fit_report(
         path = tmp / "fitted_scenario.toml"
         path.write_text(text, encoding="utf-8")
         scenario_from_document(path, document)  # what we write, attitude run reads
+        written = ["fitted_scenario.toml"]
+        for k, family in enumerate(fit.families[1:], start=2):  # the others, as much
+            other, lines = scenario_document(
+                family, f"{name} (family {k})", family.horizon(), context, source
+            )
+            path = tmp / f"fitted_scenario_family_{k}.toml"
+            path.write_text(scenario_text(other, lines), encoding="utf-8")
+            scenario_from_document(path, other)
+            written.append(path.name)
         summary = _summary(fit, horizon, source)
         write_json(tmp / "fit.json", summary)
         _parameters_csv(fit, tmp)
@@ -270,7 +373,7 @@ def write_fit_report(
             "Prediction uncertainty": _plot_uncertainty(fit, horizon, tmp / "uncertainty.png"),
         }
         files = [
-            "fitted_scenario.toml",
+            *written,
             "parameters.csv",
             "correlations.csv",
             "fit.json",
@@ -300,19 +403,47 @@ def _parameters_csv(fit: SpinStateFit, tmp: Path) -> None:
 
 
 def _residuals_csv(fit: SpinStateFit, path: Path) -> None:
-    lines = [
+    """residuals.csv, written by Arrow's CSV writer (its doubles read back to the bit;
+    a million rows in a second, where Python's formatting took fourteen); the
+    normalized residuals to six digits."""
+    import pyarrow as pa
+    from pyarrow import csv as pa_csv
+
+    header = (
         "# residuals of attitude fit: measured minus fitted. gyro: rad/s, body axes; "
         "attitude: rad, the body-axes rotation vector of fitted^-1 * measured; "
-        "normalized: divided by the noise sigma; inlier: 0 for an outlier",
-        "sensor,t_s,residual_x,residual_y,residual_z,normalized_x,normalized_y,normalized_z,inlier",
-    ]
-    for sensor, block in fit.residuals.items():
-        rows = zip(block["t"], block["residual"], block["normalized"], block["inlier"], strict=True)
-        for t, r, z, ok in rows:
-            values = ",".join(repr(float(v)) for v in (t, *r))
-            normalized = ",".join(f"{float(v):.6g}" for v in z)
-            lines.append(f"{sensor},{values},{normalized},{int(ok)}")
-    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
+        "normalized: divided by the noise sigma; inlier: 0 for an outlier\n"
+        "sensor,t_s,residual_x,residual_y,residual_z,normalized_x,normalized_y,normalized_z,"
+        "inlier\n"
+    )
+    with open(path, "wb") as stream:
+        stream.write(header.encode("utf-8"))
+        for sensor, block in fit.residuals.items():
+            count = len(block["t"])
+            columns = {
+                "sensor": pa.array(np.full(count, sensor)),
+                "t_s": pa.array(np.asarray(block["t"], dtype=np.float64)),
+            }
+            for k, axis in enumerate("xyz"):
+                columns[f"residual_{axis}"] = pa.array(block["residual"][:, k])
+            for k, axis in enumerate("xyz"):
+                columns[f"normalized_{axis}"] = pa.array(_six_digits(block["normalized"][:, k]))
+            columns["inlier"] = pa.array(block["inlier"].astype(np.int8))
+            pa_csv.write_csv(
+                pa.table(columns),
+                stream,
+                pa_csv.WriteOptions(include_header=False, quoting_style="none"),
+            )
+
+
+def _six_digits(values: NDArray[np.float64]) -> NDArray[np.float64]:
+    """Each value rounded to six significant digits (written shortest, it reads so)."""
+    values = np.asarray(values, dtype=np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        exponent = np.floor(np.log10(np.abs(values)))
+        scale = np.where(np.isfinite(exponent), 10.0 ** (5.0 - exponent), 1.0)
+        rounded = np.round(values * scale) / scale
+    return np.where(np.isfinite(rounded), rounded, values)
 
 
 def _plot_residuals(fit: SpinStateFit, path: Path) -> str:
@@ -327,8 +458,11 @@ def _plot_residuals(fit: SpinStateFit, path: Path) -> str:
     for axes, sensor in zip(panels[:-1], sensors, strict=True):
         block = fit.residuals[sensor]
         t, z, ok = block["t"], block["normalized"], block["inlier"]
+        # At most PLOTTED_POINTS dots an axis, evenly: a million dots on a 900-pixel
+        # panel show the same band as these (the outliers are all drawn).
+        shown = np.flatnonzero(ok)[:: max(1, math.ceil(np.count_nonzero(ok) / PLOTTED_POINTS))]
         for k, (axis, colour) in enumerate(zip("xyz", ("C0", "C1", "C2"), strict=True)):
-            axes.plot(t[ok], z[ok, k], ".", markersize=2, color=colour, label=axis)
+            axes.plot(t[shown], z[shown, k], ".", markersize=2, color=colour, label=axis)
         if np.any(~ok):
             axes.plot(
                 t[~ok],

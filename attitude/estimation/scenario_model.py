@@ -1,5 +1,6 @@
-"""The fitted motion under known torques: gravity gradient on a given orbit, burns, with
-known impulses, through the splitting of ``TorquedSolver``.
+"""The fitted motion under gravity gradient on a given orbit (with the scenario's burns
+and known impulses), through the splitting of ``TorquedSolver``.  Burns without gravity
+gradient are fitted on the exact motion instead (attitude.estimation.burns).
 
 The same parameters and interface as ``ExactModel`` (attitude.estimation.model), but
 the motion is a scenario (attitude.scenario) propagated by ``propagate``: each segment

@@ -21,11 +21,20 @@ and never stopping in a local minimum.
 - **Outliers**: at the end, samples with a normalized residual component beyond
   ``OUTLIER_SIGMA`` are flagged, and the last solve uses plain least squares on the
   others, whose Jacobian then gives the covariance (attitude.estimation.statistics).
+- **Long arcs**: a stage is fitted on at most ``STAGE_SAMPLES`` samples, every k-th of
+  its arc (a stage needs the motion's shape, and a million samples made each stage a
+  minute); the last solve takes them all, beyond ``CHUNKED_ABOVE`` by Gauss–Newton on
+  the R factor of the Jacobian accumulated stretch by stretch, so that the Jacobian of
+  the whole arc (its sensitivities 2.4 GB for a million gyro samples) is never in
+  memory at once.  ``progress`` hears of each stage, with the time left.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
+import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -54,6 +63,13 @@ RMS_LIMIT = 2.0
 OUTLIER_SIGMA = 5.0
 # The robust loss is quadratic within this many σ.
 ROBUST_SCALE = 3.0
+# A stage of the growing arc is fitted on at most about this many samples (evenly
+# thinned); the last solve, which gives the covariance, on all of them.
+STAGE_SAMPLES = 20_000
+# Beyond this many samples, the last solve is Gauss–Newton on the Jacobian's R factor
+# accumulated over stretches of CHUNK_SAMPLES (its memory then stays bounded).
+CHUNKED_ABOVE = 200_000
+CHUNK_SAMPLES = 50_000
 # How far the arc grows: predicted 1σ within these fractions of the signal.
 RATE_FRACTION = 0.05
 ATTITUDE_RAD = 0.1
@@ -106,6 +122,34 @@ class Data:
             self.σ_attitude,
         )
 
+    def thinned(self, limit: int) -> Data:
+        """At most about ``limit`` samples: every k-th of each sensor, its last kept (the
+        arc's end), the inliers' marks with them.  A stage of the growing arc needs the
+        motion's shape, not every sample of a long arc: the last solve has them all."""
+        if self.count <= limit:
+            return self
+        step = math.ceil(self.count / limit)
+
+        def every(times):
+            if times is None:
+                return None
+            keep = np.zeros(times.size, dtype=bool)
+            keep[::step] = True
+            keep[-1] = True
+            return keep
+
+        g, a = every(self.t_rates), every(self.t_attitude)
+        return Data(
+            None if g is None or self.t_rates is None else self.t_rates[g],
+            None if g is None or self.rates is None else self.rates[g],
+            self.σ_rates,
+            None if a is None or self.t_attitude is None else self.t_attitude[a],
+            None if a is None or self.attitude is None else self.attitude[a],
+            self.σ_attitude,
+            None if g is None or self.rate_inliers is None else self.rate_inliers[g],
+            None if a is None or self.attitude_inliers is None else self.attitude_inliers[a],
+        )
+
     @property
     def times(self) -> NDArray[np.float64]:
         parts = [t for t in (self.t_rates, self.t_attitude) if t is not None]
@@ -147,7 +191,7 @@ class Solution:
     x: NDArray[np.float64]
     data: Data
     r: NDArray[np.float64]
-    jac: NDArray[np.float64]
+    jac: NDArray[np.float64]  # or its R factor (the same JᵀJ) after a chunked last solve
     start: str
     stages: list[tuple[float, float]] = field(default_factory=list)  # (arc end, RMS)
     tried: list[str] = field(default_factory=list)  # the starts that failed, and why
@@ -176,7 +220,11 @@ def _solve(model, x0, data: Data, robust: bool, max_nfev: int = 100):
     def fun(z):
         return residuals(model, full(z), data, False)
 
+    first = x0[active].copy()
+
     def jac(z):
+        if np.array_equal(z, first):  # least_squares starts where J0 was taken
+            return J0[:, active]
         return residuals(model, full(z), data, True)[1][:, active]
 
     result = least_squares(
@@ -246,8 +294,55 @@ def _predicted_sigma(model, x, cov, data: Data, times: NDArray[np.float64]):
     return σ_rate, σ_attitude
 
 
+class _Clock:
+    """What the fit has done and how long the rest should take, for ``progress``: the
+    stages' wall time so far, the arc's growth per stage, and the last solve's cost
+    from the stages' cost per sample."""
+
+    def __init__(self, progress: Callable[[str], None] | None, data: Data):
+        self.say = progress or (lambda text: None)
+        self.data = data
+        self.times = data.times
+        self.stages: list[tuple[float, float, int]] = []  # (arc end, wall s, samples)
+        self.mark = time.perf_counter()
+
+    def stage(self, t_end: float, samples: int, rms: float) -> None:
+        now = time.perf_counter()
+        self.stages.append((t_end, now - self.mark, samples))
+        self.mark = now
+        t_first, t_last = float(self.times[0]), float(self.times[-1])
+        done = (t_end - t_first) / max(t_last - t_first, 1e-300)
+        self.say(
+            f"fit: arc to t = {t_end:.6g} s of {t_last:.6g} s ({100.0 * done:.0f} %) on "
+            f"{samples} samples, residuals {rms:.3g} σ; {self.rest(t_end)}"
+        )
+
+    def rest(self, t_end: float) -> str:
+        """'about N s more' from the stages so far (the growing arc's remaining stages
+        at their mean cost, and the last solve at their cost per sample)."""
+        walls = [w for _, w, _ in self.stages]
+        per_sample = sum(walls) / max(sum(n for _, _, n in self.stages), 1)
+        t_first, t_last = float(self.times[0]), float(self.times[-1])
+        length = max(t_end - t_first, 1e-300)
+        growth = 4.0
+        if len(self.stages) > 1:
+            lengths = [max(e - t_first, 1e-300) for e, _, _ in self.stages]
+            growth = max(min((lengths[-1] / lengths[0]) ** (1.0 / (len(lengths) - 1)), 4.0), 1.25)
+        remaining = math.ceil(math.log(max((t_last - t_first) / length, 1.0)) / math.log(growth))
+        # The last solve: a few passes over every sample, each about half a stage's
+        # cost per sample (measured on a million-sample arc).
+        estimate = remaining * sum(walls) / len(walls) + 0.5 * per_sample * self.data.count
+        return f"about {estimate:.2g} s more" if estimate >= 1.0 else "under a second more"
+
+    def final(self) -> None:
+        self.say(
+            f"fit: the last solve on all {self.data.count} samples (outliers marked), then "
+            f"the covariance; {self.rest(float(self.times[-1]))}"
+        )
+
+
 def _progressive(
-    model, x, data: Data, first_end: float, label: str
+    model, x, data: Data, first_end: float, label: str, clock: _Clock | None = None
 ) -> Solution | tuple[str, float]:
     """One start through the growing arcs; a Solution, or why it failed and the end of
     the arc on which it did."""
@@ -257,7 +352,7 @@ def _progressive(
     stages: list[tuple[float, float]] = []
     bridges: list[str] = []
     while True:
-        arc = data.until(t_end)
+        arc = data.until(t_end).thinned(STAGE_SAMPLES)
         try:
             x = _solve(model, x, arc, robust=True)
         except (ValueError, np.linalg.LinAlgError, InputError) as exc:
@@ -265,6 +360,8 @@ def _progressive(
         model, x = model.recentred(x)
         rms = _inlier_rms(residuals(model, x, arc, False))
         stages.append((t_end, rms))
+        if clock is not None:
+            clock.stage(t_end, arc.count, rms)
         if not math.isfinite(rms) or rms > RMS_LIMIT:
             return (
                 f"{label}: a local minimum on the arc to t = {t_end:.6g} s (RMS of the "
@@ -300,14 +397,78 @@ def _final(solution: Solution) -> Solution:
         attitude_inliers = np.all(block <= OUTLIER_SIGMA, axis=1)
     data = replace(data, rate_inliers=rate_inliers, attitude_inliers=attitude_inliers)
     clean = data.until(np.inf, inliers_only=True)
+    if clean.count > CHUNKED_ABOVE and getattr(model, "torques", None) is None:
+        x, R = _chunked_gauss_newton(model, x, clean)
+        model, x = model.recentred(x)
+        return replace(
+            solution, model=model, x=x, data=data, r=residuals(model, x, clean, False), jac=R
+        )
     x = _solve(model, x, clean, robust=False)
     model, x = model.recentred(x)
     r, J = residuals(model, x, clean, True)
     return replace(solution, model=model, x=x, data=data, r=r, jac=J)
 
 
+def _pieces(data: Data, size: int):
+    """``data`` in consecutive stretches of about ``size`` samples (both sensors cut at
+    the same times)."""
+    times = data.times
+    edges = [-np.inf, *times[size::size].tolist(), np.inf]
+    for lo, hi in itertools.pairwise(edges):
+        t_r, rates = _between(data.t_rates, data.rates, lo, hi)
+        t_a, attitude = _between(data.t_attitude, data.attitude, lo, hi)
+        if t_r is not None or t_a is not None:
+            yield Data(t_r, rates, data.σ_rates, t_a, attitude, data.σ_attitude)
+
+
+def _between(t, values, lo: float, hi: float):
+    """The samples (times, values) in [lo, hi), or (None, None) if none."""
+    if t is None or values is None:
+        return None, None
+    keep = (t >= lo) & (t < hi)
+    return (t[keep], values[keep]) if np.any(keep) else (None, None)
+
+
+def _chunked_gauss_newton(model, x, data: Data, iterations: int = 8):
+    """Least squares on a long arc without its Jacobian in memory: Gauss–Newton steps
+    from the growing arc's solution (already within a few σ of the optimum), each from
+    the R factor of the Jacobian accumulated stretch by stretch (a QR of [R; J_k]: no
+    normal equations formed), with a halved step if a step does not lower the cost.
+    The solution and R at it: RᵀR = JᵀJ, all that the covariance needs."""
+
+    def accumulate(x):
+        R = np.zeros((0, x.size))
+        z = np.zeros(0)
+        cost = 0.0
+        for piece in _pieces(data, CHUNK_SAMPLES):
+            r, J = residuals(model, x, piece, True)
+            cost += float(r @ r)
+            Q, R = np.linalg.qr(np.vstack([R, J]))
+            z = Q.T @ np.concatenate([z, r])
+        return R, z, cost
+
+    R, z, cost = accumulate(x)
+    for _ in range(iterations):
+        step = -np.linalg.lstsq(R, z, rcond=None)[0]  # R δ = −Qᵀr
+        expected = float(z @ z) - float((z + R @ step) @ (z + R @ step))
+        if expected <= 1e-10 * max(cost, 1.0):
+            break
+        for _ in range(8):
+            trial = x + step
+            R_trial, z_trial, cost_trial = accumulate(trial)
+            if cost_trial <= cost:
+                x, R, z, cost = trial, R_trial, z_trial, cost_trial
+                break
+            step = 0.5 * step
+        else:
+            break
+    return x, R
+
+
 def fit_from_starts(
-    starts: list[tuple[Any, NDArray[np.float64], str, float]], data: Data
+    starts: list[tuple[Any, NDArray[np.float64], str, float]],
+    data: Data,
+    progress: Callable[[str], None] | None = None,
 ) -> Solution:
     """The first start (model, x, label, first arc end) to fit the whole arc with
     residuals at the noise, after the outliers are set aside; ``FitRefused`` if none.
@@ -316,13 +477,14 @@ def fit_from_starts(
     quarter as long (down to its first 20 samples), twice at most: a minimum that the
     growing arc walked into is usually a cycle slip that a shorter first arc avoids."""
     failures = []
+    clock = _Clock(progress, data)
     times = data.times
     t_first = float(times[0])
     shortest = float(times[min(times.size - 1, 19)])
     for model, x, label, first_end in starts:
         end = first_end
         for attempt in range(3):
-            outcome = _progressive(model, x, data, end, label)
+            outcome = _progressive(model, x, data, end, label, clock)
             if isinstance(outcome, Solution):
                 break
             message, failed_at = outcome
@@ -332,6 +494,7 @@ def fit_from_starts(
                 break
         if not isinstance(outcome, Solution):
             continue
+        clock.final()
         final = _final(outcome)
         if final.rms > RMS_LIMIT:
             failures.append(f"{label}: residuals {final.rms:.3g} σ after the outliers")

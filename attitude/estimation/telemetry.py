@@ -28,6 +28,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.spatial.transform import Rotation
 
 from attitude.base.errors import InputError
 from attitude.base.quantities import as_si_array
@@ -65,6 +66,8 @@ class Telemetry:
     epoch: Any = None
     source: str = "telemetry"
     notes: list[str] = field(default_factory=list)
+    # The gyro read exactly 0 on every axis at every one of its (two or more) readings.
+    gyro_reads_zero: bool = False
 
     @property
     def span(self) -> tuple[float, float]:
@@ -167,18 +170,27 @@ def _sensor(
 def _frozen(values: NDArray[np.float64]) -> NDArray[np.bool_]:
     """The repeats (not the first reading) of runs of ``FROZEN_RUN`` or more identical rows."""
     repeat = np.concatenate([[False], np.all(values[1:] == values[:-1], axis=1)])
+    # Runs of repeats: [start, stop) where ``repeat`` is True; a run of k repeats is a
+    # run of k + 1 identical readings.
+    edges = np.diff(np.concatenate([[0], repeat.astype(np.int8), [0]]))
+    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
     frozen = np.zeros(len(values), dtype=bool)
-    k = 0
-    while k < len(values):
-        if not repeat[k]:
-            k += 1
-            continue
-        start = k
-        while k < len(values) and repeat[k]:
-            k += 1
-        if k - start + 1 >= FROZEN_RUN:
-            frozen[start:k] = True
+    for start, stop in zip(starts, stops, strict=True):
+        if stop - start + 1 >= FROZEN_RUN:
+            frozen[start:stop] = True
     return frozen
+
+
+def _rotation_quaternions(attitude: Rotation, count: int, source: str) -> NDArray[np.float64]:
+    """N attitudes given as a ``Rotation`` (one per time) as (N, 4) quaternions, scalar
+    first."""
+    if attitude.single or len(attitude) != count:
+        shown = "a single rotation" if attitude.single else f"{len(attitude)} rotations"
+        raise InputError(
+            f"quaternions as a Rotation must hold one attitude per time ({count}), got {shown}",
+            file=source,
+        )
+    return attitude.as_quat(scalar_first=True)
 
 
 def prepare_telemetry(
@@ -191,7 +203,8 @@ def prepare_telemetry(
 
     ``times``: an astropy ``Time`` array or seconds; ``angular_velocity``: (N, 3) body
     rates, rad/s (or a ``Quantity``); ``quaternions``: (N, 4) body → ICRF, scalar first
-    (w, x, y, z).  Rows of NaN are missing readings of that kind.
+    (w, x, y, z), or a ``scipy.spatial.transform.Rotation`` of N attitudes (body →
+    ICRF).  Rows of NaN are missing readings of that kind.
     """
     if angular_velocity is None and quaternions is None:
         raise InputError("give angular_velocity, quaternions or both", file=source)
@@ -207,8 +220,11 @@ def prepare_telemetry(
         ω, present = _readings(
             angular_velocity, "angular_velocity", 3, t.size, source, "angular_velocity"
         )
+        zero = int(np.count_nonzero(present)) >= 2 and not np.any(ω[present])
         gyro = _sensor(t, ω, present, "angular_velocity", source, notes)
     if quaternions is not None:
+        if isinstance(quaternions, Rotation):  # what the package returns: an attitude
+            quaternions = _rotation_quaternions(quaternions, t.size, source)
         q, present = _readings(quaternions, "dimensionless", 4, t.size, source, "quaternions")
         norm = np.linalg.norm(np.where(present[:, None], q, 1.0), axis=1)
         bad = present & (np.abs(norm - 1.0) > NORM_TOLERANCE)
@@ -225,6 +241,7 @@ def prepare_telemetry(
     if gyro is None and attitude is None:
         raise InputError("every reading is missing", file=source)
     telemetry = Telemetry(gyro, attitude, epoch, source, notes)
+    telemetry.gyro_reads_zero = angular_velocity is not None and zero
     for sensor, name in ((gyro, "angular_velocity"), (attitude, "quaternions")):
         if sensor is not None and len(sensor) > 2:
             gaps = np.diff(sensor.t)

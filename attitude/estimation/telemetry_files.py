@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import csv
 import re
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -49,6 +50,8 @@ _QUATERNION = "wxyz"
 _TIME_NAMES = {"time", "epoch", *(f"time_{scale}" for scale in SCALES)}
 _EPOCH_LINE = re.compile(r"^#\s*epoch:\s*(\S+)\s+([A-Za-z]+)")
 _ERROR_CELL = re.compile(r"In CSV column #(\d+): Row #(\d+): .*?invalid value '([^']*)'")
+_ERROR_WIDTH = re.compile(r"Expected (\d+) columns, got (\d+): (.*)")
+_BOM = b"\xef\xbb\xbf"
 
 
 @dataclass
@@ -84,7 +87,14 @@ def read_telemetry(
         raise InputError(f"cannot read: {exc.strerror or exc}", file=str(path)) from None
     if head.startswith(b"PAR1"):
         return _parquet(path, time_scale, epoch)
-    if head.lstrip().startswith(b"CCSDS_AEM_VERS"):
+    marked = head.startswith(_BOM)  # a UTF-8 byte-order mark, as Excel writes
+    if head[len(_BOM) if marked else 0 :].lstrip().startswith(b"CCSDS_AEM_VERS"):
+        if marked:
+            raise InputError(
+                "begins with a UTF-8 byte-order mark: a CCSDS AEM in KVN is ASCII text "
+                "(CCSDS 504.0-B-2); save it without the mark",
+                file=name,
+            )
         return _aem(path)
     if b"\x00" in head:
         raise InputError("a binary file, not telemetry (CSV, Parquet or CCSDS AEM)", file=name)
@@ -155,7 +165,9 @@ def _columns(names: list[str], file: str) -> dict[str, Any]:
 
 
 def _numbers(table, column: str, file: str) -> NDArray[np.float64]:
-    """A column as float64, nulls as NaN; a cell that is not a number is refused."""
+    """A column as float64, nulls as NaN; a cell that is not a decimal number is
+    refused, naming its row (a CSV's cells are read as texts: Arrow's own inference
+    takes '0x10' for 16)."""
     import pyarrow as pa
     import pyarrow.compute as pc
 
@@ -163,17 +175,19 @@ def _numbers(table, column: str, file: str) -> NDArray[np.float64]:
     if not (pa.types.is_floating(values.type) or pa.types.is_integer(values.type)):
         if pa.types.is_null(values.type):
             return np.full(len(values), np.nan)
-        texts = values.cast(pa.string())
-        for row, text in enumerate(texts.to_pylist()):
-            if text is None or text.strip().lower() in ("", "nan"):
-                continue
-            try:
-                float(text)
-            except ValueError:
-                raise InputError(
-                    f"{text!r} is not a number", file=file, key=f"row {row}, column {column}"
-                ) from None
-        values = pc.cast(texts, pa.float64())
+        texts = pc.utf8_trim_whitespace(values.cast(pa.string()))
+        texts = pc.if_else(pc.equal(texts, ""), pa.scalar(None, pa.string()), texts)
+        try:
+            values = pc.cast(texts, pa.float64())
+        except pa.ArrowInvalid:
+            for row, text in enumerate(texts.to_pylist()):
+                try:
+                    pc.cast(pa.array([text], pa.string()), pa.float64())
+                except pa.ArrowInvalid:
+                    raise InputError(
+                        f"{text!r} is not a number", file=file, key=f"row {row}, column {column}"
+                    ) from None
+            raise  # pragma: no cover (the column failed and no cell does)
     array = values.to_numpy(zero_copy_only=False).astype(np.float64)
     return np.where(np.isnan(array), np.nan, array)
 
@@ -232,14 +246,26 @@ def _iso_times(texts: NDArray, scale: str, file: str, column: str):
         row = int(np.flatnonzero(missing)[0])
         raise InputError("no time", file=file, key=f"row {row}, column {column}")
     cleaned = np.char.rstrip(np.char.strip(texts.astype(str)), "Z")
+    from erfa import ErfaWarning
+
     try:
-        with offline_time():
+        # ERFA only warns of a second 61 of a minute that has no leap second: refused.
+        with offline_time(), warnings.catch_warnings():
+            warnings.simplefilter("error", ErfaWarning)
             return Time(cleaned, format="isot", scale=scale, precision=9)
-    except (ValueError, TypeError):
+    except (ValueError, TypeError, ErfaWarning):
         for row, text in enumerate(cleaned):
             try:
-                with offline_time():
+                with offline_time(), warnings.catch_warnings():
+                    warnings.simplefilter("error", ErfaWarning)
                     Time(text, format="isot", scale=scale)
+            except ErfaWarning:
+                raise InputError(
+                    f"{str(text)!r} is not an instant of {scale.upper()}: its seconds run "
+                    "past the end of the minute (only a leap second has a 60th)",
+                    file=file,
+                    key=f"row {row}, column {column}",
+                ) from None
             except (ValueError, TypeError):
                 raise InputError(
                     f"{str(text)!r} is not an ISO 8601 epoch",
@@ -257,7 +283,8 @@ def _csv(path: Path, head: bytes, time_scale, epoch) -> TelemetryFile:
     from pyarrow import csv as pa_csv
 
     file = path.name
-    lines = head.decode("utf-8", errors="replace").splitlines()
+    # "utf-8-sig": a byte-order mark (Excel's "CSV UTF-8") is not part of the header.
+    lines = head.decode("utf-8-sig", errors="replace").splitlines()
     comments = 0
     notes: list[str] = []
     for line in lines:
@@ -266,15 +293,24 @@ def _csv(path: Path, head: bytes, time_scale, epoch) -> TelemetryFile:
         comments += 1
         found = _EPOCH_LINE.match(line)
         if found and epoch is None:
-            epoch = as_time(found.group(1), found.group(2).lower(), f"{file}: # epoch")
-    header = next(csv.reader([lines[comments]])) if comments < len(lines) else []
-    # Epoch texts stay texts (Arrow would parse them as POSIX timestamps, which have no
-    # leap second), and so do the numbers, until each column is checked.
-    texts = {name: pa.string() for name in header if name.strip().lower() in _TIME_NAMES}
+            try:
+                epoch = as_time(found.group(1), found.group(2).lower(), "# epoch")
+            except InputError as exc:
+                raise exc.located(file=file) from None
+    first = lines[comments] if comments < len(lines) else ""
+    # A semicolon-separated table (what a spreadsheet in a locale with decimal commas
+    # writes as "CSV") when its header has semicolons and no comma.
+    delimiter = ";" if ";" in first and "," not in first else ","
+    header = next(csv.reader([first], delimiter=delimiter)) if first else []
+    # Every cell is read as text: epochs (Arrow would parse them as POSIX timestamps,
+    # which have no leap second) and numbers (its inference reads '0x10' as 16), each
+    # column then converted and checked (_numbers, _iso_times).
+    texts = {name: pa.string() for name in header}
     try:
         table = pa_csv.read_csv(
             path,
             read_options=pa_csv.ReadOptions(skip_rows=comments),
+            parse_options=pa_csv.ParseOptions(delimiter=delimiter),
             convert_options=pa_csv.ConvertOptions(
                 column_types=texts,
                 strings_can_be_null=True,
@@ -282,11 +318,34 @@ def _csv(path: Path, head: bytes, time_scale, epoch) -> TelemetryFile:
             ),
         )
     except pa.ArrowInvalid as exc:
-        raise InputError(f"not a CSV table: {str(exc).splitlines()[0][:200]}", file=file) from None
+        raise _csv_error(str(exc), path, comments, delimiter) from None
     except OSError as exc:
         raise InputError(f"cannot read: {exc}", file=str(path)) from None
     columns = _columns(table.column_names, file)
     return _assemble(table, columns, file, time_scale, epoch, notes)
+
+
+def _csv_error(text: str, path: Path, comments: int, delimiter: str) -> InputError:
+    """Arrow's complaint about a table, in the words of this module: which row, and
+    what is wrong with it."""
+    found = _ERROR_WIDTH.search(text)
+    if found:
+        expected, got, line = int(found.group(1)), int(found.group(2)), found.group(3)
+        row = None
+        with open(path, encoding="utf-8-sig", errors="replace") as stream:
+            for number, content in enumerate(stream):
+                if content.rstrip("\r\n") == line:
+                    row = number - comments - 1  # the data rows' numbering, from 0
+                    break
+        where = f"row {row}" if row is not None and row >= 0 else None
+        return InputError(
+            f"{got} cell{'s' if got != 1 else ''} where the header has {expected} "
+            f"(cells separated by {delimiter!r}): {line[:120]!r}",
+            file=path.name,
+            key=where,
+        )
+    first = text.splitlines()[0] if text else "unreadable"
+    return InputError(f"not a CSV table: {first[:200]}", file=path.name)
 
 
 def _parquet(path: Path, time_scale, epoch) -> TelemetryFile:
@@ -297,16 +356,23 @@ def _parquet(path: Path, time_scale, epoch) -> TelemetryFile:
     try:
         table = pq.read_table(path)
     except (pa.ArrowInvalid, OSError) as exc:
-        raise InputError(
-            f"not a readable Parquet file: {str(exc).splitlines()[0][:200]}", file=file
-        ) from None
+        text = str(exc).splitlines()[0] if str(exc) else ""
+        reason = (
+            "no Parquet footer (the file is cut short, or not Parquet)"
+            if "magic bytes" in text
+            else text[:200]
+        )
+        raise InputError(f"not a readable Parquet file: {reason}", file=file) from None
     metadata = table.schema.metadata or {}
     stated = metadata.get(b"attitude.epoch")
     if epoch is None and stated:
         text = stated.decode()
         parts = text.split()
         if len(parts) == 2:
-            epoch = as_time(parts[0], parts[1].lower(), f"{file}: attitude.epoch")
+            try:
+                epoch = as_time(parts[0], parts[1].lower(), "attitude.epoch")
+            except InputError as exc:
+                raise exc.located(file=file) from None
     columns = _columns(table.column_names, file)
     return _assemble(table, columns, file, time_scale, epoch, [])
 
@@ -319,7 +385,11 @@ def _aem(path: Path) -> TelemetryFile:
     from attitude.files.aem_reader import INERTIAL, TYPES
 
     file = path.name
-    message, _ = read_message(path, "Aem")
+    try:
+        message, _ = read_message(path, "Aem")
+    except InputError as exc:  # its reason starts with the file's name: said once
+        reason = exc.reason.removeprefix(f"{file}: ").removeprefix(f"{path}: ")
+        raise InputError(reason, file=file) from None
     if str(message.version).strip() not in ("2.0", "2"):
         raise InputError(f"CCSDS_AEM_VERS = {message.version}: only AEM 2.0 is read", file=file)
     times, quats, rates = [], [], []

@@ -122,6 +122,7 @@ from typing import TYPE_CHECKING, Any, BinaryIO
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.spatial.transform import Rotation
 
 from attitude.base.errors import InputError
 from attitude.environment.timescales import as_time, iso_texts, offline_time, tt_seconds
@@ -180,7 +181,8 @@ class AemSegment:
 
     - ``times``: 1-D ``astropy.time.Time``, strictly increasing (compared in TT), any scale.
     - ``quaternion_body_to_inertial_scalar_first``: (N, 4), unit quaternions (w, x, y, z)
-      taking body coordinates to inertial ones.
+      taking body coordinates to inertial ones, or a ``Rotation`` of N attitudes (body →
+      inertial).
     - ``angular_velocity_body_rad_s``: (N, 3), the body's angular velocity with respect
       to inertial space, in body axes, rad/s.
     - ``comments``: optional lines written at the start of the segment's metadata.
@@ -198,6 +200,10 @@ class AemSegment:
     def __post_init__(self) -> None:
         times = _checked_times(self.times)
         n = len(times)
+        attitude = self.quaternion_body_to_inertial_scalar_first
+        if isinstance(attitude, Rotation):  # an attitude, as the package returns them
+            attitude = attitude.as_quat(scalar_first=True)
+            object.__setattr__(self, "quaternion_body_to_inertial_scalar_first", attitude)
         quaternions = _checked_array(
             "quaternion_body_to_inertial_scalar_first",
             self.quaternion_body_to_inertial_scalar_first,

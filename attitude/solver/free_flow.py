@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from scipy.spatial.transform import Rotation
 
 from attitude.base.errors import InputError
 from attitude.base.quantities import as_si_array
@@ -74,7 +75,8 @@ def advance(
     angular_momentum
         (3,) or (N, 3): body-frame angular momentum, N m s.
     quaternion_wxyz
-        (4,) or (N, 4): attitude, body → inertial, scalar FIRST; normalized here.
+        (4,) or (N, 4): attitude, body → inertial, scalar FIRST; normalized here.  Or a
+        ``scipy.spatial.transform.Rotation`` (one, or a stack of N), body → inertial.
     dt
         scalar or (N,): time steps, s, any sign.
 
@@ -92,6 +94,8 @@ def advance(
     """
     moments = _as_floats(inertia, "moment_of_inertia", "inertia")
     m = _as_floats(angular_momentum, "angular_momentum", "angular_momentum")
+    if isinstance(quaternion_wxyz, Rotation):  # an attitude, as the package returns them
+        quaternion_wxyz = quaternion_wxyz.as_quat(scalar_first=True)
     q = _as_floats(quaternion_wxyz, None, "quaternion_wxyz")
     τ = _as_floats(dt, "time", "dt")
     if moments.shape == (3,) and m.shape == (3,) and q.shape == (4,) and τ.ndim == 0:
